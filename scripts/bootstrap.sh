@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# One entry point for a fresh Debian 12 machine (run as root, or with sudo available):
+#   scripts/bootstrap.sh run   [SCENARIO]   install missing packages, build, run the default scenario
+#   scripts/bootstrap.sh test               install missing packages, build, run the whole test suite
+# Installs only Debian packages that are missing, so a second call skips apt entirely.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(build-essential cmake pkg-config sumo libeigen3-dev libyaml-cpp-dev catch2 libcli11-dev
+  nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev gnuplot-nox)
+BUILD_DIR=${DUALGRID_BUILD_DIR:-build}
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "bootstrap: installing missing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$BUILD_DIR" -j "$(nproc)"
+
+case "${1:-run}" in
+  run)
+    scenario=${2:-scenarios/highway.yaml}
+    "$BUILD_DIR/tools/dualgrid" run "$scenario" --out "run/$(basename "$scenario" .yaml)"
+    ;;
+  test)
+    ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)"
+    ;;
+  *)
+    echo "usage: scripts/bootstrap.sh run [SCENARIO] | test" >&2
+    exit 2
+    ;;
+esac
