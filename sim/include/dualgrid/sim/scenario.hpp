@@ -1,0 +1,114 @@
+// Traffic scenario parameters: what SUMO runs. Filled by the scenario loader, validated here.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+
+namespace dualgrid::sim {
+
+/// A vehicle class: SUMO vType attributes plus the radar cross-section the radar model uses.
+struct VehicleTypeSpec {
+  double length = 4.5;               ///< [m]
+  double width = 1.8;                ///< [m]
+  double max_speed = 40.0;           ///< [m/s] vehicle limit
+  double accel = 2.6;                ///< [m/s^2]
+  double decel = 4.5;                ///< [m/s^2]
+  double speed_factor_dev = 0.1;     ///< std of SUMO's speed factor (desired speed spread)
+  double rcs_dbsm = 10.0;            ///< radar cross-section [dBsm]
+  std::string vclass = "passenger";  ///< SUMO vClass
+  bool overtake_right = false;  ///< SUMO lcOvertakeRight: may pass slower vehicles on their right
+};
+
+/// How the ego's speed is chosen.
+struct SpeedPolicy {
+  enum class Mode { kCruise, kFixed };
+  /// kCruise: SUMO drives with `speed` as desired speed (car following applies);
+  /// kFixed: the speed is imposed every step (traffic is ignored).
+  Mode mode = Mode::kCruise;
+  double speed = 27.78;  ///< [m/s]
+};
+
+/// One explicitly placed vehicle (the ego uses the same fields).
+struct VehicleSpec {
+  std::string id;
+  std::string type = "car";
+  std::string route;      ///< name of an entry of ScenarioSpec::routes
+  double depart = 0.0;    ///< [s]
+  int lane = 0;           ///< departure lane index (0 = rightmost)
+  double position = 0.0;  ///< [m] departure position of the front bumper along the first edge
+  double speed = 27.78;   ///< [m/s] departure speed
+  std::optional<double> desired_speed;  ///< [m/s] cruise speed; default: SUMO's speed factor
+  bool lane_change = true;              ///< false: SUMO never changes its lane on its own
+};
+
+/// A SUMO flow: vehicles of one type on one route at a fixed period.
+struct FlowSpec {
+  std::string id;
+  std::string type = "car";
+  std::string route;
+  double begin = 0.0;         ///< [s]
+  double end = 60.0;          ///< [s]
+  double period = 5.0;        ///< [s] between departures
+  std::string lane = "best";  ///< SUMO departLane: an index, "random", "free", "best"
+  double position = 0.0;      ///< [m] departure position along the first edge
+  double speed_min = 19.44;   ///< [m/s] desired speeds are drawn in [speed_min, speed_max]
+  double speed_max = 36.11;   ///< [m/s]
+};
+
+/// A scripted event at a time: a speed change or a lane change of one vehicle.
+struct ActionSpec {
+  double time = 0.0;  ///< [s]
+  std::string vehicle;
+  std::optional<double> set_speed;  ///< [m/s] new desired speed
+  std::optional<int> change_lane;   ///< target lane index
+  double duration = 3.0;  ///< [s] how long SUMO keeps the lane-change request / speed ramp
+};
+
+/// A guard rail (or any thin static line) in world coordinates.
+struct GuardRail {
+  std::string id;
+  std::vector<Position> points;
+  double rcs_dbsm_per_metre = 0.0;  ///< [dBsm per metre of rail]
+};
+
+/// A parked vehicle or other static box.
+struct ParkedBox {
+  std::string id;
+  OrientedBox box;
+  double rcs_dbsm = 10.0;
+};
+
+struct ScenarioSpec {
+  std::string name;
+  std::string description;
+  std::string network;        ///< network name, resolved to <network dir>/<name>.net.xml
+  double duration = 60.0;     ///< [s]
+  double step_length = 0.05;  ///< [s] SUMO step = radar cycle
+  std::uint64_t seed = 1;
+  double lane_change_duration = 3.0;  ///< [s] SUMO --lanechange.duration: continuous lane changes
+
+  std::map<std::string, VehicleTypeSpec> vehicle_types;
+  std::map<std::string, std::vector<std::string>> routes;  ///< name -> edge ids
+  VehicleSpec ego;
+  SpeedPolicy ego_speed;
+  std::vector<VehicleSpec> vehicles;
+  std::vector<FlowSpec> flows;
+  std::vector<ActionSpec> actions;
+  std::vector<GuardRail> guard_rails;
+  std::vector<ParkedBox> parked;
+
+  /// Checks ranges and cross references; `error` names the offending field.
+  bool IsValid(std::string* error) const;
+  /// Number of simulation steps.
+  int StepCount() const;
+};
+
+/// Speed band of the paper's scenarios (70-130 km/h), used to validate traffic speeds.
+inline constexpr double kMinTrafficSpeed = 0.0;
+inline constexpr double kMaxTrafficSpeed = 70.0;
+
+}  // namespace dualgrid::sim

@@ -1,0 +1,74 @@
+// In-process SUMO (libsumo) driven by a ScenarioSpec.
+//
+// libsumo holds one simulation per process in global state, so at most one SumoSimulation may be
+// alive at a time (a second constructor throws). Run several scenarios or seeds in separate
+// processes (`dualgrid experiment` does).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dualgrid/sim/ground_truth.hpp"
+#include "dualgrid/sim/scenario.hpp"
+
+namespace dualgrid::sim {
+
+/// Default folder of the generated networks (the build's networks/ folder), overridden by the
+/// environment variable DUALGRID_NETWORK_DIR.
+std::filesystem::path DefaultNetworkDir();
+
+/// Resolves a scenario's network name to an existing .net.xml file or throws std::runtime_error
+/// naming the path it looked for.
+std::filesystem::path ResolveNetwork(const std::string& network,
+                                     const std::filesystem::path& network_dir);
+
+/// Writes the SUMO route file (vTypes, routes, vehicles, flows) for a scenario.
+void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path);
+
+class SumoSimulation {
+ public:
+  /// Starts SUMO. `work_dir` receives the generated route file and SUMO's message log.
+  /// Throws std::runtime_error with a one-line message on any SUMO error.
+  SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
+                 const std::filesystem::path& work_dir);
+  ~SumoSimulation();
+  SumoSimulation(const SumoSimulation&) = delete;
+  SumoSimulation& operator=(const SumoSimulation&) = delete;
+
+  /// Advances one step (spec.step_length) and refreshes frame(). Returns false once the scenario
+  /// duration is reached or the ego has left the network.
+  bool Step();
+  /// Ground truth after the last Step().
+  const Frame& frame() const { return frame_; }
+  const ScenarioSpec& spec() const { return spec_; }
+  /// A lane's centre line (world frame) and width, for pictures.
+  struct LaneShape {
+    std::string id;
+    std::vector<Position> points;
+    double width = 3.5;
+  };
+  /// All non-internal lanes of the network.
+  std::vector<LaneShape> LaneShapes() const;
+
+ private:
+  struct LaneGeometry {
+    std::vector<Position> points;
+    std::vector<double> s;  // cumulative length at each point
+  };
+  const LaneGeometry& Lane(const std::string& lane_id);
+  VehicleState ReadVehicle(const std::string& id);
+  void ApplyDepartures();
+  void ApplyActions();
+
+  ScenarioSpec spec_;
+  Frame frame_;
+  int step_ = 0;
+  std::size_t next_action_ = 0;
+  std::map<std::string, LaneGeometry> lanes_;
+  std::map<std::string, double> previous_yaw_;
+  std::uint64_t departures_ = 0;
+};
+
+}  // namespace dualgrid::sim
