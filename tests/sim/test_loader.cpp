@@ -1,0 +1,117 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+#include "dualgrid/scenario/loader.hpp"
+
+using namespace dualgrid;
+using scenario::ConfigError;
+using scenario::LoadScenario;
+
+namespace {
+
+const char* kValid = R"(
+name: tiny
+network: highway
+duration: 5.0
+vehicle_types:
+  car: {length: 4.5, width: 1.8}
+routes:
+  east: [east_1, east_2]
+ego: {type: car, route: east, lane: 1, position: 100, speed: 25}
+traffic:
+  vehicles:
+    - {id: a, type: car, route: east, lane: 0, position: 150, speed: 25}
+  flows:
+    - {id: f, type: car, route: east, begin: 0, end: 5, period: 2}
+actions:
+  - {time: 2.0, vehicle: a, set_speed: 30}
+obstacles:
+  guard_rails:
+    - {id: r, points: [[0, 0], [100, 0]]}
+  parked:
+    - {id: p, center: [10, -5], length: 4.5, width: 1.8}
+)";
+
+std::filesystem::path Write(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "dualgrid_test_loader";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  REQUIRE(pos != std::string::npos);
+  return s.replace(pos, from.size(), to);
+}
+
+// Loads `text` and returns the error message (fails the test if loading succeeds).
+std::string ErrorOf(const std::string& text) {
+  const auto path = Write("bad.yaml", text);
+  try {
+    LoadScenario(path);
+  } catch (const ConfigError& e) {
+    const std::string msg = e.what();
+    CHECK(msg.find(path.string()) != std::string::npos);  // names the file
+    CHECK(msg.find('\n') == std::string::npos);           // one line
+    return msg;
+  }
+  FAIL("expected a ConfigError for:\n" << text);
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("A valid scenario loads with defaults filled in", "[loader]") {
+  const auto c = LoadScenario(Write("ok.yaml", kValid));
+  CHECK(c.sim.name == "tiny");
+  CHECK(c.sim.step_length == Approx(0.05));  // default radar cycle
+  CHECK(c.sim.ego.id == "ego");
+  CHECK_FALSE(c.sim.ego.lane_change);  // the ego keeps its lane by default
+  CHECK(c.sim.routes.at("east").size() == 2);
+  CHECK(c.sim.vehicles.size() == 1);
+  CHECK(c.sim.flows.size() == 1);
+  CHECK(c.sim.actions.at(0).set_speed.value() == Approx(30));
+  CHECK(c.sim.guard_rails.at(0).points.size() == 2);
+  CHECK(c.sim.parked.at(0).box.center.y() == Approx(-5));
+}
+
+TEST_CASE("The shipped scenarios load", "[loader]") {
+  const std::string name = GENERATE("scenarios/highway.yaml", "scenarios/simple_road.yaml");
+  const auto c = LoadScenario(name);
+  CHECK(c.sim.duration > 0);
+  CHECK_FALSE(c.sim.vehicles.empty());
+}
+
+TEST_CASE("Malformed scenarios are rejected naming the key and the expectation", "[loader]") {
+  struct Case {
+    std::string from, to, key, expected;
+  };
+  const Case c = GENERATE(values<Case>({
+      {"duration: 5.0", "duration: five", "'duration'", "expected a number"},
+      {"duration: 5.0", "duration: -5", "'duration'", "> 0"},
+      {"duration: 5.0", "duraton: 5.0", "'duraton'", "not a known setting"},
+      {"network: highway\n", "", "'network'", "required"},
+      {"lane: 1,", "lane: one,", "'ego.lane'", "expected an integer"},
+      {"route: east, lane: 0", "route: west, lane: 0", "'traffic.vehicles[0].route'",
+       "unknown route"},
+      {"period: 2}", "period: 2, colour: red}", "'traffic.flows[0].colour'", "not a known setting"},
+      {"set_speed: 30", "set_speed: [30]", "'actions[0].set_speed'", "expected a number"},
+      {"[[0, 0], [100, 0]]", "[[0, 0], [100]]", "'obstacles.guard_rails[0].points[1]'",
+       "expected a point"},
+      {"car: {length: 4.5", "car: {length: 0", "'vehicle_types.car.length'", "must be in"},
+      {"vehicle: a", "vehicle: nobody", "'actions[0].vehicle'", "unknown vehicle"},
+      {"ego: {", "ego: [", "", "not valid YAML"},
+  }));
+  const std::string msg = ErrorOf(Replace(kValid, c.from, c.to));
+  INFO(msg);
+  CHECK(msg.find(c.key) != std::string::npos);
+  CHECK(msg.find(c.expected) != std::string::npos);
+}
+
+TEST_CASE("A missing scenario file is reported", "[loader]") {
+  CHECK_THROWS_WITH(LoadScenario("no/such/file.yaml"), Catch::Contains("not found"));
+}

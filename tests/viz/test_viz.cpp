@@ -1,0 +1,463 @@
+#include <cairo.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dualgrid/core/random.hpp"
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/viz/birds_eye_view.hpp"
+#include "dualgrid/viz/charts.hpp"
+#include "dualgrid/viz/color.hpp"
+#include "dualgrid/viz/grid_panels.hpp"
+#include "dualgrid/viz/map_transform.hpp"
+
+using namespace dualgrid;
+using namespace dualgrid::viz;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path TempDir() {
+  const fs::path dir = fs::temp_directory_path() / "dualgrid_test_viz";
+  fs::create_directories(dir);
+  return dir;
+}
+
+struct Rgb8 {
+  int r, g, b;
+};
+
+// A PNG read back through cairo (the same library that wrote it, but via its decoder).
+class Png {
+ public:
+  explicit Png(const fs::path& path) : surface_(cairo_image_surface_create_from_png(path.c_str())) {
+    REQUIRE(cairo_surface_status(surface_) == CAIRO_STATUS_SUCCESS);
+  }
+  ~Png() { cairo_surface_destroy(surface_); }
+  int width() const { return cairo_image_surface_get_width(surface_); }
+  int height() const { return cairo_image_surface_get_height(surface_); }
+  // Pixel containing the continuous pixel coordinate p (our images are opaque).
+  Rgb8 At(const Vector2& p) const { return At(int(std::floor(p.x())), int(std::floor(p.y()))); }
+  Rgb8 At(int x, int y) const {
+    REQUIRE(x >= 0);
+    REQUIRE(y >= 0);
+    REQUIRE(x < width());
+    REQUIRE(y < height());
+    const unsigned char* data = cairo_image_surface_get_data(surface_);
+    const int stride = cairo_image_surface_get_stride(surface_);
+    const std::uint32_t v = reinterpret_cast<const std::uint32_t*>(data + y * stride)[x];
+    return {int((v >> 16) & 0xFF), int((v >> 8) & 0xFF), int(v & 0xFF)};
+  }
+
+ private:
+  cairo_surface_t* surface_;
+};
+
+// Exact colour up to 8-bit rounding: 1 level per channel.
+bool Near(const Rgb8& p, const Rgba& c, int tol = 1) {
+  return std::abs(p.r - int(std::lround(c.r * 255))) <= tol &&
+         std::abs(p.g - int(std::lround(c.g * 255))) <= tol &&
+         std::abs(p.b - int(std::lround(c.b * 255))) <= tol;
+}
+std::string Str(const Rgb8& p) {
+  return "(" + std::to_string(p.r) + "," + std::to_string(p.g) + "," + std::to_string(p.b) + ")";
+}
+
+void CheckInvalidArgument(const std::function<void()>& f, const std::string& field) {
+  try {
+    f();
+    FAIL("expected std::invalid_argument naming " << field);
+  } catch (const std::invalid_argument& e) {
+    CHECK_THAT(e.what(), Catch::Contains(field));
+  }
+}
+
+GridRaster UnknownRaster(int nx, int ny, double res, Position origin) {
+  GridRaster g;
+  g.cells_x = nx;
+  g.cells_y = ny;
+  g.resolution = res;
+  g.origin = origin;
+  const std::size_t n = std::size_t(nx) * ny;
+  g.free.assign(n, 0.f);
+  g.static_occ.assign(n, 0.f);
+  g.dynamic.assign(n, 0.f);
+  g.mean_vx.assign(n, 0.f);
+  g.mean_vy.assign(n, 0.f);
+  return g;
+}
+
+Position CellCentre(const GridRaster& g, int x, int y) {
+  return g.origin + Vector2((x + 0.5) * g.resolution, (y + 0.5) * g.resolution);
+}
+
+}  // namespace
+
+TEST_CASE("MapTransform: round trip, y up, equal aspect over sampled rectangles",
+          "[viz][property]") {
+  const std::uint32_t index = GENERATE(range(0u, 40u));
+  CounterRng rng(7, RngPurpose::kTest, 0, index);
+  const Position min(rng.Uniform(-500, 500), rng.Uniform(-500, 500));
+  const WorldRect rect{min, min + Vector2(rng.Uniform(5, 300), rng.Uniform(5, 300))};
+  const int width = int(rng.Uniform(100, 3000));
+  const Vector2 offset(rng.Uniform(0, 100), rng.Uniform(0, 100));
+  const MapTransform t(rect, width, offset);
+
+  CHECK(t.scale() == Approx(width / rect.width()));
+  CHECK(t.pixel_height() == std::lround(rect.height() * t.scale()));
+  CHECK((t.ToPixel(Position(rect.min.x(), rect.max.y())) - offset).norm() < 1e-9);
+  CHECK(t.ToPixel(rect.max).x() == Approx(offset.x() + width));
+  for (int k = 0; k < 20; ++k) {
+    const Position p(rng.Uniform(rect.min.x(), rect.max.x()),
+                     rng.Uniform(rect.min.y(), rect.max.y()));
+    const Position q = p + Vector2(rng.Normal(0, 10), rng.Normal(0, 10));
+    CHECK((t.ToWorld(t.ToPixel(p)) - p).norm() < 1e-9);
+    // Equal aspect: pixel distances are world distances times one scale, in every direction.
+    CHECK((t.ToPixel(q) - t.ToPixel(p)).norm() == Approx((q - p).norm() * t.scale()));
+    // y up: moving north moves up the image (smaller row), east moves right.
+    const double d = rng.Uniform(0.1, 10);
+    CHECK(t.ToPixel(p + Vector2(0, d)).y() == Approx(t.ToPixel(p).y() - d * t.scale()));
+    CHECK(t.ToPixel(p + Vector2(d, 0)).x() == Approx(t.ToPixel(p).x() + d * t.scale()));
+    CHECK((t.VectorToPixel(q - p) - (t.ToPixel(q) - t.ToPixel(p))).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("MapTransform rejects degenerate rectangles naming the field", "[viz]") {
+  CheckInvalidArgument([] { MapTransform({{0, 0}, {0, 5}}, 100); }, "world.max.x");
+  CheckInvalidArgument([] { MapTransform({{0, 0}, {5, -1}}, 100); }, "world.max.y");
+  CheckInvalidArgument([] { MapTransform({{0, 0}, {5, 5}}, 0); }, "pixel_width");
+}
+
+TEST_CASE("HueColor is a saturated periodic hue wheel", "[viz][property]") {
+  CHECK(Near({255, 0, 0}, HueColor(0.0)));
+  CHECK(Near({0, 255, 0}, HueColor(2.0 * kPi / 3.0)));
+  CHECK(Near({0, 0, 255}, HueColor(-2.0 * kPi / 3.0)));
+  const double a = GENERATE(range(-7.0, 7.0, 0.13));
+  const Rgba c = HueColor(a), d = HueColor(a + 2.0 * kPi);
+  CHECK(c.r == Approx(d.r).margin(1e-9));
+  CHECK(c.g == Approx(d.g).margin(1e-9));
+  CHECK(c.b == Approx(d.b).margin(1e-9));
+  CHECK(std::max({c.r, c.g, c.b}) == Approx(1.0));
+  CHECK(std::min({c.r, c.g, c.b}) == Approx(0.0).margin(1e-12));
+}
+
+TEST_CASE("CellColor blends masses and thresholds dynamic cells", "[viz][property]") {
+  CHECK(Near({255, 255, 255}, CellColor(1, 0, 0, 0, 0)));
+  CHECK(Near({0, 0, 0}, CellColor(0, 1, 0, 0, 0)));
+  CHECK(Near({128, 128, 128}, CellColor(0, 0, 0, 0, 0)));
+  CHECK(Near({255, 0, 0}, CellColor(0, 0, 1, 5, 0)));
+  CHECK(Near({128, 255, 0}, CellColor(0, 0, 1, 0, 5)));  // hue 90 deg: yellow-green
+
+  const std::uint32_t index = GENERATE(range(0u, 60u));
+  CounterRng rng(11, RngPurpose::kTest, 1, index);
+  // Masses on the simplex (free + static + dynamic <= 1), random direction.
+  double f = rng.Uniform(), s = rng.Uniform(), d = rng.Uniform();
+  const double sum = f + s + d + rng.Uniform(0.0, 1.0);
+  f /= sum, s /= sum, d /= sum;
+  const double angle = rng.Uniform(-kPi, kPi);
+  const float vx = float(3 * std::cos(angle)), vy = float(3 * std::sin(angle));
+  const Rgba hue = HueColor(std::atan2(vy, vx));
+  const double u = 1.0 - f - s - d;
+  const Rgba c = CellColor(float(f), float(s), float(d), vx, vy);
+  CHECK(c.r == Approx(f + 0.5 * u + d * hue.r).margin(1e-6));
+  CHECK(c.g == Approx(f + 0.5 * u + d * hue.g).margin(1e-6));
+  CHECK(c.b == Approx(f + 0.5 * u + d * hue.b).margin(1e-6));
+
+  CellColorOptions thr;
+  thr.coloring = CellColoring::kThreshold;
+  thr.dynamic_threshold = 0.6;
+  const Rgba t = CellColor(float(f), float(s), float(d), vx, vy, thr);
+  if (d > 0.6) {
+    CHECK(t.r == Approx(hue.r));
+    CHECK(t.g == Approx(hue.g));
+    CHECK(t.b == Approx(hue.b));
+  } else {  // dynamic mass reads as unknown grey: no hue, equal channels
+    CHECK(t.r == Approx(f + 0.5 * (1.0 - f - s)).margin(1e-6));
+    CHECK(t.g == Approx(t.r).margin(1e-9));
+    CHECK(t.b == Approx(t.r).margin(1e-9));
+  }
+  CHECK(CellColor(0, 0, 0.7f, vx, vy, thr).r == Approx(hue.r));
+}
+
+TEST_CASE("Palette: modes and sensors are distinct and consistent", "[viz]") {
+  for (Mode m : {Mode::kPosition, Mode::kVelocity, Mode::kDual}) {
+    REQUIRE(ModeFromName(ModeName(m)) == m);
+    std::string upper(ModeName(m));
+    for (char& ch : upper) ch = char(std::toupper(ch));
+    CHECK(ModeFromName(upper) == m);
+  }
+  CHECK_FALSE(ModeFromName("radar").has_value());
+  std::vector<Rgba> all = {ModeColor(Mode::kPosition), ModeColor(Mode::kVelocity),
+                           ModeColor(Mode::kDual)};
+  for (int i = 0; i < 8; ++i) all.push_back(SensorColor(i));
+  for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t j = i + 1; j < all.size(); ++j)
+      CHECK(std::abs(all[i].r - all[j].r) + std::abs(all[i].g - all[j].g) +
+                std::abs(all[i].b - all[j].b) >
+            0.15);
+  CHECK(SensorColor(9).r == SensorColor(1).r);
+  CHECK(CategoryColor(2).g == ModeColor(Mode::kDual).g);
+}
+
+TEST_CASE("RenderGridPanels: cell colours, truth outlines, layout", "[viz]") {
+  // 40 m x 10 m at 0.5 m; one panel per mode with a dynamic cell at a panel-specific column.
+  const Position origin(-20.0, -5.0);
+  std::vector<GridPanel> panels;
+  const char* names[] = {"position", "velocity", "dual"};
+  for (int k = 0; k < 3; ++k) {
+    GridPanel p;
+    p.title = names[k];
+    p.raster = UnknownRaster(80, 20, 0.5, origin);
+    auto set = [&](int x, int y, float f, float s, float d, float vx, float vy) {
+      const std::size_t i = std::size_t(y) * 80 + x;
+      p.raster.free[i] = f;
+      p.raster.static_occ[i] = s;
+      p.raster.dynamic[i] = d;
+      p.raster.mean_vx[i] = vx;
+      p.raster.mean_vy[i] = vy;
+    };
+    set(5, 5, 1, 0, 0, 0, 0);             // free
+    set(10, 5, 0, 1, 0, 0, 0);            // static
+    set(20 + 10 * k, 15, 0, 0, 1, 8, 0);  // dynamic, +x
+    set(60, 15, 0, 0, 1, 0, -8);          // dynamic, -y
+    p.truth_boxes.push_back(OrientedBox{Position(10.0, 0.0), 0.0, 4.0, 2.0});
+    p.particles.push_back(Position(-15.0, 3.0));
+    panels.push_back(std::move(p));
+  }
+  GridFigureOptions opt;
+  opt.image_width = 1000;
+  opt.title = "t = 12.0 s";
+  const GridFigureLayout layout = LayoutGridPanels(panels, opt);
+  REQUIRE(layout.panels.size() == 3);
+  for (int k = 0; k + 1 < 3; ++k)  // stacked vertically, no overlap, same x placement
+    CHECK(layout.panels[k + 1].pixel_offset().y() >=
+          layout.panels[k].pixel_offset().y() + layout.panels[k].pixel_height());
+  CHECK(layout.panels[0].pixel_offset().x() == layout.panels[2].pixel_offset().x());
+  CHECK(layout.panels[0].scale() * 0.5 > 6.0);  // cells are several pixels wide
+
+  const fs::path path = TempDir() / "grid_panels.png";
+  fs::remove(path);
+  RenderGridPanels(panels, path.string(), opt);
+  REQUIRE(fs::exists(path));
+  const Png png(path);
+  CHECK(png.width() == layout.width);
+  CHECK(png.height() == layout.height);
+  CHECK(Near(png.At(2, 2), colors::kWhite));  // background
+  for (int k = 0; k < 3; ++k) {
+    INFO("panel " << k);
+    const MapTransform& t = layout.panels[k];
+    const GridRaster& g = panels[k].raster;
+    CHECK(Near(png.At(t.ToPixel(CellCentre(g, 5, 5))), colors::kWhite));
+    CHECK(Near(png.At(t.ToPixel(CellCentre(g, 10, 5))), colors::kBlack));
+    CHECK(Near(png.At(t.ToPixel(CellCentre(g, 40, 10))), colors::kUnknown));
+    const Rgb8 dyn = png.At(t.ToPixel(CellCentre(g, 20 + 10 * k, 15)));
+    INFO("dynamic +x cell " << Str(dyn));
+    CHECK(Near(dyn, HueColor(0.0)));
+    CHECK(Near(png.At(t.ToPixel(CellCentre(g, 60, 15))), HueColor(-0.5 * kPi)));
+    // The +x cell of another panel is not dynamic here.
+    CHECK(Near(png.At(t.ToPixel(CellCentre(g, 20 + 10 * ((k + 1) % 3), 15))), colors::kUnknown));
+    // Truth outline: the pixel on the middle of the box's top edge is black, its interior is not.
+    CHECK(Near(png.At(t.ToPixel(Position(10.0, 1.0))), colors::kBlack, 40));
+    CHECK(Near(png.At(t.ToPixel(Position(10.0, 0.0))), colors::kUnknown));
+  }
+}
+
+TEST_CASE("RenderGridPanels rejects invalid rasters naming the field", "[viz]") {
+  GridPanel ok;
+  ok.raster = UnknownRaster(10, 4, 0.5, Position(0, 0));
+  const std::string path = (TempDir() / "invalid.png").string();
+  CheckInvalidArgument([&] { RenderGridPanels({}, path); }, "panels is empty");
+  GridPanel empty;
+  CheckInvalidArgument([&] { RenderGridPanels({ok, empty}, path); }, "panels[1].raster.cells_x");
+  const char* fields[] = {"free", "static_occ", "dynamic", "mean_vx", "mean_vy"};
+  const int which = GENERATE(0, 1, 2, 3, 4);
+  GridPanel bad = ok;
+  std::vector<float>* arrays[] = {&bad.raster.free, &bad.raster.static_occ, &bad.raster.dynamic,
+                                  &bad.raster.mean_vx, &bad.raster.mean_vy};
+  arrays[which]->pop_back();
+  CheckInvalidArgument(
+      [&] {
+        RenderGridPanels({ok, bad}, path);
+      },
+      std::string("panels[1].raster.") + fields[which]);
+  bad = ok;
+  bad.raster.resolution = 0.0;
+  CheckInvalidArgument([&] { LayoutGridPanels({bad}); }, "panels[0].raster.resolution");
+  GridFigureOptions opt;
+  opt.cell.dynamic_threshold = 1.5;
+  CheckInvalidArgument([&] { RenderGridPanels({ok}, path, opt); },
+                       "options.cell.dynamic_threshold");
+}
+
+TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]") {
+  BirdsEyeOptions opt;
+  opt.pixel_width = 1600;
+  opt.title = "highway, t = 3.0 s";
+  BirdsEyeView view({{-40.0, -20.0}, {120.0, 20.0}}, opt);
+  REQUIRE(view.transform().pixel_height() == 400);
+  CHECK(view.transform().scale() == Approx(10.0));
+  const Vector2 shift = view.ToImagePixel({0, 0}) - view.transform().ToPixel({0, 0});
+  CHECK(shift.x() == 0.0);
+  CHECK(shift.y() > 0.0);  // title band
+
+  for (int lane = 0; lane < 3; ++lane)
+    view.DrawLane({{-40.0, -5.0 + 3.5 * lane}, {120.0, -5.0 + 3.5 * lane}}, 3.5);
+  view.DrawGuardRail({{-40.0, -7.2}, {120.0, -7.2}});
+  const SensorFov fov{Position(2.3, 0.0), 0.0, DegToRad(20.0), 100.0, 0, "front LRR"};
+  view.DrawSensorFov(fov);
+  VehicleStyle ego;
+  ego.label = "ego";
+  ego.ego = true;
+  view.DrawVehicle({Position(0, -1.5), 0.0, 4.6, 1.9}, ego);
+  const Rgba fill{0.0, 0.0, 1.0, 1.0};
+  VehicleStyle truck;
+  truck.fill = fill;
+  truck.label = "truck 3";
+  truck.velocity = Velocity(25, 0);
+  view.DrawVehicle({Position(40, 2.0), 0.1, 12.0, 2.5}, truck);
+  std::vector<DetectionMark> dets = {
+      {Position(60.0, 15.0), Velocity(-10.0, 0.0), 2, false},
+      {Position(80.0, -15.0), Velocity(0.0, 0.0), 1, true},
+  };
+  view.DrawDetections(dets);
+  const fs::path path = TempDir() / "birds_eye.png";
+  fs::remove(path);
+  view.SavePng(path.string());
+  REQUIRE(fs::exists(path));
+  const Png png(path);
+  CHECK(png.width() == 1600);
+  CHECK(png.height() == view.image_height());
+  CHECK(png.height() > 400);
+
+  CHECK(Near(png.At(view.ToImagePixel({-30.0, 15.0})), colors::kWhite));  // background
+  // Vehicle fill behind the centre (the velocity arrow starts at the centre).
+  CHECK(
+      Near(png.At(view.ToImagePixel(Position(40, 2) + Rotation(0.1) * Vector2(-3.0, 0.6))), fill));
+  CHECK(Near(png.At(view.ToImagePixel({0.0, -1.5})), colors::kEgo));
+  CHECK(Near(png.At(view.ToImagePixel({-30.0, -1.5})), colors::kLane));
+  CHECK(Near(png.At(view.ToImagePixel({-30.0, -7.2})), colors::kGuardRail));
+  // Inside the wedge over white: white composited with the sensor colour at alpha 0.12.
+  const Rgba s0 = SensorColor(0);
+  CHECK(Near(png.At(view.ToImagePixel({90.0, 12.0})), Mix(colors::kWhite, s0, 0.12), 2));
+  // Just outside the wedge edge (20 deg) at the same range: white.
+  const Position outside = fov.origin + 40.0 * UnitVector(DegToRad(23.0));
+  CHECK(Near(png.At(view.ToImagePixel(outside)), colors::kWhite));
+  // Detection dot in its sensor colour (over the wedge tint).
+  const Rgb8 det = png.At(view.ToImagePixel({60.0, 15.0}));
+  INFO("detection " << Str(det));
+  CHECK(Near(det, SensorColor(2), 3));
+  // Clutter cross darkens its centre pixel.
+  const Rgb8 clutter = png.At(view.ToImagePixel({80.0, -15.0}));
+  CHECK(clutter.r + clutter.g + clutter.b < 3 * 200);
+  // Radial velocity arrow (-10 m/s * 0.2 s = 2 m west): drawn 1 m west of the dot.
+  const Rgb8 arrow = png.At(view.ToImagePixel({59.0, 15.0}));
+  CHECK(arrow.r + arrow.g + arrow.b < 3 * 230);
+}
+
+TEST_CASE("BirdsEyeView rejects bad input and unwritable paths", "[viz]") {
+  CheckInvalidArgument([] { BirdsEyeView({{0, 0}, {-1, 5}}); }, "world.max.x");
+  BirdsEyeOptions opt;
+  opt.pixel_width = 10;
+  CheckInvalidArgument([&] { BirdsEyeView({{0, 0}, {10, 5}}, opt); }, "options.pixel_width");
+  BirdsEyeView view({{0, 0}, {100, 20}});
+  CheckInvalidArgument(
+      [&] {
+        view.DrawSensorFov({Position(0, 0), 0.0, 0.0, 50.0, 0, ""});
+      },
+      "half_fov");
+  DetectionStyle style;
+  style.max_speed = 0.0;
+  CheckInvalidArgument([&] { view.DrawDetections({}, style); }, "style.max_speed");
+  CHECK_THROWS_AS(view.SavePng("/nonexistent_dir_dualgrid/x.png"), std::runtime_error);
+}
+
+TEST_CASE("RenderBarChart draws grouped bars in mode colours", "[viz]") {
+  BarChart chart;
+  chart.title = "Tracked duration per object";
+  chart.x_label = "object";
+  chart.y_label = "tracked [% of visible time]";
+  chart.categories = {"obj 1", "obj 2", "obj 3", "obj 4"};
+  chart.series = {{"position", {0.7, 0.5, 0.9, std::nan("")}, {}},
+                  {"velocity", {0.6, 0.3, 0.1, 0.2}, {}},
+                  {"dual", {0.9, 0.8, 0.95, 0.7}, {}}};
+  chart.percent = true;
+  const fs::path path = TempDir() / "bars.png";
+  fs::remove(path);
+  RenderBarChart(chart, path.string());
+  const Png png(path);
+  CHECK(png.width() == chart.width);
+  CHECK(png.height() == chart.height);
+  CHECK(Near(png.At(1, 1), colors::kWhite));
+  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const double slot = a.width / 4, bar_w = 0.8 * slot / 3;
+  // The axis is [0, 1] (percent); sample each bar half-way up.
+  for (int s = 0; s < 3; ++s)
+    for (int c = 0; c < 4; ++c) {
+      const double v = chart.series[s].values[c];
+      const Vector2 mid(a.left + slot * (c + 0.1) + bar_w * (s + 0.5),
+                        a.top + a.height * (1.0 - 0.5 * (std::isnan(v) ? 0.7 : v)));
+      INFO("series " << s << " category " << c);
+      if (std::isnan(v))
+        CHECK_FALSE(Near(png.At(mid), ModeColor(Mode::kPosition), 20));
+      else
+        CHECK(Near(png.At(mid), ModeColor(static_cast<Mode>(s))));
+    }
+  BarChart bad = chart;
+  bad.series[1].values.pop_back();
+  CheckInvalidArgument([&] { RenderBarChart(bad, path.string()); }, "series[1].values");
+  bad = chart;
+  bad.categories.clear();
+  CheckInvalidArgument([&] { RenderBarChart(bad, path.string()); }, "categories");
+}
+
+TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
+  const bool log_y = GENERATE(false, true);
+  LineChart chart;
+  chart.title = "Particle weights (dual)";
+  chart.y_label = "weight";
+  chart.log_y = log_y;
+  LineSeries s{"w_position", {}, {}, {}, 4.0, false};
+  for (int k = 0; k <= 100; ++k) {
+    s.x.push_back(0.1 * k);
+    s.y.push_back(log_y ? std::pow(10.0, 0.1 * k - 5.0) : 0.5);
+  }
+  chart.series.push_back(s);
+  chart.spans.push_back({3.0, 8.0, "radial speed differs"});
+  if (log_y) {
+    chart.y_min = 1e-5;
+    chart.y_max = 1e5;
+  } else {
+    chart.y_min = 0.0;
+    chart.y_max = 1.0;
+  }
+  const fs::path path = TempDir() / (log_y ? "lines_log.png" : "lines.png");
+  fs::remove(path);
+  RenderLineChart(chart, path.string());
+  const Png png(path);
+  CHECK(png.width() == chart.width);
+  CHECK(png.height() == chart.height);
+  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  // x axis spans the data [0, 10]; the series crosses mid-height at x = 5 either way
+  // (0.5 of [0, 1] linear, 10^0 of [1e-5, 1e5] log).
+  const Vector2 mid(a.left + 0.5 * a.width, a.top + 0.5 * a.height);
+  const Rgba color = CategoryColor(0);
+  const Rgb8 on = png.At(mid);
+  INFO("on line " << Str(on));
+  CHECK(Near(on, color, 3));
+  // Well off the line, at x = 1 outside the span: background white.
+  CHECK(
+      Near(png.At(Vector2(a.left + 0.1 * a.width + 0.5, a.top + 0.1 * a.height)), colors::kWhite));
+  LineChart bad = chart;
+  bad.series[0].y.pop_back();
+  CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "series[0].y");
+  bad = chart;
+  bad.log_y = true;
+  bad.y_min = std::nan("");
+  for (double& y : bad.series[0].y) y = -1.0;
+  CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "positive");
+}

@@ -1,0 +1,83 @@
+// Simple clean charts: grouped bars (paper Fig. 6) and lines over time (paper Fig. 4).
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dualgrid/viz/color.hpp"
+
+namespace dualgrid::viz {
+
+struct BarSeries {
+  std::string name;  ///< legend label; a mode name ("dual", ...) picks ModeColor by default
+  std::vector<double> values;  ///< one per category; NaN = no bar
+  std::optional<Rgba> color;
+};
+
+struct BarChart {
+  std::string title;
+  std::string x_label;
+  std::string y_label;
+  std::vector<std::string> categories;  ///< e.g. object ids
+  std::vector<BarSeries> series;        ///< e.g. one per mode
+  /// Values are fractions in [0, 1] shown as percent (axis and value labels).
+  bool percent = false;
+  /// y axis range; y_max NaN = automatic (1 for percent).
+  double y_min = 0.0;
+  double y_max = std::numeric_limits<double>::quiet_NaN();
+  bool value_labels = true;  ///< print each value above its bar
+  int width = 1000;
+  int height = 520;
+  bool IsValid(std::string* error) const;
+};
+
+struct LineSeries {
+  std::string name;
+  std::vector<double> x;
+  std::vector<double> y;  ///< same size as x; NaN (or <= 0 on a log axis) breaks the line
+  std::optional<Rgba> color;
+  double line_width = 2.0;  ///< [px]
+  bool dashed = false;
+};
+
+/// Shaded x interval with an optional label (e.g. "radial speed differs").
+struct XSpan {
+  double x0 = 0.0;
+  double x1 = 0.0;
+  std::string label;
+};
+
+struct LineChart {
+  std::string title;
+  std::string x_label = "time [s]";
+  std::string y_label;
+  std::vector<LineSeries> series;
+  std::vector<XSpan> spans;
+  bool log_y = false;
+  /// Axis ranges; NaN = from the data.
+  double x_min = std::numeric_limits<double>::quiet_NaN();
+  double x_max = std::numeric_limits<double>::quiet_NaN();
+  double y_min = std::numeric_limits<double>::quiet_NaN();
+  double y_max = std::numeric_limits<double>::quiet_NaN();
+  int width = 1000;
+  int height = 520;
+  bool IsValid(std::string* error) const;
+};
+
+/// Throw std::invalid_argument (naming the field) for bad input, std::runtime_error if the PNG
+/// cannot be written.
+void RenderBarChart(const BarChart& chart, const std::string& path);
+void RenderLineChart(const LineChart& chart, const std::string& path);
+
+/// Plot-area rectangle in pixels (left, top, width, height) used by both charts; exposed for tests.
+struct PlotArea {
+  double left = 0.0;
+  double top = 0.0;
+  double width = 0.0;
+  double height = 0.0;
+};
+PlotArea ChartPlotArea(int width, int height);
+
+}  // namespace dualgrid::viz

@@ -1,0 +1,82 @@
+// Dynamic occupancy grid pictures (paper Fig. 7): one panel per filter mode, stacked vertically.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/viz/color.hpp"
+#include "dualgrid/viz/map_transform.hpp"
+
+namespace dualgrid::viz {
+
+/// Cell masses and mean velocities of a grid, axis-aligned with the world frame.
+struct GridRaster {
+  int cells_x = 0;
+  int cells_y = 0;
+  double resolution = 0.0;             ///< cell edge [m]
+  Position origin = Position::Zero();  ///< world position of the lower-left corner of cell (0,0)
+  /// Row-major, index = y * cells_x + x, x along world +x, y along world +y.
+  std::vector<float> free, static_occ, dynamic, mean_vx, mean_vy;
+
+  /// World rectangle covered by the grid.
+  WorldRect Extent() const;
+  /// False (error names the field) for non-positive sizes or arrays not of cells_x * cells_y.
+  bool IsValid(std::string* error) const;
+};
+
+enum class CellColoring {
+  /// colour = free*white + static*black + dynamic*HueColor(atan2(vy, vx)) + unknown*grey, with
+  /// unknown = 1 - free - static - dynamic (clamped at 0; masses renormalised if they sum above 1).
+  /// Continuous, so weak dynamic mass shows as a faint tint.
+  kBlend,
+  /// Cells with dynamic > dynamic_threshold are pure HueColor; others use the blend above with
+  /// their dynamic mass counted as unknown (the paper's classification, threshold 0.6).
+  kThreshold,
+};
+
+struct CellColorOptions {
+  CellColoring coloring = CellColoring::kBlend;
+  double dynamic_threshold = 0.6;
+  bool IsValid(std::string* error) const;
+};
+
+/// Colour of one cell (see CellColoring). Negative masses count as 0.
+Rgba CellColor(float free, float static_occ, float dynamic, float vx, float vy,
+               const CellColorOptions& options = {});
+
+struct GridPanel {
+  std::string title;  ///< e.g. "position", "velocity", "dual"
+  GridRaster raster;
+  std::vector<OrientedBox> truth_boxes;  ///< ground-truth outlines (black on a white halo)
+  std::vector<Position> particles;       ///< optional, drawn as tiny dots
+  std::vector<OrientedBox> ego_boxes;    ///< optional ego outline(s), drawn green
+};
+
+struct GridFigureOptions {
+  /// Whole image width [px]: left axis margin + map + right legend column.
+  int image_width = 1600;
+  std::string title;  ///< figure title above all panels when not empty
+  CellColorOptions cell;
+  double font_size = 14.0;
+  bool IsValid(std::string* error) const;
+};
+
+/// Where each panel's map lands in the image (exposed so callers and tests can locate cells).
+struct GridFigureLayout {
+  int width = 0;
+  int height = 0;
+  std::vector<MapTransform> panels;  ///< with pixel offsets into the image
+};
+
+/// Throws std::invalid_argument (naming e.g. "panels[1].raster.dynamic") for bad input.
+GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
+                                  const GridFigureOptions& options = {});
+
+/// Renders the panels stacked vertically, each with its title and axes in metres, plus a legend
+/// column (hue wheel for the direction of motion, free/static/unknown swatches, scale bar).
+/// Throws std::invalid_argument for bad input, std::runtime_error if the PNG cannot be written.
+void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& path,
+                      const GridFigureOptions& options = {});
+
+}  // namespace dualgrid::viz
