@@ -1,5 +1,7 @@
 #include "dualgrid/scenario/loader.hpp"
 
+#include <algorithm>
+
 #include "yaml_reader.hpp"
 
 namespace dualgrid::scenario {
@@ -131,7 +133,160 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   }
 }
 
+void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
+  if (auto m = r.Map("mount")) {
+    m->Read("x", &p->mount.position.x());
+    m->Read("y", &p->mount.position.y());
+    m->ReadDegrees("yaw_deg", &p->mount.yaw);
+    m->Finish();
+  }
+  r.ReadDegrees("fov_deg", &p->fov);
+  r.Read("min_range", &p->min_range);
+  r.Read("max_range", &p->max_range);
+  r.Read("min_range_rate", &p->min_range_rate);
+  r.Read("max_range_rate", &p->max_range_rate);
+  r.Read("range_resolution", &p->range_resolution);
+  r.ReadDegrees("azimuth_resolution_deg", &p->azimuth_resolution);
+  r.Read("range_rate_resolution", &p->range_rate_resolution);
+  r.Read("range_bias_fraction", &p->range_bias_fraction);
+  r.Read("azimuth_bias_fraction", &p->azimuth_bias_fraction);
+  r.Read("range_rate_bias_fraction", &p->range_rate_bias_fraction);
+  r.Read("reference_range", &p->reference_range);
+  r.Read("reference_rcs_dbsm", &p->reference_rcs_dbsm);
+  r.Read("reference_pd", &p->reference_pd);
+  r.Read("false_alarm_rate", &p->false_alarm_rate);
+  r.Read("update_period", &p->update_period);
+}
+
+// Turns "field: message" from an IsValid into a ConfigError under `section`.
+[[noreturn]] void Invalid(const std::string& file, const std::string& section,
+                          const std::string& error) {
+  const auto colon = error.find(": ");
+  const std::string field = colon == std::string::npos ? "" : error.substr(0, colon);
+  const std::string message = colon == std::string::npos ? error : error.substr(colon + 2);
+  throw ConfigError(file + ": key '" + (section.empty() ? field : section + "." + field) + "' " +
+                    message);
+}
+
+void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* radar) {
+  const auto& ego_type = spec.vehicle_types.at(spec.ego.type);
+  radar->sensors = radar::DefaultRig(ego_type.length, ego_type.width);
+  auto section = root.Map("sensors");
+  if (!section) return;
+  std::string rig = "default";
+  section->Read("rig", &rig);
+  if (rig != "default") section->Fail("rig", "expected 'default', got '" + rig + "'");
+  section->Read("noise", &radar->options.noise);
+  section->Read("false_alarms", &radar->options.false_alarms);
+  section->Read("occlusion", &radar->options.occlusion);
+  auto names = [&] {
+    std::string all;
+    for (const auto& s : radar->sensors) all += (all.empty() ? "" : ", ") + s.name;
+    return all;
+  };
+  for (auto& [name, r] : section->NamedMaps("overrides")) {
+    auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
+                           [&](const radar::SensorParams& s) { return s.name == name; });
+    if (it == radar->sensors.end())
+      throw ConfigError(r.file() + ": key '" + r.path() + "' names unknown sensor '" + name +
+                        "' (expected one of: " + names() + ")");
+    ReadSensorFields(r, &*it);
+    r.Finish();
+  }
+  if (section->Has("use")) {
+    std::vector<std::string> use;
+    section->Read("use", &use);
+    std::vector<radar::SensorParams> kept;
+    for (const std::string& name : use) {
+      auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
+                             [&](const radar::SensorParams& s) { return s.name == name; });
+      if (it == radar->sensors.end())
+        section->Fail("use", "names unknown sensor '" + name + "' (expected one of: " + names() + ")");
+      kept.push_back(*it);
+    }
+    if (kept.empty()) section->Fail("use", "must list at least one sensor");
+    radar->sensors = kept;
+  }
+  section->Finish();
+  for (const auto& s : radar->sensors) {
+    std::string error;
+    if (!s.IsValid(&error)) Invalid(root.file(), "sensors.overrides." + s.name, error);
+  }
+}
+
+void ReadFilter(MapReader& root, filter::FilterParams* f) {
+  auto r = root.Map("filter");
+  if (!r) return;
+  r->Read("length_x", &f->length_x);
+  r->Read("width_y", &f->width_y);
+  r->Read("resolution", &f->resolution);
+  r->Read("num_particles", &f->num_particles);
+  r->Read("num_birth", &f->num_birth);
+  r->Read("process_noise_position", &f->process_noise_position);
+  r->Read("process_noise_velocity", &f->process_noise_velocity);
+  r->Read("persistence", &f->persistence);
+  r->Read("birth_probability", &f->birth_probability);
+  r->Read("birth_max_tangential_speed", &f->birth_max_tangential_speed);
+  r->Read("birth_sigma_radial", &f->birth_sigma_radial);
+  r->Read("sigma_f", &f->sigma_f);
+  r->Read("sigma_static_distance", &f->sigma_static_distance);
+  r->Read("sigma_static_velocity", &f->sigma_static_velocity);
+  r->Read("sigma_v", &f->sigma_v);
+  r->Read("cutoff_sigmas", &f->cutoff_sigmas);
+  r->Read("occupied_mass", &f->occupied_mass);
+  r->Read("free_mass", &f->free_mass);
+  r->Read("free_mass_no_return", &f->free_mass_no_return);
+  r->ReadDegrees("free_angle_bin_deg", &f->free_angle_bin);
+  r->Read("free_bin_dilation", &f->free_bin_dilation);
+  r->Read("free_decay", &f->free_decay);
+  r->Read("static_persistence", &f->static_persistence);
+  r->Read("static_gain", &f->static_gain);
+  r->Read("static_speed", &f->static_speed);
+  r->Read("decay_eps", &f->decay_eps);
+  std::string mode(filter::ToString(f->mode));
+  r->Read("mode", &mode);
+  const auto parsed = filter::ParseWeightMode(mode);
+  if (!parsed) r->Fail("mode", "expected 'position', 'velocity' or 'dual', got '" + mode + "'");
+  f->mode = *parsed;
+  r->Finish();
+  std::string error;
+  if (!f->IsValid(&error)) Invalid(root.file(), "filter", error);
+}
+
+void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
+  auto r = root.Map("evaluation");
+  if (!r) return;
+  r->Read("dynamic_threshold", &e->dynamic_threshold);
+  r->Read("dbscan_eps", &e->dbscan.eps);
+  r->Read("dbscan_min_points", &e->dbscan.min_points);
+  r->Read("gate_box_margin", &e->tracking.association.box_margin);
+  r->Read("gate_center", &e->tracking.association.center_gate);
+  r->Read("consistent_required", &e->tracking.required);
+  r->Read("consistent_window", &e->tracking.window);
+  r->Read("min_frames_in_grid", &e->tracking.min_frames_in_grid);
+  r->Finish();
+  std::string error;
+  if (!e->IsValid(&error)) Invalid(root.file(), "evaluation", error);
+}
+
 }  // namespace
+
+bool EvaluationConfig::IsValid(std::string* error) const {
+  if (!(dynamic_threshold > 0.0 && dynamic_threshold < 1.0)) {
+    if (error) *error = "dynamic_threshold: must be in (0, 1)";
+    return false;
+  }
+  std::string e;
+  if (!dbscan.IsValid(&e)) {
+    if (error) *error = "dbscan_" + e;
+    return false;
+  }
+  if (!tracking.IsValid(&e)) {
+    if (error) *error = e;
+    return false;
+  }
+  return true;
+}
 
 ScenarioConfig LoadScenario(const std::filesystem::path& file) {
   const std::string name = file.string();
@@ -149,12 +304,12 @@ ScenarioConfig LoadScenario(const std::filesystem::path& file) {
   MapReader root(doc, name, "");
   ReadSim(root, &config.sim);
   if (config.sim.name.empty()) config.sim.name = file.stem().string();
-  root.Finish();
   std::string error;
-  if (!config.sim.IsValid(&error)) {
-    const auto colon = error.find(": ");
-    throw ConfigError(name + ": key '" + error.substr(0, colon) + "' " + error.substr(colon + 2));
-  }
+  if (!config.sim.IsValid(&error)) Invalid(name, "", error);
+  ReadRadar(root, config.sim, &config.radar);
+  ReadFilter(root, &config.filter);
+  ReadEvaluation(root, &config.evaluation);
+  root.Finish();
   return config;
 }
 

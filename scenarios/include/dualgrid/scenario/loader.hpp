@@ -6,6 +6,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "dualgrid/eval/dbscan.hpp"
+#include "dualgrid/eval/metrics.hpp"
+#include "dualgrid/filter/params.hpp"
+#include "dualgrid/radar_model/radar_model.hpp"
 #include "dualgrid/sim/scenario.hpp"
 
 namespace dualgrid::scenario {
@@ -16,9 +20,26 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The `sensors:` section: the radar rig and which model effects are on.
+struct RadarConfig {
+  std::vector<radar::SensorParams> sensors;  ///< default: radar::DefaultRig of the ego's box
+  radar::ModelOptions options;
+};
+
+/// The `evaluation:` section (scoring as in the paper's Sec. V).
+struct EvaluationConfig {
+  double dynamic_threshold = 0.6;  ///< a cell is dynamic when P(dynamic) exceeds this
+  eval::DbscanParams dbscan;
+  eval::TrackingMetricsParams tracking;
+  bool IsValid(std::string* error) const;
+};
+
 struct ScenarioConfig {
   std::filesystem::path file;
   sim::ScenarioSpec sim;
+  RadarConfig radar;
+  filter::FilterParams filter;
+  EvaluationConfig evaluation;
 };
 
 /// Loads and validates a scenario file. Throws ConfigError.
