@@ -1,0 +1,63 @@
+// Cell-level classification scores (not in the paper): predicted free / static / dynamic cells
+// against ground-truth boxes rasterised onto the grid.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include <nlohmann/json.hpp>
+
+#include "dualgrid/core/types.hpp"
+
+namespace dualgrid::eval {
+
+/// Cell classes as plain bytes so that per-frame arrays are std::span<const std::uint8_t>.
+enum class CellClass : std::uint8_t { kFree = 0, kStatic = 1, kDynamic = 2, kUnknown = 3 };
+inline constexpr int kNumTruthClasses = 3;      // free, static, dynamic
+inline constexpr int kNumPredictedClasses = 4;  // ... and unknown
+
+/// Predicted class of a cell from its masses: dynamic when p_dynamic > threshold (the paper's
+/// rule with 0.6), else static when p_static > threshold, else free when p_free > threshold,
+/// else unknown. With threshold >= 0.5 and masses summing to <= 1 at most one class qualifies.
+CellClass ClassifyCell(double p_free, double p_static, double p_dynamic, double threshold = 0.6);
+
+/// Ground-truth class per cell: kDynamic when the cell centre lies in a moving box, else kStatic
+/// when it lies in a stationary box (parked vehicle, guard-rail segment given as a thin box), else
+/// kFree. `cell_centers` and the boxes share a frame. Writes out[i] for every cell.
+/// Throws std::invalid_argument on a size mismatch.
+void RasterizeTruth(std::span<const Position> cell_centers, std::span<const OrientedBox> moving,
+                    std::span<const OrientedBox> stationary, std::span<std::uint8_t> out);
+
+struct CellMetrics {
+  /// confusion[truth][predicted], truth in {free, static, dynamic}, predicted adds unknown.
+  std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses> confusion{};
+  std::int64_t cells = 0;  ///< (frame, observed cell) pairs counted
+  int frames = 0;
+  /// Precision / recall / F1 of one class; empty when a denominator is zero.
+  std::optional<double> dynamic_precision, dynamic_recall, dynamic_f1;
+  std::optional<double> static_precision, static_recall, static_f1;
+  /// Share of counted cells whose prediction equals the truth (unknown counts as wrong).
+  std::optional<double> accuracy;
+};
+
+/// Sums a confusion matrix over frames.
+class CellClassificationAccumulator {
+ public:
+  /// `predicted` and `truth` hold CellClass values per cell; `observed` is empty (all cells count)
+  /// or non-zero for cells to count (e.g. cells some radar has observed). Throws
+  /// std::invalid_argument on a size mismatch or an out-of-range class.
+  void AddFrame(std::span<const std::uint8_t> predicted, std::span<const std::uint8_t> truth,
+                std::span<const std::uint8_t> observed = {});
+
+  CellMetrics Result() const;
+
+ private:
+  CellMetrics m_;
+};
+
+void to_json(nlohmann::json& j, const CellMetrics& m);
+void from_json(const nlohmann::json& j, CellMetrics& m);
+
+}  // namespace dualgrid::eval

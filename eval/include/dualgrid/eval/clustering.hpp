@@ -1,0 +1,52 @@
+// Particle clusters as in the paper's Sec. V: particles of dynamic cells are clustered with
+// DBSCAN and each cluster yields a weighted mean position and velocity.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/eval/dbscan.hpp"
+
+namespace dualgrid::eval {
+
+/// One particle handed over by the filter (the caller passes only particles of cells with
+/// P(dynamic) > 0.6). World frame.
+struct WeightedParticle {
+  Position position = Position::Zero();
+  Velocity velocity = Velocity::Zero();
+  double weight = 0.0;  ///< >= 0; any scale (only ratios within a cluster matter)
+};
+
+/// A cluster of particles, world frame.
+struct Cluster {
+  Position position = Position::Zero();  ///< weighted mean position [m]
+  Velocity velocity = Velocity::Zero();  ///< weighted mean velocity [m/s]
+  double weight = 0.0;                   ///< sum of member weights
+  int size = 0;                          ///< number of member particles
+  Position min = Position::Zero();       ///< axis-aligned bounding box of the members [m]
+  Position max = Position::Zero();
+};
+
+/// Clusters particles with DBSCAN on their positions; noise particles are dropped. Clusters come
+/// in DBSCAN label order (lowest member index first). Means are weighted; a cluster whose weights
+/// sum to zero falls back to plain means so that it still reports a location.
+/// Reuses its buffers across calls.
+class ParticleClusterer {
+ public:
+  explicit ParticleClusterer(const DbscanParams& params = {}) : dbscan_(params) {}
+
+  /// Throws std::invalid_argument for a negative or non-finite weight or a non-finite particle.
+  std::vector<Cluster> Run(std::span<const WeightedParticle> particles);
+
+  /// DBSCAN labels of the particles of the last Run (kNoise or index into its clusters).
+  std::span<const int> labels() const { return labels_; }
+
+ private:
+  Dbscan dbscan_;
+  std::vector<Position> positions_;
+  std::vector<double> weights_;
+  std::vector<int> labels_;
+};
+
+}  // namespace dualgrid::eval

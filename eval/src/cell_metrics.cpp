@@ -1,0 +1,111 @@
+#include "dualgrid/eval/cell_metrics.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "json_util.hpp"
+
+namespace dualgrid::eval {
+
+using detail::OptFromJson;
+using detail::OptToJson;
+
+CellClass ClassifyCell(double p_free, double p_static, double p_dynamic, double threshold) {
+  if (p_dynamic > threshold) return CellClass::kDynamic;
+  if (p_static > threshold) return CellClass::kStatic;
+  if (p_free > threshold) return CellClass::kFree;
+  return CellClass::kUnknown;
+}
+
+void RasterizeTruth(std::span<const Position> cell_centers, std::span<const OrientedBox> moving,
+                    std::span<const OrientedBox> stationary, std::span<std::uint8_t> out) {
+  if (out.size() != cell_centers.size())
+    throw std::invalid_argument("RasterizeTruth: " + std::to_string(out.size()) + " outputs for " +
+                                std::to_string(cell_centers.size()) + " cells");
+  const auto n = static_cast<std::int64_t>(cell_centers.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    auto c = CellClass::kFree;
+    for (const OrientedBox& b : stationary) {
+      if (b.Contains(cell_centers[i])) c = CellClass::kStatic;
+    }
+    for (const OrientedBox& b : moving) {
+      if (b.Contains(cell_centers[i])) c = CellClass::kDynamic;
+    }
+    out[i] = static_cast<std::uint8_t>(c);
+  }
+}
+
+void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predicted,
+                                             std::span<const std::uint8_t> truth,
+                                             std::span<const std::uint8_t> observed) {
+  if (predicted.size() != truth.size() || (!observed.empty() && observed.size() != truth.size()))
+    throw std::invalid_argument("CellClassificationAccumulator::AddFrame: sizes differ (" +
+                                std::to_string(predicted.size()) + " predicted, " +
+                                std::to_string(truth.size()) + " truth, " +
+                                std::to_string(observed.size()) + " observed)");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (!observed.empty() && observed[i] == 0) continue;
+    if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
+      throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
+                                  std::to_string(i) + " has class out of range");
+    ++m_.confusion[truth[i]][predicted[i]];
+    ++m_.cells;
+  }
+  ++m_.frames;
+}
+
+CellMetrics CellClassificationAccumulator::Result() const {
+  CellMetrics m = m_;
+  auto ratio = [](std::int64_t num, std::int64_t den) -> std::optional<double> {
+    if (den == 0) return std::nullopt;
+    return static_cast<double>(num) / static_cast<double>(den);
+  };
+  auto scores = [&](int k, std::optional<double>& precision, std::optional<double>& recall,
+                    std::optional<double>& f1) {
+    std::int64_t predicted = 0, actual = 0;
+    for (int t = 0; t < kNumTruthClasses; ++t) predicted += m.confusion[t][k];
+    for (int p = 0; p < kNumPredictedClasses; ++p) actual += m.confusion[k][p];
+    precision = ratio(m.confusion[k][k], predicted);
+    recall = ratio(m.confusion[k][k], actual);
+    // F1 = 2 TP / (2 TP + FP + FN); defined whenever the class occurs in truth or prediction.
+    f1 = ratio(2 * m.confusion[k][k], predicted + actual);
+  };
+  scores(static_cast<int>(CellClass::kDynamic), m.dynamic_precision, m.dynamic_recall,
+         m.dynamic_f1);
+  scores(static_cast<int>(CellClass::kStatic), m.static_precision, m.static_recall, m.static_f1);
+  std::int64_t correct = 0;
+  for (int k = 0; k < kNumTruthClasses; ++k) correct += m.confusion[k][k];
+  m.accuracy = ratio(correct, m.cells);
+  return m;
+}
+
+void to_json(nlohmann::json& j, const CellMetrics& m) {
+  j = nlohmann::json{{"confusion_truth_by_predicted", m.confusion},
+                     {"confusion_rows", {"free", "static", "dynamic"}},
+                     {"confusion_columns", {"free", "static", "dynamic", "unknown"}},
+                     {"cells", m.cells},
+                     {"frames", m.frames},
+                     {"dynamic_precision", OptToJson(m.dynamic_precision)},
+                     {"dynamic_recall", OptToJson(m.dynamic_recall)},
+                     {"dynamic_f1", OptToJson(m.dynamic_f1)},
+                     {"static_precision", OptToJson(m.static_precision)},
+                     {"static_recall", OptToJson(m.static_recall)},
+                     {"static_f1", OptToJson(m.static_f1)},
+                     {"accuracy", OptToJson(m.accuracy)}};
+}
+
+void from_json(const nlohmann::json& j, CellMetrics& m) {
+  j.at("confusion_truth_by_predicted").get_to(m.confusion);
+  j.at("cells").get_to(m.cells);
+  j.at("frames").get_to(m.frames);
+  m.dynamic_precision = OptFromJson(j, "dynamic_precision");
+  m.dynamic_recall = OptFromJson(j, "dynamic_recall");
+  m.dynamic_f1 = OptFromJson(j, "dynamic_f1");
+  m.static_precision = OptFromJson(j, "static_precision");
+  m.static_recall = OptFromJson(j, "static_recall");
+  m.static_f1 = OptFromJson(j, "static_f1");
+  m.accuracy = OptFromJson(j, "accuracy");
+}
+
+}  // namespace dualgrid::eval

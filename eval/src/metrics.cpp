@@ -1,0 +1,226 @@
+#include "dualgrid/eval/metrics.hpp"
+
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "json_util.hpp"
+
+namespace dualgrid::eval {
+
+using detail::OptFromJson;
+using detail::OptToJson;
+
+bool TrackingMetricsParams::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& msg) {
+    if (error != nullptr) *error = msg;
+    return false;
+  };
+  std::string inner;
+  if (!association.IsValid(&inner)) return fail("association." + inner);
+  if (window < 1) return fail("window must be >= 1");
+  if (required < 1 || required > window) return fail("required must be in [1, window]");
+  if (min_frames_in_grid < 1) return fail("min_frames_in_grid must be >= 1");
+  return true;
+}
+
+TrackingMetricsAccumulator::TrackingMetricsAccumulator(const TrackingMetricsParams& params)
+    : params_(params) {
+  std::string error;
+  if (!params_.IsValid(&error)) throw std::invalid_argument("TrackingMetricsParams: " + error);
+}
+
+AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
+                                                       std::span<const Cluster> clusters,
+                                                       std::span<const TruthObject> objects) {
+  if (!std::isfinite(time) || (last_time_ && time <= *last_time_))
+    throw std::invalid_argument("TrackingMetricsAccumulator::AddFrame: time " +
+                                std::to_string(time) + " does not follow " +
+                                (last_time_ ? std::to_string(*last_time_) : "the start"));
+  {
+    std::set<int> ids;
+    for (const TruthObject& o : objects) {
+      if (!ids.insert(o.id).second)
+        throw std::invalid_argument("TrackingMetricsAccumulator::AddFrame: object id " +
+                                    std::to_string(o.id) + " repeated at time " +
+                                    std::to_string(time));
+    }
+  }
+  AssociationResult a = Associate(clusters, objects, params_.association);
+  last_time_ = time;
+  ++frames_;
+  clusters_ += static_cast<std::int64_t>(clusters.size());
+  false_clusters_ += a.num_false;
+  duplicate_clusters_ += a.num_duplicate;
+
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    const TruthObject& o = objects[k];
+    const int c = a.cluster_of_object[k];
+    const bool tracked = o.in_grid && c >= 0;
+    // Objects enter the table when first in the grid; earlier frames carry no information.
+    auto it = objects_.find(o.id);
+    if (it == objects_.end()) {
+      if (!o.in_grid) continue;
+      it = objects_.emplace(o.id, ObjectState{}).first;
+    }
+    ObjectState& s = it->second;
+    if (o.in_grid) {
+      ++s.frames_in_grid;
+      if (!s.first_in_grid_time) s.first_in_grid_time = time;
+    }
+    if (tracked) {
+      ++s.frames_tracked;
+      const double dx = (clusters[c].position - o.box.center).norm();
+      const double dv = (clusters[c].velocity - o.velocity).norm();
+      s.position_error_sum += dx;
+      s.velocity_error_sum += dv;
+      position_error_sum_ += dx;
+      velocity_error_sum_ += dv;
+      ++matches_;
+    }
+    if (!s.clock_start_time && o.in_grid && o.in_coverage) s.clock_start_time = time;
+    if (s.clock_start_time && !s.track_onset_time) {
+      if (static_cast<int>(s.window.size()) == params_.window) s.window.erase(s.window.begin());
+      s.window.emplace_back(time, tracked);
+      int count = 0;
+      std::optional<double> earliest;
+      for (const auto& [t, tr] : s.window) {
+        if (!tr) continue;
+        ++count;
+        if (!earliest) earliest = t;
+      }
+      if (count >= params_.required) {
+        s.track_onset_time = earliest;
+        s.window.clear();
+        s.window.shrink_to_fit();
+      }
+    }
+  }
+  return a;
+}
+
+ScenarioMetrics TrackingMetricsAccumulator::Result() const {
+  ScenarioMetrics m;
+  m.frames = frames_;
+  m.matches = matches_;
+  if (matches_ > 0) {
+    m.position_error = position_error_sum_ / static_cast<double>(matches_);
+    m.velocity_error = velocity_error_sum_ / static_cast<double>(matches_);
+  }
+  if (frames_ > 0) {
+    m.clusters_per_scan = static_cast<double>(clusters_) / frames_;
+    m.false_clusters_per_scan = static_cast<double>(false_clusters_) / frames_;
+    m.duplicate_clusters_per_scan = static_cast<double>(duplicate_clusters_) / frames_;
+  }
+  double d_sum = 0.0, td_sum = 0.0;
+  for (const auto& [id, s] : objects_) {
+    ObjectMetrics o;
+    o.id = id;
+    o.frames_in_grid = s.frames_in_grid;
+    o.frames_tracked = s.frames_tracked;
+    o.scored = s.frames_in_grid >= params_.min_frames_in_grid;
+    o.first_in_grid_time = s.first_in_grid_time;
+    o.clock_start_time = s.clock_start_time;
+    o.track_onset_time = s.track_onset_time;
+    if (s.frames_in_grid > 0)
+      o.tracked_fraction = static_cast<double>(s.frames_tracked) / s.frames_in_grid;
+    if (s.track_onset_time) o.detection_time = *s.track_onset_time - *s.clock_start_time;
+    if (s.frames_tracked > 0) {
+      o.position_error = s.position_error_sum / s.frames_tracked;
+      o.velocity_error = s.velocity_error_sum / s.frames_tracked;
+    }
+    if (o.scored) {
+      ++m.objects_scored;
+      d_sum += *o.tracked_fraction;
+      if (o.detection_time) {
+        ++m.objects_detected;
+        td_sum += *o.detection_time;
+      } else if (o.clock_start_time) {
+        ++m.objects_never_tracked;
+      } else {
+        ++m.objects_never_observable;
+      }
+    }
+    m.objects.push_back(o);
+  }
+  if (m.objects_scored > 0) m.tracked_fraction = d_sum / m.objects_scored;
+  if (m.objects_detected > 0) m.detection_time = td_sum / m.objects_detected;
+  return m;
+}
+
+void to_json(nlohmann::json& j, const TrackingMetricsParams& p) {
+  j = {{"association", p.association},
+       {"required", p.required},
+       {"window", p.window},
+       {"min_frames_in_grid", p.min_frames_in_grid}};
+}
+
+void to_json(nlohmann::json& j, const ObjectMetrics& m) {
+  j = nlohmann::json{{"id", m.id},
+                     {"frames_in_grid", m.frames_in_grid},
+                     {"frames_tracked", m.frames_tracked},
+                     {"scored", m.scored},
+                     {"first_in_grid_time", OptToJson(m.first_in_grid_time)},
+                     {"clock_start_time", OptToJson(m.clock_start_time)},
+                     {"track_onset_time", OptToJson(m.track_onset_time)},
+                     {"tracked_fraction", OptToJson(m.tracked_fraction)},
+                     {"detection_time", OptToJson(m.detection_time)},
+                     {"position_error", OptToJson(m.position_error)},
+                     {"velocity_error", OptToJson(m.velocity_error)}};
+}
+
+void from_json(const nlohmann::json& j, ObjectMetrics& m) {
+  j.at("id").get_to(m.id);
+  j.at("frames_in_grid").get_to(m.frames_in_grid);
+  j.at("frames_tracked").get_to(m.frames_tracked);
+  j.at("scored").get_to(m.scored);
+  m.first_in_grid_time = OptFromJson(j, "first_in_grid_time");
+  m.clock_start_time = OptFromJson(j, "clock_start_time");
+  m.track_onset_time = OptFromJson(j, "track_onset_time");
+  m.tracked_fraction = OptFromJson(j, "tracked_fraction");
+  m.detection_time = OptFromJson(j, "detection_time");
+  m.position_error = OptFromJson(j, "position_error");
+  m.velocity_error = OptFromJson(j, "velocity_error");
+}
+
+void to_json(nlohmann::json& j, const ScenarioMetrics& m) {
+  j = nlohmann::json{{"frames", m.frames},
+                     {"matches", m.matches},
+                     {"position_error", OptToJson(m.position_error)},
+                     {"velocity_error", OptToJson(m.velocity_error)},
+                     {"detection_time", OptToJson(m.detection_time)},
+                     {"tracked_fraction", OptToJson(m.tracked_fraction)},
+                     {"objects_scored", m.objects_scored},
+                     {"objects_detected", m.objects_detected},
+                     {"objects_never_tracked", m.objects_never_tracked},
+                     {"objects_never_observable", m.objects_never_observable},
+                     {"clusters_per_scan", m.clusters_per_scan},
+                     {"false_clusters_per_scan", m.false_clusters_per_scan},
+                     {"duplicate_clusters_per_scan", m.duplicate_clusters_per_scan},
+                     {"cells", m.cells ? nlohmann::json(*m.cells) : nlohmann::json(nullptr)},
+                     {"objects", m.objects}};
+}
+
+void from_json(const nlohmann::json& j, ScenarioMetrics& m) {
+  j.at("frames").get_to(m.frames);
+  j.at("matches").get_to(m.matches);
+  m.position_error = OptFromJson(j, "position_error");
+  m.velocity_error = OptFromJson(j, "velocity_error");
+  m.detection_time = OptFromJson(j, "detection_time");
+  m.tracked_fraction = OptFromJson(j, "tracked_fraction");
+  j.at("objects_scored").get_to(m.objects_scored);
+  j.at("objects_detected").get_to(m.objects_detected);
+  j.at("objects_never_tracked").get_to(m.objects_never_tracked);
+  j.at("objects_never_observable").get_to(m.objects_never_observable);
+  j.at("clusters_per_scan").get_to(m.clusters_per_scan);
+  j.at("false_clusters_per_scan").get_to(m.false_clusters_per_scan);
+  j.at("duplicate_clusters_per_scan").get_to(m.duplicate_clusters_per_scan);
+  const auto cells = j.find("cells");
+  if (cells != j.end() && !cells->is_null())
+    m.cells = cells->get<CellMetrics>();
+  else
+    m.cells.reset();
+  j.at("objects").get_to(m.objects);
+}
+
+}  // namespace dualgrid::eval

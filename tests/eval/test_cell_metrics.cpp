@@ -1,0 +1,101 @@
+#include <cstdint>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "dualgrid/core/random.hpp"
+#include "dualgrid/eval/cell_metrics.hpp"
+
+using dualgrid::OrientedBox;
+using dualgrid::Position;
+using dualgrid::eval::CellClass;
+using dualgrid::eval::CellClassificationAccumulator;
+using dualgrid::eval::CellMetrics;
+using dualgrid::eval::ClassifyCell;
+using dualgrid::eval::RasterizeTruth;
+
+namespace {
+constexpr std::uint8_t F = 0, S = 1, D = 2, U = 3;
+}
+
+TEST_CASE("ClassifyCell uses the 0.6 threshold strictly", "[cells]") {
+  CHECK(ClassifyCell(0.1, 0.2, 0.61) == CellClass::kDynamic);
+  CHECK(ClassifyCell(0.2, 0.2, 0.6) == CellClass::kUnknown);  // "larger than 0.6"
+  CHECK(ClassifyCell(0.1, 0.7, 0.2) == CellClass::kStatic);
+  CHECK(ClassifyCell(0.9, 0.05, 0.05) == CellClass::kFree);
+  CHECK(ClassifyCell(0.4, 0.3, 0.3) == CellClass::kUnknown);
+}
+
+TEST_CASE("Confusion matrix and scores counted by hand", "[cells]") {
+  // truth:     D D D D S S F F F F
+  // predicted: D D D F D S F F U D
+  // observed:  all but the last cell in frame 1; frame 2 repeats the first 4 cells.
+  const std::vector<std::uint8_t> truth = {D, D, D, D, S, S, F, F, F, F};
+  const std::vector<std::uint8_t> pred = {D, D, D, F, D, S, F, F, U, D};
+  std::vector<std::uint8_t> observed(10, 1);
+  observed[9] = 0;
+  CellClassificationAccumulator acc;
+  acc.AddFrame(pred, truth, observed);
+  acc.AddFrame(std::span(pred).first(4), std::span(truth).first(4));
+  const CellMetrics m = acc.Result();
+  CHECK(m.frames == 2);
+  CHECK(m.cells == 13);
+  // Dynamic truth row: 3 + 3 predicted dynamic, 1 + 1 predicted free.
+  CHECK(m.confusion[D][D] == 6);
+  CHECK(m.confusion[D][F] == 2);
+  CHECK(m.confusion[S][D] == 1);
+  CHECK(m.confusion[S][S] == 1);
+  CHECK(m.confusion[F][F] == 2);
+  CHECK(m.confusion[F][U] == 1);
+  CHECK(m.confusion[F][D] == 0);  // the unobserved cell is not counted
+  // Dynamic: TP 6, FP 1, FN 2.
+  CHECK(*m.dynamic_precision == Approx(6.0 / 7.0));
+  CHECK(*m.dynamic_recall == Approx(6.0 / 8.0));
+  CHECK(*m.dynamic_f1 == Approx(12.0 / 15.0));
+  // Static: TP 1, FP 0, FN 1.
+  CHECK(*m.static_precision == Approx(1.0));
+  CHECK(*m.static_recall == Approx(0.5));
+  CHECK(*m.accuracy == Approx((6.0 + 1.0 + 2.0) / 13.0));
+}
+
+TEST_CASE("Cell scores are empty without the class", "[cells]") {
+  const std::vector<std::uint8_t> truth = {F, F}, pred = {F, U};
+  CellClassificationAccumulator acc;
+  acc.AddFrame(pred, truth);
+  const CellMetrics m = acc.Result();
+  CHECK_FALSE(m.dynamic_precision);
+  CHECK_FALSE(m.dynamic_recall);
+  CHECK_FALSE(m.dynamic_f1);
+  CHECK(*m.accuracy == Approx(0.5));
+  CHECK_THROWS_AS(acc.AddFrame(pred, std::vector<std::uint8_t>{F}), std::invalid_argument);
+  CHECK_THROWS_AS(acc.AddFrame(std::vector<std::uint8_t>{4}, std::vector<std::uint8_t>{F}),
+                  std::invalid_argument);
+}
+
+TEST_CASE("RasterizeTruth marks cell centres inside boxes, moving over stationary", "[cells]") {
+  // 0.5 m cells, centres at (0.25 + 0.5 i, 0.25 + 0.5 j) for a 20 x 8 grid.
+  std::vector<Position> centers;
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 20; ++i) centers.emplace_back(0.25 + 0.5 * i, 0.25 + 0.5 * j);
+  const double yaw = GENERATE(0.0, 0.4, -1.2);
+  const std::vector<OrientedBox> moving = {{{3.0, 2.0}, yaw, 4.5, 1.8}};
+  const std::vector<OrientedBox> stationary = {{{3.0, 2.0}, 0.0, 9.0, 0.6},
+                                               {{8.0, 3.0}, 0.0, 2.0, 1.0}};
+  std::vector<std::uint8_t> out(centers.size(), 99);
+  RasterizeTruth(centers, moving, stationary, out);
+  for (std::size_t i = 0; i < centers.size(); ++i) {
+    const auto expected = moving[0].Contains(centers[i])       ? D
+                          : stationary[0].Contains(centers[i]) ? S
+                          : stationary[1].Contains(centers[i]) ? S
+                                                               : F;
+    CHECK(out[i] == expected);
+  }
+  // The car covers about 4.5 * 1.8 / 0.25 = 32 cell centres; allow the rasterisation slack of
+  // one perimeter row (perimeter 12.6 m / 0.5 m ~ 25 cells).
+  int dynamic = 0;
+  for (const auto c : out) dynamic += c == D;
+  CHECK(dynamic >= 32 - 25);
+  CHECK(dynamic <= 32 + 25);
+  CHECK_THROWS_AS(RasterizeTruth(centers, moving, stationary, std::span(out).first(3)),
+                  std::invalid_argument);
+}

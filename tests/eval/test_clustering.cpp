@@ -1,0 +1,88 @@
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "dualgrid/core/random.hpp"
+#include "dualgrid/eval/clustering.hpp"
+
+using dualgrid::CounterRng;
+using dualgrid::Position;
+using dualgrid::RngPurpose;
+using dualgrid::Velocity;
+using dualgrid::eval::Cluster;
+using dualgrid::eval::kNoise;
+using dualgrid::eval::ParticleClusterer;
+using dualgrid::eval::WeightedParticle;
+
+TEST_CASE("Clusters carry weighted means, size and bounding box", "[clustering]") {
+  const std::vector<WeightedParticle> particles = {
+      {{0.0, 0.0}, {10.0, 0.0}, 1.0},
+      {{0.5, 0.0}, {12.0, 0.0}, 3.0},
+      {{0.5, 0.5}, {10.0, 2.0}, 0.0},
+      {{50.0, 50.0}, {0.0, 0.0}, 5.0},  // isolated: noise, must not leak into any mean
+      {{20.0, 0.0}, {-5.0, 1.0}, 2.0},
+      {{20.0, 0.5}, {-5.0, 1.0}, 2.0},
+      {{20.5, 0.0}, {-7.0, 1.0}, 4.0},
+  };
+  ParticleClusterer clusterer;
+  const std::vector<Cluster> clusters = clusterer.Run(particles);
+  REQUIRE(clusters.size() == 2);
+  CHECK(clusterer.labels()[3] == kNoise);
+  const Cluster& a = clusters[0];
+  CHECK(a.size == 3);
+  CHECK(a.weight == Approx(4.0));
+  // (1*(0,0) + 3*(0.5,0) + 0*(0.5,0.5)) / 4
+  CHECK(a.position.x() == Approx(0.375));
+  CHECK(a.position.y() == Approx(0.0).margin(1e-12));
+  CHECK(a.velocity.x() == Approx((10.0 + 36.0) / 4.0));
+  CHECK(a.velocity.y() == Approx(0.0).margin(1e-12));
+  CHECK(a.min == Position(0.0, 0.0));
+  CHECK(a.max == Position(0.5, 0.5));
+  const Cluster& b = clusters[1];
+  CHECK(b.size == 3);
+  CHECK(b.position.x() == Approx((40.0 + 40.0 + 82.0) / 8.0));
+  CHECK(b.position.y() == Approx(1.0 / 8.0));
+  CHECK(b.velocity.x() == Approx((-10.0 - 10.0 - 28.0) / 8.0));
+  CHECK(b.velocity.y() == Approx(1.0));
+}
+
+TEST_CASE("Weighted mean of a cluster lies within its bounding box", "[clustering]") {
+  const std::uint64_t seed = GENERATE(range(1, 11));
+  CounterRng rng(seed, RngPurpose::kTest, 0, 0);
+  std::vector<WeightedParticle> particles(200);
+  for (auto& p : particles) {
+    p.position = Position(rng.Normal(0.0, 1.0), rng.Normal(0.0, 0.5));
+    p.velocity = Velocity(rng.Normal(20.0, 1.0), rng.Normal(0.0, 1.0));
+    p.weight = rng.Uniform();
+  }
+  ParticleClusterer clusterer;
+  const auto clusters = clusterer.Run(particles);
+  int members = 0;
+  for (const Cluster& c : clusters) {
+    members += c.size;
+    CHECK((c.position.array() >= c.min.array() - 1e-12).all());
+    CHECK((c.position.array() <= c.max.array() + 1e-12).all());
+  }
+  int labelled = 0;
+  for (const int l : clusterer.labels()) labelled += l != kNoise;
+  CHECK(members == labelled);
+}
+
+TEST_CASE("Zero total weight falls back to the plain mean", "[clustering]") {
+  const std::vector<WeightedParticle> particles = {
+      {{0.0, 0.0}, {1.0, 0.0}, 0.0}, {{1.0, 0.0}, {3.0, 0.0}, 0.0}, {{0.5, 0.6}, {2.0, 3.0}, 0.0}};
+  ParticleClusterer clusterer;
+  const auto clusters = clusterer.Run(particles);
+  REQUIRE(clusters.size() == 1);
+  CHECK(clusters[0].position.x() == Approx(0.5));
+  CHECK(clusters[0].position.y() == Approx(0.2));
+  CHECK(clusters[0].velocity.x() == Approx(2.0));
+  CHECK(clusters[0].velocity.y() == Approx(1.0));
+}
+
+TEST_CASE("Negative or non-finite weights are rejected", "[clustering]") {
+  ParticleClusterer clusterer;
+  const double bad = GENERATE(-1.0, std::numeric_limits<double>::quiet_NaN());
+  const std::vector<WeightedParticle> particles = {{{0.0, 0.0}, {0.0, 0.0}, bad}};
+  CHECK_THROWS_AS(clusterer.Run(particles), std::invalid_argument);
+}
