@@ -201,7 +201,8 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
       auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
                              [&](const radar::SensorParams& s) { return s.name == name; });
       if (it == radar->sensors.end())
-        section->Fail("use", "names unknown sensor '" + name + "' (expected one of: " + names() + ")");
+        section->Fail("use",
+                      "names unknown sensor '" + name + "' (expected one of: " + names() + ")");
       kept.push_back(*it);
     }
     if (kept.empty()) section->Fail("use", "must list at least one sensor");
@@ -264,6 +265,8 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
   r->Read("consistent_required", &e->tracking.required);
   r->Read("consistent_window", &e->tracking.window);
   r->Read("min_frames_in_grid", &e->tracking.min_frames_in_grid);
+  r->Read("focus_object", &e->focus_object);
+  r->Read("snapshot_times", &e->snapshot_times);
   r->Finish();
   std::string error;
   if (!e->IsValid(&error)) Invalid(root.file(), "evaluation", error);

@@ -136,6 +136,14 @@ void MapReader::Read(const std::string& key, std::vector<std::string>* out) {
   }
 }
 
+void MapReader::Read(const std::string& key, std::vector<double>* out) {
+  if (auto n = Get(key)) {
+    if (!n.IsSequence()) Fail(key, "expected a list of numbers, got " + Show(n));
+    out->clear();
+    for (std::size_t i = 0; i < n.size(); ++i) out->push_back(ToDouble(n[i], key));
+  }
+}
+
 std::optional<MapReader> MapReader::Map(const std::string& key) {
   auto n = Get(key);
   if (!n) return std::nullopt;

@@ -33,6 +33,7 @@ class MapReader {
   void Read(const std::string& key, Position* out);
   void Read(const std::string& key, std::vector<Position>* out);
   void Read(const std::string& key, std::vector<std::string>* out);
+  void Read(const std::string& key, std::vector<double>* out);
   /// Reads an angle given in degrees into radians.
   void ReadDegrees(const std::string& key, double* out_rad);
   /// Reads `key`, which must be present.

@@ -91,3 +91,64 @@ TEST_CASE("Errors are one line with a non-zero exit", "[cli]") {
     CHECK(r.output.find("SUMO") != std::string::npos);
   }
 }
+
+TEST_CASE("snapshot writes a bird's-eye PNG", "[cli]") {
+  const auto dir = TempDir("snapshot");
+  const auto png = dir / "hw.png";
+  const Result r = Run("snapshot scenarios/highway.yaml --time 3 -q --out " + png.string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  std::ifstream in(png, std::ios::binary);
+  char magic[8] = {};
+  in.read(magic, 8);
+  CHECK(std::string(magic + 1, 3) == "PNG");
+  CHECK(fs::file_size(png) > 10000);
+}
+
+TEST_CASE("sim writes detections for all five radars", "[cli]") {
+  const auto dir = TempDir("detections");
+  REQUIRE(Run("sim scenarios/highway.yaml --duration 2 -q --out " + dir.string()).code == 0);
+  const std::string csv = Slurp(dir / "detections.csv");
+  for (const char* name :
+       {",front_left,", ",front_right,", ",rear_left,", ",rear_right,", ",front,"})
+    CHECK(csv.find(name) != std::string::npos);
+  CHECK(csv.find(",truck_3,") != std::string::npos);  // the parallel truck is seen
+}
+
+TEST_CASE("An unknown sensor in a scenario is one line with a non-zero exit", "[cli]") {
+  const auto dir = TempDir("sensor");
+  std::string text = Slurp("scenarios/simple_road.yaml");
+  text += "\nsensors:\n  overrides:\n    roof: {max_range: 100}\n";
+  std::ofstream(dir / "s.yaml") << text;
+  const Result r = Run("sim " + (dir / "s.yaml").string() + " --out " + (dir / "o").string());
+  CHECK(r.code != 0);
+  CHECK(CountLines(r.output) == 1);
+  CHECK(r.output.find("unknown sensor 'roof'") != std::string::npos);
+}
+
+TEST_CASE("run: short end-to-end runs give finite metrics for all three modes", "[cli][run]") {
+  const std::string scenario = GENERATE("simple_road", "highway");
+  const auto dir = TempDir("run_" + scenario);
+  const Result r = Run("run scenarios/" + scenario + ".yaml --duration 6 -q --out " + dir.string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const std::string metrics = Slurp(dir / "metrics.json");
+  for (const char* mode : {"\"position\"", "\"velocity\"", "\"dual\""})
+    CHECK(metrics.find(mode) != std::string::npos);
+  CHECK(metrics.find("nan") == std::string::npos);
+  CHECK(metrics.find("inf") == std::string::npos);
+  const std::string table = Slurp(dir / "table.csv");
+  CHECK(table.find("tracked") == std::string::npos);  // sanity: CSV, not Markdown
+  CHECK(table.find(",D,") != std::string::npos);
+  CHECK(fs::exists(dir / "figures" / "tracked_share.png"));
+}
+
+TEST_CASE("run: results do not depend on the number of OpenMP threads", "[cli][run]") {
+  const auto a = TempDir("threads1"), b = TempDir("threads2");
+  const std::string common = "run scenarios/highway.yaml --duration 4 --no-figures -q ";
+  REQUIRE(Run(common + "--threads 1 --out " + a.string()).code == 0);
+  REQUIRE(Run(common + "--threads 2 --out " + b.string()).code == 0);
+  CHECK(Slurp(a / "objects.csv") == Slurp(b / "objects.csv"));
+  CHECK(Slurp(a / "table.csv") == Slurp(b / "table.csv"));
+  CHECK(Slurp(a / "weights.csv") == Slurp(b / "weights.csv"));
+}

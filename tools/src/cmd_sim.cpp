@@ -9,8 +9,8 @@
 
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
-#include "dualgrid/sim/sumo_simulation.hpp"
 #include "output.hpp"
+#include "pipeline.hpp"
 #include "progress.hpp"
 
 namespace dualgrid::tools {
@@ -22,9 +22,9 @@ int RunSim(const RunOptions& options) {
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();
-  sim::SumoSimulation simulation(spec, sim::ResolveNetwork(spec.network, options.network_dir),
-                                 options.out);
+  Pipeline pipeline(config, options.network_dir, options.out, {});
   GroundTruthWriter truth(options.out / "ground_truth.csv");
+  DetectionWriter detections(options.out / "detections.csv");
   WriteObstacles(spec, options.out / "obstacles.csv");
 
   struct Seen {
@@ -34,9 +34,13 @@ int RunSim(const RunOptions& options) {
   std::map<std::string, Seen> seen;
   Progress progress("sim " + spec.name, spec.StepCount(), !options.quiet);
   int steps = 0;
-  while (simulation.Step()) {
-    const sim::Frame& f = simulation.frame();
+  std::size_t detection_count = 0, clutter_count = 0;
+  while (pipeline.Step()) {
+    const sim::Frame& f = pipeline.frame();
     truth.Write(f);
+    detections.Write(pipeline);
+    detection_count += pipeline.detections().size();
+    for (const auto& d : pipeline.detections()) clutter_count += d.is_clutter ? 1 : 0;
     for (const auto& v : f.vehicles) {
       auto [it, inserted] = seen.try_emplace(v.id, Seen{v.type, f.time, f.time, 1e9});
       it->second.last = f.time;
@@ -57,6 +61,9 @@ int RunSim(const RunOptions& options) {
   summary["steps"] = steps;
   summary["simulated_s"] = steps * spec.step_length;
   summary["wall_s"] = wall;
+  summary["detections"] = detection_count;
+  summary["clutter_detections"] = clutter_count;
+  for (const auto& sensor : pipeline.radar().sensors()) summary["sensors"].push_back(sensor.name);
   for (const auto& [id, s] : seen) {
     summary["vehicles"][id] = {{"type", s.type},
                                {"first_s", s.first},
@@ -67,7 +74,8 @@ int RunSim(const RunOptions& options) {
   if (!options.quiet) {
     std::cout << spec.name << ": " << steps << " steps (" << Fixed(steps * spec.step_length, 1)
               << " s simulated in " << Fixed(wall, 1) << " s), " << seen.size()
-              << " other vehicles; output in " << options.out.string() << "\n";
+              << " other vehicles, " << detection_count << " radar detections; output in "
+              << options.out.string() << "\n";
   }
   return 0;
 }

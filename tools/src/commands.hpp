@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "dualgrid/filter/params.hpp"
+
 namespace dualgrid::tools {
 
 /// Options shared by every command that runs a scenario.
@@ -20,6 +22,38 @@ struct RunOptions {
   bool quiet = false;
 };
 
+/// `dualgrid run`: the co-simulation with the grid filters, scored against the ground truth.
+struct FilterRunOptions {
+  RunOptions run;
+  std::vector<std::string> modes = {"position", "velocity", "dual"};
+  std::vector<double> snapshots;  ///< grid picture times [s]; empty: from the scenario
+  bool figures = true;
+  bool write_detections = false;
+  int threads = 0;  ///< OpenMP threads; 0: the OpenMP default
+};
+
+/// `dualgrid experiment`: `run` over seeds 1..N in separate processes, then aggregated.
+struct ExperimentOptions {
+  FilterRunOptions run;
+  int seeds = 10;
+  int first_seed = 1;
+  int jobs = 0;            ///< parallel runs; 0: number of cores
+  std::string executable;  ///< this program, to start the runs
+};
+
+/// `dualgrid snapshot`: bird's-eye picture of one time of a scenario.
+struct SnapshotOptions {
+  RunOptions run;
+  double time = 10.0;
+  double behind = 60.0, ahead = 140.0, half_width = 22.0;  ///< view around the ego [m]
+};
+
 int RunSim(const RunOptions& options);
+int RunFilters(const FilterRunOptions& options);
+int RunExperiment(const ExperimentOptions& options);
+int RunSnapshot(const SnapshotOptions& options);
+
+/// Parses mode names or throws naming the bad one.
+std::vector<filter::WeightMode> ParseModes(const std::vector<std::string>& names);
 
 }  // namespace dualgrid::tools

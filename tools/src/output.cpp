@@ -60,6 +60,26 @@ void GroundTruthWriter::Write(const sim::Frame& f) {
   for (const auto& v : f.vehicles) row(v, false);
 }
 
+DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(OpenOutput(path)) {
+  out_ << "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
+          "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter\n";
+}
+
+void DetectionWriter::Write(const Pipeline& p) {
+  const auto& f = p.frame();
+  for (const auto& d : p.detections()) {
+    out_ << f.step << ',' << Fixed(f.time, 3) << ',' << d.sensor << ','
+         << p.radar().sensors()[d.sensor].name << ',' << Fixed(d.range, 4) << ','
+         << Fixed(d.azimuth, 6) << ',' << Fixed(d.range_rate, 4) << ',' << Fixed(d.snr_db, 2) << ','
+         << Fixed(d.position_ego.x(), 4) << ',' << Fixed(d.position_ego.y(), 4) << ','
+         << Fixed(d.position_world.x(), 4) << ',' << Fixed(d.position_world.y(), 4) << ','
+         << Fixed(d.radial_speed_compensated, 4) << ',' << Fixed(d.radial_velocity_world.x(), 4)
+         << ',' << Fixed(d.radial_velocity_world.y(), 4) << ','
+         << Fixed(d.sensor_position_world.x(), 4) << ',' << Fixed(d.sensor_position_world.y(), 4)
+         << ',' << p.ids().Name(d.source_id) << ',' << (d.is_clutter ? 1 : 0) << '\n';
+  }
+}
+
 void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& path) {
   std::ofstream out = OpenOutput(path);
   out << "id,kind,vertex,x,y,yaw,length,width\n";

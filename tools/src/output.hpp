@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
+#include "pipeline.hpp"
 
 namespace dualgrid::tools {
 
@@ -26,6 +27,16 @@ class GroundTruthWriter {
  public:
   explicit GroundTruthWriter(const std::filesystem::path& path);
   void Write(const sim::Frame& frame);
+
+ private:
+  std::ofstream out_;
+};
+
+/// detections.csv: one row per radar detection per step.
+class DetectionWriter {
+ public:
+  explicit DetectionWriter(const std::filesystem::path& path);
+  void Write(const Pipeline& pipeline);
 
  private:
   std::ofstream out_;

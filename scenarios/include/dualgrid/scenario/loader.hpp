@@ -31,6 +31,11 @@ struct EvaluationConfig {
   double dynamic_threshold = 0.6;  ///< a cell is dynamic when P(dynamic) exceeds this
   eval::DbscanParams dbscan;
   eval::TrackingMetricsParams tracking;
+  /// Vehicle whose particle weights are plotted over time (paper Fig. 4); empty: the vehicle
+  /// that stays longest in the grid.
+  std::string focus_object;
+  /// Times [s] of the grid pictures (paper Fig. 7); empty: 1/4, 1/2 and 3/4 of the duration.
+  std::vector<double> snapshot_times;
   bool IsValid(std::string* error) const;
 };
 

@@ -1,0 +1,274 @@
+// `dualgrid run`: one SUMO run, one radar stream, three filters side by side, scored per step.
+#include <omp.h>
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "dualgrid/eval/aggregate.hpp"
+#include "figures.hpp"
+#include "output.hpp"
+#include "pipeline.hpp"
+#include "progress.hpp"
+#include "scoring.hpp"
+
+namespace dualgrid::tools {
+
+std::vector<filter::WeightMode> ParseModes(const std::vector<std::string>& names) {
+  std::vector<filter::WeightMode> modes;
+  for (const std::string& n : names) {
+    const auto m = filter::ParseWeightMode(n);
+    if (!m)
+      throw std::invalid_argument("unknown mode '" + n + "' (expected position, velocity, dual)");
+    if (std::find(modes.begin(), modes.end(), *m) != modes.end())
+      throw std::invalid_argument("mode '" + n + "' given twice");
+    modes.push_back(*m);
+  }
+  if (modes.empty()) throw std::invalid_argument("--modes needs at least one mode");
+  return modes;
+}
+
+namespace {
+
+nlohmann::json SensorJson(const radar::SensorParams& s) {
+  return {{"name", s.name},
+          {"mount",
+           {{"x", s.mount.position.x()},
+            {"y", s.mount.position.y()},
+            {"yaw_deg", RadToDeg(s.mount.yaw)}}},
+          {"fov_deg", RadToDeg(s.fov)},
+          {"min_range", s.min_range},
+          {"max_range", s.max_range},
+          {"min_range_rate", s.min_range_rate},
+          {"max_range_rate", s.max_range_rate},
+          {"range_resolution", s.range_resolution},
+          {"azimuth_resolution_deg", RadToDeg(s.azimuth_resolution)},
+          {"range_rate_resolution", s.range_rate_resolution},
+          {"range_bias_fraction", s.range_bias_fraction},
+          {"azimuth_bias_fraction", s.azimuth_bias_fraction},
+          {"range_rate_bias_fraction", s.range_rate_bias_fraction},
+          {"reference_range", s.reference_range},
+          {"reference_rcs_dbsm", s.reference_rcs_dbsm},
+          {"reference_pd", s.reference_pd},
+          {"false_alarm_rate", s.false_alarm_rate},
+          {"update_period", s.update_period}};
+}
+
+nlohmann::json FilterJson(const filter::FilterParams& f) {
+  return {{"length_x", f.length_x},
+          {"width_y", f.width_y},
+          {"resolution", f.resolution},
+          {"num_particles", f.num_particles},
+          {"num_birth", f.num_birth},
+          {"process_noise_position", f.process_noise_position},
+          {"process_noise_velocity", f.process_noise_velocity},
+          {"persistence", f.persistence},
+          {"birth_probability", f.birth_probability},
+          {"birth_max_tangential_speed", f.birth_max_tangential_speed},
+          {"birth_sigma_radial", f.birth_sigma_radial},
+          {"sigma_f", f.sigma_f},
+          {"sigma_static_distance", f.sigma_static_distance},
+          {"sigma_static_velocity", f.sigma_static_velocity},
+          {"sigma_v", f.sigma_v},
+          {"cutoff_sigmas", f.cutoff_sigmas},
+          {"occupied_mass", f.occupied_mass},
+          {"free_mass", f.free_mass},
+          {"free_mass_no_return", f.free_mass_no_return},
+          {"free_angle_bin_deg", RadToDeg(f.free_angle_bin)},
+          {"free_bin_dilation", f.free_bin_dilation},
+          {"free_decay", f.free_decay},
+          {"static_persistence", f.static_persistence},
+          {"static_gain", f.static_gain},
+          {"static_speed", f.static_speed},
+          {"decay_eps", f.decay_eps}};
+}
+
+// Everything the run actually used, so any result can be rerun or compared.
+nlohmann::json ConfigJson(const scenario::ScenarioConfig& c, const FilterRunOptions& o) {
+  nlohmann::json j;
+  j["scenario_file"] = c.file.string();
+  j["scenario"] = c.sim.name;
+  j["seed"] = c.sim.seed;
+  j["duration_s"] = c.sim.duration;
+  j["step_length_s"] = c.sim.step_length;
+  j["modes"] = o.modes;
+  j["radar"]["noise"] = c.radar.options.noise;
+  j["radar"]["false_alarms"] = c.radar.options.false_alarms;
+  j["radar"]["occlusion"] = c.radar.options.occlusion;
+  for (const auto& s : c.radar.sensors) j["radar"]["sensors"].push_back(SensorJson(s));
+  j["filter"] = FilterJson(c.filter);
+  j["evaluation"]["dynamic_threshold"] = c.evaluation.dynamic_threshold;
+  j["evaluation"]["dbscan"] = c.evaluation.dbscan;
+  j["evaluation"]["tracking"] = c.evaluation.tracking;
+  j["evaluation"]["focus_object"] = c.evaluation.focus_object;
+  return j;
+}
+
+}  // namespace
+
+int RunFilters(const FilterRunOptions& options) {
+  if (options.threads > 0) omp_set_num_threads(options.threads);
+  const std::vector<filter::WeightMode> modes = ParseModes(options.modes);
+  std::vector<std::string> mode_names;
+  for (auto m : modes) mode_names.emplace_back(filter::ToString(m));
+  scenario::ScenarioConfig config = LoadConfig(options.run);
+  const auto& out = options.run.out;
+  std::filesystem::create_directories(out / "figures");
+  CopyScenario(config, out);
+  std::ofstream(out / "config.json") << ConfigJson(config, options).dump(2) << "\n";
+
+  const auto wall_start = std::chrono::steady_clock::now();
+  Pipeline pipeline(config, options.run.network_dir, out, modes);
+  GroundTruthWriter truth(out / "ground_truth.csv");
+  std::unique_ptr<DetectionWriter> detections;
+  if (options.write_detections)
+    detections = std::make_unique<DetectionWriter>(out / "detections.csv");
+
+  std::vector<ModeScorer> scorers(modes.size(), ModeScorer(config.evaluation));
+  std::vector<double> snapshot_times = options.snapshots;
+  if (snapshot_times.empty()) snapshot_times = config.evaluation.snapshot_times;
+  if (snapshot_times.empty())
+    for (double f : {0.25, 0.5, 0.75}) snapshot_times.push_back(f * config.sim.duration);
+  std::sort(snapshot_times.begin(), snapshot_times.end());
+  std::size_t next_snapshot = 0;
+
+  // Weight traces (paper Fig. 4) of the dual filter, or of the last mode if dual is not run.
+  const std::size_t trace_mode =
+      std::find(modes.begin(), modes.end(), filter::WeightMode::kDual) != modes.end()
+          ? std::find(modes.begin(), modes.end(), filter::WeightMode::kDual) - modes.begin()
+          : modes.size() - 1;
+  std::map<std::string, WeightTrace> traces;
+  std::map<std::string, int> frames_in_grid;
+
+  Progress progress("run " + config.sim.name + " seed " + std::to_string(config.sim.seed),
+                    config.sim.StepCount(), !options.run.quiet);
+  int steps = 0;
+  std::size_t total_detections = 0;
+  while (pipeline.Step()) {
+    const sim::Frame& f = pipeline.frame();
+    truth.Write(f);
+    if (detections) detections->Write(pipeline);
+    total_detections += pipeline.detections().size();
+    std::vector<GridSnapshot> snaps;
+    std::vector<std::uint8_t> truth_classes;
+    for (std::size_t m = 0; m < modes.size(); ++m) {
+      const auto& grid = pipeline.grid(m);
+      snaps.push_back(TakeSnapshot(grid));
+      if (m == 0) truth_classes = TruthClasses(snaps[0], f, config.sim);
+      scorers[m].AddFrame(f.time, grid, snaps[m], pipeline.TruthObjects(grid), truth_classes);
+    }
+    // Weight masses of the particles inside each vehicle's box, for the focus-object figure.
+    {
+      const auto& p = pipeline.grid(trace_mode).particles();
+      for (const auto& v : f.vehicles) {
+        if (!pipeline.grid(trace_mode).CellOf(v.box.center)) continue;
+        ++frames_in_grid[v.id];
+        double wp = 0, wv = 0, w = 0;
+        const OrientedBox grown{v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0};
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
+          wp += p.w_position[i];
+          wv += p.w_velocity[i];
+          w += p.weight[i];
+        }
+        double doppler = 0;
+        int n = 0;
+        for (const auto& d : pipeline.detections())
+          if (pipeline.ids().Name(d.source_id) == v.id) {
+            doppler += std::abs(d.radial_speed_compensated);
+            ++n;
+          }
+        auto& t = traces[v.id];
+        t.time.push_back(f.time);
+        t.w_position.push_back(wp);
+        t.w_velocity.push_back(wv);
+        t.weight.push_back(w);
+        t.radial_speed_ratio.push_back(
+            n > 0 && v.velocity.norm() > 0.1 ? doppler / n / v.velocity.norm() : std::nan(""));
+      }
+    }
+    if (options.figures && next_snapshot < snapshot_times.size() &&
+        f.time + 1e-9 >= snapshot_times[next_snapshot]) {
+      RenderGridFigure(mode_names, snaps, f, f.time,
+                       out / "figures" / ("grid_t" + Fixed(f.time, 1) + ".png"));
+      RenderScene(pipeline, out / "figures" / ("scene_t" + Fixed(f.time, 1) + ".png"), 60, 140, 22);
+      ++next_snapshot;
+    }
+    ++steps;
+    progress.Update(steps, "t=" + Fixed(f.time, 1) + " s");
+  }
+  progress.Finish();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+  // Results.
+  std::vector<eval::ScenarioMetrics> metrics;
+  std::vector<eval::ModeRuns> runs;
+  nlohmann::json mj;
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    metrics.push_back(scorers[m].Result());
+    runs.push_back({mode_names[m], {metrics.back()}});
+    mj["modes"][mode_names[m]] = metrics.back();
+  }
+  mj["scenario"] = config.sim.name;
+  mj["seed"] = config.sim.seed;
+  mj["steps"] = steps;
+  mj["wall_s"] = wall;
+  mj["detections_per_step"] = steps ? static_cast<double>(total_detections) / steps : 0.0;
+  for (const auto& [id, n] : frames_in_grid)
+    (void)n, mj["object_names"][std::to_string(pipeline.ids().Id(id))] = id;
+  std::ofstream(out / "metrics.json") << mj.dump(2) << "\n";
+
+  {
+    std::ofstream objects = OpenOutput(out / "objects.csv");
+    objects << "mode,id,name,frames_in_grid,frames_tracked,scored,D,t_d,delta_x,delta_v\n";
+    for (std::size_t m = 0; m < modes.size(); ++m) {
+      for (const auto& o : metrics[m].objects) {
+        auto opt = [](const std::optional<double>& v) { return v ? Fixed(*v, 4) : std::string(); };
+        objects << mode_names[m] << ',' << o.id << ',' << pipeline.ids().Name(o.id) << ','
+                << o.frames_in_grid << ',' << o.frames_tracked << ',' << (o.scored ? 1 : 0) << ','
+                << opt(o.tracked_fraction) << ',' << opt(o.detection_time) << ','
+                << opt(o.position_error) << ',' << opt(o.velocity_error) << '\n';
+      }
+    }
+  }
+  const eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
+  std::ofstream(out / "table.md") << table.ToMarkdown();
+  std::ofstream(out / "table.csv") << table.ToCsv();
+  std::ofstream(out / "table.json") << table.ToJson().dump(2) << "\n";
+
+  // Focus object: the scenario's choice, else the vehicle longest in the grid.
+  std::string focus = config.evaluation.focus_object;
+  if (focus.empty() || !traces.count(focus)) {
+    int best = -1;
+    for (const auto& [id, n] : frames_in_grid)
+      if (n > best) best = n, focus = id;
+  }
+  if (traces.count(focus)) {
+    const WeightTrace& t = traces.at(focus);
+    std::ofstream w = OpenOutput(out / "weights.csv");
+    w << "time,object,w_position,w_velocity,w_resample,doppler_ratio\n";
+    for (std::size_t i = 0; i < t.time.size(); ++i)
+      w << Fixed(t.time[i], 3) << ',' << focus << ',' << t.w_position[i] << ',' << t.w_velocity[i]
+        << ',' << t.weight[i] << ',' << t.radial_speed_ratio[i] << '\n';
+    if (options.figures)
+      RenderWeightTrace(t, focus, mode_names[trace_mode], out / "figures" / "weights.png");
+  }
+  if (options.figures)
+    RenderTrackedShares(mode_names, metrics, pipeline.ids(),
+                        config.sim.name + ": tracked share D per object (seed " +
+                            std::to_string(config.sim.seed) + ")",
+                        out / "figures" / "tracked_share.png");
+
+  if (!options.run.quiet) {
+    std::cout << table.ToMarkdown() << "\n"
+              << config.sim.name << ": " << steps << " steps in " << Fixed(wall, 1)
+              << " s; results in " << out.string() << "\n";
+  }
+  return 0;
+}
+
+}  // namespace dualgrid::tools

@@ -1,0 +1,34 @@
+// `dualgrid snapshot`: a bird's-eye picture of a scenario at one time.
+#include <iostream>
+
+#include "commands.hpp"
+#include "figures.hpp"
+#include "output.hpp"
+#include "pipeline.hpp"
+
+namespace dualgrid::tools {
+
+int RunSnapshot(const SnapshotOptions& options) {
+  RunOptions run = options.run;
+  scenario::ScenarioConfig config = LoadConfig(run);
+  if (!(options.time > 0.0 && options.time <= config.sim.duration))
+    throw std::invalid_argument("--time must be in (0, " + Fixed(config.sim.duration, 2) +
+                                "] s, the scenario's duration");
+  config.sim.duration = options.time;
+  // SUMO's route file and log go next to the picture.
+  const std::filesystem::path png = run.out;
+  const std::filesystem::path work = png.has_parent_path()
+                                         ? png.parent_path() / (png.stem().string() + "_sumo")
+                                         : std::filesystem::path(png.stem().string() + "_sumo");
+  Pipeline pipeline(config, run.network_dir, work, {});
+  while (pipeline.Step()) {
+  }
+  if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
+  RenderScene(pipeline, png, options.behind, options.ahead, options.half_width);
+  if (!run.quiet)
+    std::cout << "wrote " << png.string() << " (t = " << Fixed(pipeline.frame().time, 2) << " s, "
+              << pipeline.detections().size() << " detections)\n";
+  return 0;
+}
+
+}  // namespace dualgrid::tools

@@ -1,0 +1,138 @@
+#include "figures.hpp"
+
+#include <cmath>
+
+#include "dualgrid/viz/birds_eye_view.hpp"
+#include "dualgrid/viz/charts.hpp"
+#include "dualgrid/viz/grid_panels.hpp"
+#include "output.hpp"
+
+namespace dualgrid::tools {
+
+void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
+                 double ahead, double half_width) {
+  const sim::Frame& f = pipeline.frame();
+  const Position c = f.ego.box.center;
+  viz::BirdsEyeOptions options;
+  options.title = pipeline.config().sim.name + "  t = " + Fixed(f.time, 2) + " s  (" +
+                  std::to_string(pipeline.detections().size()) + " detections)";
+  viz::BirdsEyeView view({c + Position(-behind, -half_width), c + Position(ahead, half_width)},
+                         options);
+  for (const auto& lane : pipeline.simulation().LaneShapes())
+    view.DrawLane(lane.points, lane.width);
+  for (const auto& g : pipeline.config().sim.guard_rails) view.DrawGuardRail(g.points);
+  for (const auto& p : pipeline.config().sim.parked) {
+    viz::VehicleStyle style;
+    style.fill = viz::colors::kGuardRail;
+    style.label = p.id;
+    view.DrawVehicle(p.box, style);
+  }
+  const auto& radar = pipeline.radar();
+  const auto poses = radar.SensorPoses(pipeline.ego_motion().pose);
+  for (std::size_t s = 0; s < poses.size(); ++s) {
+    const auto& p = radar.sensors()[s];
+    view.DrawSensorFov(
+        {poses[s].position, poses[s].yaw, 0.5 * p.fov, p.max_range, static_cast<int>(s), p.name});
+  }
+  for (const auto& v : f.vehicles) {
+    viz::VehicleStyle style;
+    style.label = v.id;
+    style.velocity = v.velocity - f.ego.velocity;  // relative motion reads better at speed
+    view.DrawVehicle(v.box, style);
+  }
+  viz::VehicleStyle ego_style;
+  ego_style.ego = true;
+  ego_style.label = "ego";
+  view.DrawVehicle(f.ego.box, ego_style);
+  std::vector<viz::DetectionMark> marks;
+  for (const auto& d : pipeline.detections())
+    marks.push_back({d.position_world, d.radial_velocity_world, d.sensor, d.is_clutter});
+  viz::DetectionStyle style;
+  style.coloring = viz::DetectionColoring::kBySpeed;
+  view.DrawDetections(marks, style);
+  view.SavePng(path.string());
+}
+
+namespace {
+
+viz::GridRaster ToRaster(const GridSnapshot& s) {
+  return {s.cells_x,    s.cells_y, s.resolution, s.origin, s.free,
+          s.static_occ, s.dynamic, s.mean_vx,    s.mean_vy};
+}
+
+}  // namespace
+
+void RenderGridFigure(const std::vector<std::string>& modes,
+                      const std::vector<GridSnapshot>& snapshots, const sim::Frame& frame,
+                      double time, const std::filesystem::path& path) {
+  std::vector<viz::GridPanel> panels;
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    viz::GridPanel panel;
+    panel.title = modes[i];
+    panel.raster = ToRaster(snapshots[i]);
+    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(v.box);
+    panel.ego_boxes.push_back(frame.ego.box);
+    panels.push_back(std::move(panel));
+  }
+  viz::GridFigureOptions options;
+  options.title = "Dynamic grid at t = " + Fixed(time, 2) +
+                  " s: hue = direction of motion, white free, black static, grey unknown";
+  viz::RenderGridPanels(panels, path.string(), options);
+}
+
+void RenderTrackedShares(const std::vector<std::string>& modes,
+                         const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
+                         const std::string& title, const std::filesystem::path& path) {
+  std::map<int, std::vector<double>> per_object;
+  for (std::size_t m = 0; m < metrics.size(); ++m) {
+    for (const auto& o : metrics[m].objects) {
+      if (!o.scored) continue;
+      auto& row = per_object.try_emplace(o.id, modes.size(), std::nan("")).first->second;
+      row[m] = o.tracked_fraction.value_or(0.0);
+    }
+  }
+  viz::BarChart chart;
+  chart.title = title;
+  chart.x_label = "object";
+  chart.y_label = "tracked share D";
+  chart.percent = true;
+  chart.value_labels = per_object.size() <= 12;
+  chart.width = std::max(1000, 60 * static_cast<int>(per_object.size() * modes.size()) + 200);
+  for (const auto& [id, row] : per_object) chart.categories.push_back(ids.Name(id));
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    viz::BarSeries s;
+    s.name = modes[m];
+    for (const auto& [id, row] : per_object) s.values.push_back(row[m]);
+    chart.series.push_back(std::move(s));
+  }
+  if (chart.categories.empty()) return;  // nothing scored (very short run)
+  viz::RenderBarChart(chart, path.string());
+}
+
+void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
+                       const std::filesystem::path& path) {
+  if (trace.time.size() < 2) return;
+  viz::LineChart chart;
+  chart.title = "Particle weights on " + object + " (" + mode +
+                " filter): summed over the particles inside its box";
+  chart.y_label = "weight mass";
+  chart.log_y = true;
+  chart.series.push_back(
+      {"w_position", trace.time, trace.w_position, viz::ModeColor(viz::Mode::kPosition)});
+  chart.series.push_back(
+      {"w_velocity", trace.time, trace.w_velocity, viz::ModeColor(viz::Mode::kVelocity)});
+  chart.series.push_back({"w_resample", trace.time, trace.weight, viz::colors::kBlack, 1.0, true});
+  // Shade where the Doppler sees less than half of the object's speed (tangential motion).
+  std::optional<double> start;
+  for (std::size_t i = 0; i <= trace.time.size(); ++i) {
+    const bool low = i < trace.time.size() && trace.radial_speed_ratio[i] < 0.5;
+    if (low && !start) start = trace.time[i];
+    if (!low && start) {
+      chart.spans.push_back({*start, trace.time[i - 1], "Doppler < 50 % of speed"});
+      start.reset();
+    }
+  }
+  viz::RenderLineChart(chart, path.string());
+}
+
+}  // namespace dualgrid::tools

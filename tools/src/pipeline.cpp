@@ -1,0 +1,92 @@
+#include "pipeline.hpp"
+
+#include <stdexcept>
+
+namespace dualgrid::tools {
+
+int IdRegistry::Id(const std::string& name) {
+  auto [it, inserted] = ids_.try_emplace(name, static_cast<int>(names_.size()));
+  if (inserted) names_.push_back(name);
+  return it->second;
+}
+
+const std::string& IdRegistry::Name(int id) const {
+  static const std::string kClutter = "clutter";
+  if (id < 0 || id >= static_cast<int>(names_.size())) return kClutter;
+  return names_[id];
+}
+
+Pipeline::Pipeline(const scenario::ScenarioConfig& config, const std::filesystem::path& network_dir,
+                   const std::filesystem::path& work_dir, std::vector<filter::WeightMode> modes)
+    : config_(config),
+      simulation_(config.sim, sim::ResolveNetwork(config.sim.network, network_dir), work_dir),
+      radar_(config.radar.sensors, config.radar.options, config.sim.seed),
+      modes_(std::move(modes)) {
+  for (filter::WeightMode m : modes_) {
+    filter::FilterParams p = config_.filter;
+    p.mode = m;
+    // The same seed for every mode: birth and prediction noise are identical across modes until
+    // their particle sets differ, so the comparison isolates the weights.
+    filters_.push_back(std::make_unique<filter::DynamicGrid>(p, config_.sim.seed));
+  }
+  for (const auto& g : config_.sim.guard_rails)
+    static_scene_.polylines.push_back({ids_.Id(g.id), g.points, g.rcs_dbsm_per_metre});
+  for (const auto& p : config_.sim.parked)
+    static_scene_.targets.push_back({ids_.Id(p.id), p.box, Velocity::Zero(), 0.0, p.rcs_dbsm});
+}
+
+radar::Scene Pipeline::BuildScene() {
+  radar::Scene scene = static_scene_;
+  for (const sim::VehicleState& v : frame().vehicles)
+    scene.targets.push_back({ids_.Id(v.id), v.box, v.velocity, v.yaw_rate, v.rcs_dbsm});
+  return scene;
+}
+
+bool Pipeline::Step() {
+  if (!simulation_.Step()) return false;
+  const sim::Frame& f = frame();
+  ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate};
+  const double dt = f.time - last_time_;
+  last_time_ = f.time;
+
+  detections_ = radar_.Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
+                            config_.sim.step_length);
+  scanned_ = radar_.SensorsDue(f.time, config_.sim.step_length);
+
+  if (filters_.empty()) return true;
+  measurements_.clear();
+  for (const radar::Detection& d : detections_)
+    measurements_.push_back({d.position_world, d.radial_velocity_world, d.sensor_position_world});
+  coverage_.clear();
+  for (int s : scanned_) {
+    const radar::SensorParams& p = radar_.sensors()[s];
+    const Pose2 pose = radar_.SensorPose(s, ego_.pose);
+    coverage_.push_back({pose.position, pose.yaw, 0.5 * p.fov, p.min_range, p.max_range});
+  }
+  const filter::EgoInput ego{ego_.pose, ego_.velocity};
+  for (auto& g : filters_) g->Update(ego, measurements_, coverage_, dt);
+  return true;
+}
+
+std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) {
+  std::vector<eval::TruthObject> out;
+  const auto poses = radar_.SensorPoses(ego_.pose);
+  for (const sim::VehicleState& v : frame().vehicles) {
+    eval::TruthObject o;
+    o.id = ids_.Id(v.id);
+    o.box = v.box;
+    o.velocity = v.velocity;
+    o.in_grid = grid.CellOf(v.box.center).has_value();
+    for (std::size_t s = 0; s < poses.size() && !o.in_coverage; ++s) {
+      const radar::SensorParams& p = radar_.sensors()[s];
+      const Position local = poses[s].ToLocal(v.box.center);
+      const double r = local.norm();
+      o.in_coverage = r >= p.min_range && r <= p.max_range &&
+                      std::abs(std::atan2(local.y(), local.x())) <= 0.5 * p.fov;
+    }
+    out.push_back(o);
+  }
+  return out;
+}
+
+}  // namespace dualgrid::tools

@@ -1,0 +1,118 @@
+#include "scoring.hpp"
+
+#include <cmath>
+
+namespace dualgrid::tools {
+
+GridSnapshot TakeSnapshot(const filter::DynamicGrid& grid) {
+  GridSnapshot s;
+  s.cells_x = grid.cells_x();
+  s.cells_y = grid.cells_y();
+  s.resolution = grid.resolution();
+  s.origin = grid.CellCenter({0, 0}) - Position::Constant(0.5 * s.resolution);
+  const std::size_t n = static_cast<std::size_t>(s.cells_x) * s.cells_y;
+  s.free.resize(n);
+  s.static_occ.resize(n);
+  s.dynamic.resize(n);
+  s.mean_vx.resize(n);
+  s.mean_vy.resize(n);
+  s.observed.resize(n);
+  s.centers.resize(n);
+  for (int y = 0; y < s.cells_y; ++y) {
+    for (int x = 0; x < s.cells_x; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * s.cells_x + x;
+      const filter::CellState c = grid.Cell({x, y});
+      s.free[i] = static_cast<float>(c.free);
+      s.static_occ[i] = static_cast<float>(c.static_occ);
+      s.dynamic[i] = static_cast<float>(c.dynamic);
+      s.mean_vx[i] = static_cast<float>(c.mean_velocity.x());
+      s.mean_vy[i] = static_cast<float>(c.mean_velocity.y());
+      s.observed[i] = c.observed ? 1 : 0;
+      s.centers[i] = grid.CellCenter({x, y});
+    }
+  }
+  return s;
+}
+
+namespace {
+
+// A box overlaps the grid rectangle (conservative: its bounding circle).
+bool NearGrid(const OrientedBox& b, const Position& lo, const Position& hi) {
+  const double r = 0.5 * std::hypot(b.length, b.width);
+  return b.center.x() + r >= lo.x() && b.center.x() - r <= hi.x() && b.center.y() + r >= lo.y() &&
+         b.center.y() - r <= hi.y();
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Frame& frame,
+                                       const sim::ScenarioSpec& spec) {
+  const Position lo = grid.origin;
+  const Position hi = lo + Position(grid.cells_x, grid.cells_y) * grid.resolution;
+  std::vector<OrientedBox> moving, stationary;
+  // A vehicle slower than 0.5 m/s is stationary (the filter cannot call it dynamic either).
+  for (const auto& v : frame.vehicles)
+    if (NearGrid(v.box, lo, hi)) (v.velocity.norm() > 0.5 ? moving : stationary).push_back(v.box);
+  for (const auto& p : spec.parked)
+    if (NearGrid(p.box, lo, hi)) stationary.push_back(p.box);
+  for (const auto& rail : spec.guard_rails) {
+    for (std::size_t k = 0; k + 1 < rail.points.size(); ++k) {
+      // Clip the segment to the grid's x range so the box stays small, then make it one cell
+      // wide so that the rail marks one row of cells.
+      Position a = rail.points[k], b = rail.points[k + 1];
+      const Vector2 d = b - a;
+      if (std::abs(d.x()) > 1e-9) {
+        const double t0 = std::clamp((lo.x() - a.x()) / d.x(), 0.0, 1.0);
+        const double t1 = std::clamp((hi.x() - a.x()) / d.x(), 0.0, 1.0);
+        const Position a2 = a + std::min(t0, t1) * d, b2 = a + std::max(t0, t1) * d;
+        a = a2;
+        b = b2;
+      }
+      const double len = (b - a).norm();
+      if (len < 1e-6) continue;
+      const OrientedBox box{0.5 * (a + b), std::atan2(b.y() - a.y(), b.x() - a.x()), len,
+                            grid.resolution};
+      if (NearGrid(box, lo, hi)) stationary.push_back(box);
+    }
+  }
+  std::vector<std::uint8_t> out(grid.centers.size());
+  eval::RasterizeTruth(grid.centers, moving, stationary, out);
+  return out;
+}
+
+ModeScorer::ModeScorer(const scenario::EvaluationConfig& config)
+    : config_(config), clusterer_(config.dbscan), tracking_(config.tracking) {}
+
+void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
+                          const GridSnapshot& snapshot,
+                          const std::vector<eval::TruthObject>& objects,
+                          const std::vector<std::uint8_t>& truth_classes) {
+  // Paper Sec. V: particles of cells with P(dynamic) above the threshold are clustered.
+  const filter::ParticleSet& p = grid.particles();
+  dynamic_particles_.clear();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Position pos(p.x[i], p.y[i]);
+    const auto cell = grid.CellOf(pos);
+    if (!cell) continue;
+    const std::size_t k = static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x;
+    if (snapshot.dynamic[k] > config_.dynamic_threshold)
+      dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+  }
+  clusters_ = clusterer_.Run(dynamic_particles_);
+  tracking_.AddFrame(time, clusters_, objects);
+
+  predicted_.resize(snapshot.dynamic.size());
+  for (std::size_t k = 0; k < predicted_.size(); ++k) {
+    predicted_[k] = static_cast<std::uint8_t>(eval::ClassifyCell(
+        snapshot.free[k], snapshot.static_occ[k], snapshot.dynamic[k], config_.dynamic_threshold));
+  }
+  cells_.AddFrame(predicted_, truth_classes, snapshot.observed);
+}
+
+eval::ScenarioMetrics ModeScorer::Result() const {
+  eval::ScenarioMetrics m = tracking_.Result();
+  m.cells = cells_.Result();
+  return m;
+}
+
+}  // namespace dualgrid::tools

@@ -1,0 +1,55 @@
+// Glue between one filter and the scoring library: picks the particles of dynamic cells,
+// clusters them, scores clusters against the ground truth and classifies cells (paper Sec. V).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dualgrid/eval/cell_metrics.hpp"
+#include "dualgrid/eval/clustering.hpp"
+#include "dualgrid/eval/metrics.hpp"
+#include "dualgrid/filter/dynamic_grid.hpp"
+#include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/sim/ground_truth.hpp"
+
+namespace dualgrid::tools {
+
+/// Per-cell snapshot of a grid in logical row-major order (index = y * cells_x + x).
+struct GridSnapshot {
+  int cells_x = 0, cells_y = 0;
+  double resolution = 0.0;
+  Position origin = Position::Zero();  ///< lower-left corner of cell (0, 0), world
+  std::vector<float> free, static_occ, dynamic, mean_vx, mean_vy;
+  std::vector<std::uint8_t> observed;
+  /// Cell centres, world frame.
+  std::vector<Position> centers;
+};
+GridSnapshot TakeSnapshot(const filter::DynamicGrid& grid);
+
+/// Ground-truth class per cell: moving vehicles dynamic; parked boxes and guard rails (as boxes
+/// one cell wide) static; the rest free. Boxes are culled to the grid first.
+std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Frame& frame,
+                                       const sim::ScenarioSpec& spec);
+
+class ModeScorer {
+ public:
+  explicit ModeScorer(const scenario::EvaluationConfig& config);
+  /// Scores one cycle. `snapshot` is TakeSnapshot(grid); `truth_classes` from TruthClasses.
+  void AddFrame(double time, const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
+                const std::vector<eval::TruthObject>& objects,
+                const std::vector<std::uint8_t>& truth_classes);
+  eval::ScenarioMetrics Result() const;
+  /// Clusters of the last frame.
+  const std::vector<eval::Cluster>& clusters() const { return clusters_; }
+
+ private:
+  scenario::EvaluationConfig config_;
+  eval::ParticleClusterer clusterer_;
+  eval::TrackingMetricsAccumulator tracking_;
+  eval::CellClassificationAccumulator cells_;
+  std::vector<eval::WeightedParticle> dynamic_particles_;
+  std::vector<eval::Cluster> clusters_;
+  std::vector<std::uint8_t> predicted_;
+};
+
+}  // namespace dualgrid::tools
