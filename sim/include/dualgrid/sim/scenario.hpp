@@ -72,7 +72,7 @@ struct ActionSpec {
 struct GuardRail {
   std::string id;
   std::vector<Position> points;
-  double rcs_dbsm_per_metre = 0.0;  ///< [dBsm per metre of rail]
+  double rcs_dbsm_per_metre = -5.0;  ///< [dBsm per metre of rail]
 };
 
 /// A parked vehicle or other static box.
