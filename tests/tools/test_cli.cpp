@@ -152,3 +152,35 @@ TEST_CASE("run: results do not depend on the number of OpenMP threads", "[cli][r
   CHECK(Slurp(a / "table.csv") == Slurp(b / "table.csv"));
   CHECK(Slurp(a / "weights.csv") == Slurp(b / "weights.csv"));
 }
+
+TEST_CASE("tangential: crossing traffic shows almost no Doppler to the front radar", "[cli]") {
+  const auto dir = TempDir("tangential");
+  const auto yaml = dir / "crossing.yaml";
+  REQUIRE(Run("tangential --kind crossing --count 2 --speed 15 -q --out " + yaml.string()).code ==
+          0);
+  REQUIRE(Run("sim " + yaml.string() + " -q --out " + (dir / "run").string()).code == 0);
+  std::ifstream in(dir / "run" / "detections.csv");
+  std::string line;
+  std::getline(in, line);  // header
+  int near_axis = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    // columns: 3 sensor_name, 9 y_ego, 12 radial_speed, 17 source
+    if (f[3] != "front" || f[17].rfind("cross_", 0) != 0) continue;
+    if (std::abs(std::stod(f[9])) > 2.0) continue;
+    ++near_axis;
+    // A crossing car within 2 m of the ego's axis, >= 30 m ahead, moving at 15 m/s across it:
+    // radial speed <= 15 * 2 / 30 = 1 m/s, plus range-rate noise (sigma ~0.1 m/s): < 2 m/s.
+    CHECK(std::abs(std::stod(f[12])) < 2.0);
+  }
+  CHECK(near_axis > 20);
+}
+
+TEST_CASE("tangential: bad options are rejected", "[cli]") {
+  CHECK(Run("tangential --kind diagonal --out /tmp/x.yaml").code != 0);
+  const Result r = Run("tangential --kind parallel --spacing 5 --out /tmp/x.yaml");
+  CHECK(r.code != 0);
+  CHECK(r.output.find("--spacing") != std::string::npos);
+}

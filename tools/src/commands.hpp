@@ -48,7 +48,21 @@ struct SnapshotOptions {
   double behind = 60.0, ahead = 140.0, half_width = 22.0;  ///< view around the ego [m]
 };
 
+/// `dualgrid tangential`: writes a tangential-motion stress scenario.
+struct TangentialOptions {
+  std::string kind = "crossing";  ///< "crossing" (ahead, across the front radar) or "parallel"
+  int count = 4;                  ///< stress vehicles
+  double ego_speed = 20.0;        ///< [m/s]
+  double speed = 15.0;            ///< crossing speed, or speed over the ego's for parallel [m/s]
+  double first_distance = 30.0;   ///< crossing: distance ahead of the ego of the first crossing [m]
+  double spacing = 20.0;          ///< crossing: distance between crossings; parallel: offsets [m]
+  std::uint64_t seed = 1;
+  std::filesystem::path out;
+  bool quiet = false;
+};
+
 int RunSim(const RunOptions& options);
+int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);
 int RunExperiment(const ExperimentOptions& options);
 int RunSnapshot(const SnapshotOptions& options);

@@ -93,9 +93,33 @@ int main(int argc, char** argv) {
   experiment->add_option("--first-seed", exp.first_seed, "First seed");
   experiment->add_option("--jobs,-j", exp.jobs, "Parallel runs (default: number of cores)");
 
+  TangentialOptions tan;
+  auto* tangential =
+      app.add_subcommand("tangential",
+                         "Write a tangential-motion stress scenario (traffic crossing ahead of the "
+                         "ego, or driving alongside it), to run with `dualgrid run`");
+  tangential->add_option("--kind", tan.kind, "crossing or parallel")
+      ->check(CLI::IsMember({"crossing", "parallel"}));
+  tangential->add_option("--count", tan.count, "Number of stress vehicles");
+  tangential->add_option("--ego-speed", tan.ego_speed, "Ego speed [m/s]");
+  tangential->add_option("--speed", tan.speed,
+                         "Crossing speed [m/s]; parallel: speed over the ego's [m/s]");
+  tangential->add_option("--first-distance", tan.first_distance,
+                         "crossing: distance ahead of the ego of the first crossing [m]");
+  tangential->add_option("--spacing", tan.spacing, "Distance between stress vehicles [m]");
+  tangential->add_option("--seed", tan.seed, "Scenario seed");
+  tangential->add_option("--out,-o", tan.out, "Scenario file to write")->required();
+  tangential->add_flag("--quiet,-q", tan.quiet, "No summary");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (sim->parsed()) return RunSim(sim_options);
+    if (tangential->parsed()) {
+      // Parallel defaults: nearly the ego's speed, and spacing that leaves SUMO's insertion gap.
+      if (tan.kind == "parallel" && tangential->count("--speed") == 0) tan.speed = 0.3;
+      if (tan.kind == "parallel" && tangential->count("--spacing") == 0) tan.spacing = 40.0;
+      return RunTangential(tan);
+    }
     if (snapshot->parsed()) return RunSnapshot(snap);
     if (run->parsed()) return RunFilters(run_options);
     if (experiment->parsed()) {
