@@ -128,6 +128,9 @@ int RunFilters(const FilterRunOptions& options) {
     detections = std::make_unique<DetectionWriter>(out / "detections.csv");
 
   std::vector<ModeScorer> scorers(modes.size(), ModeScorer(config.evaluation));
+  // Every cluster of every cycle with its role: the tracks as the evaluation saw them.
+  std::ofstream clusters = OpenOutput(out / "clusters.csv");
+  clusters << "step,time,mode,x,y,vx,vy,weight,particles,role,object,x_ego,y_ego\n";
   std::vector<double> snapshot_times = options.snapshots;
   if (snapshot_times.empty()) snapshot_times = config.evaluation.snapshot_times;
   if (snapshot_times.empty())
@@ -158,7 +161,22 @@ int RunFilters(const FilterRunOptions& options) {
       const auto& grid = pipeline.grid(m);
       snaps.push_back(TakeSnapshot(grid));
       if (m == 0) truth_classes = TruthClasses(snaps[0], f, config.sim);
-      scorers[m].AddFrame(f.time, grid, snaps[m], pipeline.TruthObjects(grid), truth_classes);
+      const std::vector<eval::TruthObject> objects = pipeline.TruthObjects(grid);
+      scorers[m].AddFrame(f.time, grid, snaps[m], objects, truth_classes);
+      const auto& a = scorers[m].association();
+      for (std::size_t c = 0; c < scorers[m].clusters().size(); ++c) {
+        const eval::Cluster& cl = scorers[m].clusters()[c];
+        const Position local = f.EgoPose().ToLocal(cl.position);
+        static const char* kRole[] = {"matched", "duplicate", "false"};
+        clusters << f.step << ',' << Fixed(f.time, 3) << ',' << mode_names[m] << ','
+                 << Fixed(cl.position.x(), 3) << ',' << Fixed(cl.position.y(), 3) << ','
+                 << Fixed(cl.velocity.x(), 3) << ',' << Fixed(cl.velocity.y(), 3) << ','
+                 << cl.weight << ',' << cl.size << ',' << kRole[static_cast<int>(a.role[c])] << ','
+                 << (a.object_of_cluster[c] >= 0
+                         ? pipeline.ids().Name(objects[a.object_of_cluster[c]].id)
+                         : std::string())
+                 << ',' << Fixed(local.x(), 2) << ',' << Fixed(local.y(), 2) << '\n';
+      }
     }
     // Weight masses of the particles inside each vehicle's box, for the focus-object figure.
     {

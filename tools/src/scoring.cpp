@@ -99,7 +99,7 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
       dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
   }
   clusters_ = clusterer_.Run(dynamic_particles_);
-  tracking_.AddFrame(time, clusters_, objects);
+  association_ = tracking_.AddFrame(time, clusters_, objects);
 
   predicted_.resize(snapshot.dynamic.size());
   for (std::size_t k = 0; k < predicted_.size(); ++k) {

@@ -39,8 +39,9 @@ class ModeScorer {
                 const std::vector<eval::TruthObject>& objects,
                 const std::vector<std::uint8_t>& truth_classes);
   eval::ScenarioMetrics Result() const;
-  /// Clusters of the last frame.
+  /// Clusters of the last frame and their association.
   const std::vector<eval::Cluster>& clusters() const { return clusters_; }
+  const eval::AssociationResult& association() const { return association_; }
 
  private:
   scenario::EvaluationConfig config_;
@@ -49,6 +50,7 @@ class ModeScorer {
   eval::CellClassificationAccumulator cells_;
   std::vector<eval::WeightedParticle> dynamic_particles_;
   std::vector<eval::Cluster> clusters_;
+  eval::AssociationResult association_;
   std::vector<std::uint8_t> predicted_;
 };
 

@@ -1,0 +1,137 @@
+// Cycle time of DynamicGrid::Update at the paper's configuration and at scale.
+//   bench_filter --benchmark_filter=Paper    (10k particles, 200 m x 25 m at 0.5 m)
+//   bench_filter --benchmark_filter=Scale    (1e5 .. 2e6 particles, 10 % births, 1.4e6 cells)
+// Arguments: particles, threads (OpenMP). Results: docs/performance.md.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <vector>
+
+#include <omp.h>
+
+#include "dualgrid/core/random.hpp"
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/dynamic_grid.hpp"
+
+using namespace dualgrid;
+using namespace dualgrid::filter;
+
+namespace {
+
+struct Target {
+  Position p;
+  Velocity v;
+};
+
+// A synthetic traffic scene around an ego driving along x at 25 m/s: `targets` vehicles at
+// 20-36 m/s (some static) spread over the grid, `per_target` exact detections each from the
+// nearest of the given sensors (long-range front radar + four corner radars).
+class Scene {
+ public:
+  Scene(double length, double width, int targets, int per_target, double sensor_range)
+      : length_(length), width_(width), per_target_(per_target), range_(sensor_range) {
+    for (int i = 0; i < targets; ++i) {
+      CounterRng rng(42, RngPurpose::kTest, 0, static_cast<std::uint32_t>(i));
+      const bool parked = rng.Uniform() < 0.2;
+      targets_.push_back({{rng.Uniform(-0.45, 0.45) * length, rng.Uniform(-0.45, 0.45) * width},
+                          parked ? Velocity(0, 0) : Velocity(rng.Uniform(20.0, 36.0), 0.0)});
+    }
+  }
+
+  void Step(double dt, std::uint64_t step) {
+    ego_.position.x() += 25.0 * dt;
+    for (Target& t : targets_) {
+      t.p += t.v * dt;
+      // Keep targets inside the window around the ego (wrap along x).
+      const double rel = t.p.x() - ego_.position.x();
+      if (rel > 0.45 * length_) t.p.x() -= 0.9 * length_;
+      if (rel < -0.45 * length_) t.p.x() += 0.9 * length_;
+    }
+    coverage_.clear();
+    const double hl = 2.3, hw = 0.9;
+    coverage_.push_back({ego_.ToParent({hl, 0}), 0.0, DegToRad(10), 0.5, range_});
+    for (const auto& [x, y, b] : {std::tuple{hl, hw, 0.8}, std::tuple{hl, -hw, -0.8},
+                                  std::tuple{-hl, hw, 2.4}, std::tuple{-hl, -hw, -2.4}}) {
+      coverage_.push_back({ego_.ToParent({x, y}), b, DegToRad(75), 0.3, 0.5 * range_});
+    }
+    z_.clear();
+    for (std::size_t i = 0; i < targets_.size(); ++i) {
+      const Target& t = targets_[i];
+      CounterRng rng(42, RngPurpose::kTest, step, static_cast<std::uint32_t>(i));
+      const SensorCoverage& s = t.p.x() >= ego_.position.x() ? coverage_[0] : coverage_[3];
+      for (int k = 0; k < per_target_; ++k) {
+        const Position p = t.p + Vector2(rng.Uniform(-2.2, 2.2), rng.Uniform(-0.9, 0.9));
+        const Vector2 los = (p - s.origin).normalized();
+        z_.push_back({p, t.v.dot(los) * los, s.origin});
+      }
+    }
+  }
+
+  EgoInput ego() const { return {ego_, {25.0, 0.0}}; }
+  const std::vector<Measurement>& z() const { return z_; }
+  const std::vector<SensorCoverage>& coverage() const { return coverage_; }
+
+ private:
+  double length_, width_;
+  int per_target_;
+  double range_;
+  Pose2 ego_;
+  std::vector<Target> targets_;
+  std::vector<Measurement> z_;
+  std::vector<SensorCoverage> coverage_;
+};
+
+void RunCycles(benchmark::State& state, const FilterParams& fp, Scene& scene) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  DynamicGrid grid(fp, 1);
+  std::uint64_t step = 0;
+  for (int k = 0; k < 20; ++k) {  // warm-up: steady particle distribution
+    scene.Step(0.05, step++);
+    grid.Update(scene.ego(), scene.z(), scene.coverage(), 0.05);
+  }
+  for (auto _ : state) {
+    state.PauseTiming();
+    scene.Step(0.05, step++);
+    state.ResumeTiming();
+    grid.Update(scene.ego(), scene.z(), scene.coverage(), 0.05);
+  }
+  state.SetItemsProcessed(state.iterations());  // items/s = cycles per second
+  state.counters["particles"] = static_cast<double>(fp.num_particles);
+  state.counters["births"] = static_cast<double>(fp.num_birth);
+  state.counters["cells"] = static_cast<double>(grid.cells_x()) * grid.cells_y();
+  state.counters["detections"] = static_cast<double>(scene.z().size());
+}
+
+// Paper configuration: 200 m x 25 m at 0.5 m (20,000 cells), 10,000 particles, 1,000 births,
+// 10 vehicles with 5 detections each.
+void BM_PaperConfig(benchmark::State& state) {
+  FilterParams fp;
+  fp.num_particles = static_cast<int>(state.range(0));
+  fp.num_birth = fp.num_particles / 10;
+  Scene scene(fp.length_x, fp.width_y, 10, 5, 200.0);
+  RunCycles(state, fp, scene);
+}
+BENCHMARK(BM_PaperConfig)->Args({10000, 1})->Args({10000, 2})->Unit(benchmark::kMicrosecond);
+
+// At scale: 1000 m x 350 m at 0.5 m (1.4e6 cells), 10 % births, 400 vehicles x 5 detections.
+void BM_Scale(benchmark::State& state) {
+  FilterParams fp;
+  fp.length_x = 1000.0;
+  fp.width_y = 350.0;
+  fp.num_particles = static_cast<int>(state.range(0));
+  fp.num_birth = fp.num_particles / 10;
+  Scene scene(fp.length_x, fp.width_y, 400, 5, 500.0);
+  RunCycles(state, fp, scene);
+}
+BENCHMARK(BM_Scale)
+    ->Args({100000, 2})
+    ->Args({1000000, 1})
+    ->Args({1000000, 2})
+    ->Args({2000000, 1})
+    ->Args({2000000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,141 @@
+// Radar-only dynamic occupancy grid with position, velocity and dual particle weights
+// (Ronecker, Stolz, Watzenig 2023) on a Nuss-style random-finite-set particle grid.
+// Pipeline and choices: docs/algorithm.md.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/params.hpp"
+#include "dualgrid/filter/particles.hpp"
+
+namespace dualgrid::filter {
+
+/// One radar detection in the world frame, the paper's eq. (1) [x, y, v_rx, v_ry].
+struct Measurement {
+  Position position;
+  /// Ego-motion-compensated radial speed over ground times the line-of-sight unit vector.
+  Velocity radial_velocity;
+  Position sensor_position;
+};
+
+/// Field of view of one sensor that scanned this cycle (world frame).
+struct SensorCoverage {
+  Position origin;
+  double boresight = 0.0;  ///< [rad]
+  double half_fov = 0.0;   ///< [rad]
+  double min_range = 0.0;  ///< [m]
+  double max_range = 0.0;  ///< [m]
+};
+
+struct EgoInput {
+  Pose2 pose;
+  Velocity velocity = Velocity::Zero();
+};
+
+/// Logical cell index: x along world +x, y along world +y, 0..cells-1, independent of storage.
+struct CellIndex {
+  int x = 0;
+  int y = 0;
+};
+
+/// Masses of one cell after the last Update; free + static_occ + dynamic + unknown = 1.
+struct CellState {
+  double free = 0.0;
+  double static_occ = 0.0;
+  double dynamic = 0.0;
+  double unknown = 1.0;
+  /// Weighted mean and covariance of the persistent moving particles of the cell after the
+  /// weight update (before resampling); zero when the cell has none.
+  Velocity mean_velocity = Velocity::Zero();
+  Matrix2 velocity_cov = Matrix2::Zero();
+  /// Inside the field of view of at least one sensor this cycle.
+  bool observed = false;
+};
+
+class DynamicGrid {
+ public:
+  /// Throws std::invalid_argument when !params.IsValid().
+  DynamicGrid(const FilterParams& params, std::uint64_t seed);
+
+  /// One filter cycle. The first call initialises the grid around the ego. `dt` >= 0 [s].
+  void Update(const EgoInput& ego, std::span<const Measurement> measurements,
+              std::span<const SensorCoverage> coverage, double dt);
+
+  int cells_x() const { return nx_; }
+  int cells_y() const { return ny_; }
+  double resolution() const { return params_.resolution; }
+  /// Number of completed Update calls (the RNG step of the next one).
+  std::uint64_t step() const { return step_; }
+  bool initialized() const { return initialized_; }
+
+  /// World position of a logical cell's centre.
+  Position CellCenter(CellIndex c) const;
+  /// Logical cell holding `p`, std::nullopt outside the grid (or before the first Update).
+  std::optional<CellIndex> CellOf(const Position& p) const;
+  /// Throws std::out_of_range for an index outside the grid.
+  CellState Cell(CellIndex c) const;
+
+  /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count).
+  const ParticleSet& particles() const { return particles_; }
+  const FilterParams& params() const { return params_; }
+
+ private:
+  // Storage index of global cell (gx, gy): circular in both axes so that shifting moves no data.
+  std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
+  void Initialize(const EgoInput& ego);
+  void ShiftTo(const Position& ego);
+  void ResetColumn(std::int64_t gx);
+  void ResetRow(std::int64_t gy);
+  void SortParticles();
+  void BuildMeasurementGrid(std::span<const Measurement> z, std::span<const SensorCoverage> cov);
+  // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
+  void UpdateCells(std::span<const Measurement> z);
+  void Birth(std::span<const Measurement> z);
+  void Resample();
+  // Detection bucket (clamped to the bucket grid) of a world point.
+  std::pair<int, int> BucketOf(double px, double py) const;
+
+  FilterParams params_;
+  std::uint64_t seed_;
+  std::uint64_t step_ = 0;
+  bool initialized_ = false;
+  int nx_, ny_;
+  std::int64_t num_cells_;
+  std::int64_t origin_gx_ = 0, origin_gy_ = 0;  // global index of logical cell (0, 0)
+
+  // Cell layers (storage order).
+  std::vector<double> free_, static_, dynamic_, born_;
+  std::vector<std::uint8_t> view_;     // field-of-view / ray free-space bits (see .cpp)
+  std::vector<int> near_det_;          // nearest detection index or -1
+  std::vector<double> near_d2_;        // its squared distance to the cell centre
+  std::vector<std::int64_t> touched_;  // cells with near_det_ set (reset next cycle)
+
+  // Particles: persistent set (public), sorted working copy, new-born.
+  ParticleSet particles_, sorted_, births_;
+  std::vector<std::int64_t> cell_of_;     // storage cell per particle, num_cells_ if outside
+  std::vector<std::int64_t> cell_start_;  // num_cells_ + 2: particle ranges of sorted_
+  std::vector<std::int32_t> hist_;        // per-chunk histograms of the counting sort
+  std::vector<std::int64_t> hist_total_;
+  std::vector<double> scan_in_, scan_out_;  // resampling / birth weights and prefix sums
+  std::vector<std::int64_t> ranges_;
+  std::vector<double> born_scan_;
+  std::vector<std::int64_t> born_ranges_;
+
+  // Detection bucket index (logical coordinates, bucket edge >= cutoff).
+  int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
+  std::vector<std::int64_t> bucket_count_, bucket_start_;
+  std::vector<int> bucket_items_;
+  std::vector<double> det_x_, det_y_;  // detection positions in bucket order (compact queries)
+
+  // Per-sensor bearing bins for the ray free space.
+  std::vector<double> bin_range_;
+  std::vector<std::int64_t> bin_offset_;
+  std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
+};
+
+}  // namespace dualgrid::filter

@@ -1,0 +1,71 @@
+// Parameters of the radar-only dynamic grid (docs/algorithm.md maps each to the paper).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace dualgrid::filter {
+
+/// Which particle weight drives resampling (paper Sec. III-C / IV).
+enum class WeightMode {
+  kPosition,  ///< eq. (7): w = f_d(d_p) (1 - eps) w_prev.
+  kVelocity,  ///< eq. (8), blended form (see docs/algorithm.md).
+  kDual,      ///< eq. (14): both weights kept, resampled on max(w_position, w_velocity).
+};
+
+/// "position", "velocity", "dual".
+std::string_view ToString(WeightMode mode);
+/// Inverse of ToString; std::nullopt for unknown names.
+std::optional<WeightMode> ParseWeightMode(std::string_view name);
+
+/// All tuning of DynamicGrid. Defaults: the paper's configuration (200 m x 25 m at 0.5 m, 10,000
+/// particles) and a nominal cycle of 0.05 s; per-cycle factors assume that cycle.
+struct FilterParams {
+  // Grid (axis-aligned with the world frame, centred on the ego).
+  double length_x = 200.0;  ///< Extent along world x [m].
+  double width_y = 25.0;    ///< Extent along world y [m].
+  double resolution = 0.5;  ///< Cell edge [m].
+
+  // Particles.
+  int num_particles = 10000;            ///< Persistent particles, constant after resampling.
+  int num_birth = 1000;                 ///< New-born particles per cycle (10 %).
+  double process_noise_position = 0.3;  ///< Position random walk [m/sqrt(s)].
+  double process_noise_velocity = 1.5;  ///< Velocity random walk [m/s/sqrt(s)].
+  double persistence = 0.99;            ///< p_S: particle weights times this per cycle.
+  double birth_probability = 0.1;       ///< p_B: weight of the birth hypothesis vs persistence.
+  double birth_max_tangential_speed = 40.0;  ///< Tangential birth speed ~ U(-v, v) [m/s].
+  double birth_sigma_radial = 0.5;           ///< Radial birth speed noise around Doppler [m/s].
+
+  // Measurement kernels (all scaled to peak 1, see docs/algorithm.md).
+  double sigma_f = 0.6;                ///< f_d width, eq. (2) [m].
+  double sigma_static_distance = 0.6;  ///< Sigma_s distance std, eq. (4) [m].
+  double sigma_static_velocity = 0.5;  ///< Sigma_s radial-velocity std, eq. (4) [m/s].
+  double sigma_v = 1.0;                ///< Sigma_v of f_v, eq. (8) [m/s] (isotropic).
+  double cutoff_sigmas = 3.0;  ///< Detections farther than this many sigma_f are "no detection".
+  double occupied_mass = 0.9;  ///< Peak occupied mass of one detection in the measurement grid.
+  double free_mass = 0.7;      ///< Free mass along a ray in front of a detection, eq. (3).
+  double free_mass_no_return = 0.3;   ///< Free mass in a bearing bin with no detection.
+  double free_angle_bin = 0.0174533;  ///< Bearing bin for ray free space [rad] (1 deg).
+  int free_bin_dilation = 1;  ///< A detection shadows this many neighbouring bins each side.
+
+  // Temporal fusion and joint normalisation.
+  double free_decay = 0.9;           ///< Free mass kept per cycle.
+  double static_persistence = 0.98;  ///< Static mass kept per cycle.
+  double static_gain = 0.3;          ///< eta: weight of this cycle's P_static (eq. 4) in q_norm.
+  double static_speed = 1.0;         ///< Particles slower than this [m/s] vote static (v = 0).
+
+  // Particle weights.
+  double decay_eps = 0.05;  ///< eps of eqs. (7), (8).
+  WeightMode mode = WeightMode::kDual;
+
+  /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
+  int CellsX() const;
+  int CellsY() const;
+
+  /// True when every field is usable; otherwise names the offending field in *error.
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace dualgrid::filter

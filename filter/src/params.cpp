@@ -1,0 +1,92 @@
+#include "dualgrid/filter/params.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dualgrid::filter {
+
+std::string_view ToString(WeightMode mode) {
+  switch (mode) {
+    case WeightMode::kPosition:
+      return "position";
+    case WeightMode::kVelocity:
+      return "velocity";
+    case WeightMode::kDual:
+      return "dual";
+  }
+  return "unknown";
+}
+
+std::optional<WeightMode> ParseWeightMode(std::string_view name) {
+  for (WeightMode m : {WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual}) {
+    if (ToString(m) == name) return m;
+  }
+  return std::nullopt;
+}
+
+int FilterParams::CellsX() const {
+  return std::max(1, static_cast<int>(std::lround(length_x / resolution)));
+}
+int FilterParams::CellsY() const {
+  return std::max(1, static_cast<int>(std::lround(width_y / resolution)));
+}
+
+namespace {
+
+bool Fail(std::string* error, const std::string& msg) {
+  if (error) *error = msg;
+  return false;
+}
+
+}  // namespace
+
+bool FilterParams::IsValid(std::string* error) const {
+  const auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
+  const auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  const auto prob = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
+  if (!finite_pos(resolution)) return Fail(error, "resolution must be finite and > 0");
+  if (!finite_pos(length_x) || length_x < resolution)
+    return Fail(error, "length_x must be finite and >= resolution");
+  if (!finite_pos(width_y) || width_y < resolution)
+    return Fail(error, "width_y must be finite and >= resolution");
+  if (static_cast<double>(CellsX()) * CellsY() > 2.0e8)
+    return Fail(error, "length_x/width_y/resolution give more than 2e8 cells");
+  if (num_particles < 1) return Fail(error, "num_particles must be >= 1");
+  if (num_birth < 0) return Fail(error, "num_birth must be >= 0");
+  if (!finite_nonneg(process_noise_position))
+    return Fail(error, "process_noise_position must be finite and >= 0");
+  if (!finite_nonneg(process_noise_velocity))
+    return Fail(error, "process_noise_velocity must be finite and >= 0");
+  if (!prob(persistence) || persistence == 0.0) return Fail(error, "persistence must be in (0, 1]");
+  if (!prob(birth_probability)) return Fail(error, "birth_probability must be in [0, 1]");
+  if (!finite_nonneg(birth_max_tangential_speed))
+    return Fail(error, "birth_max_tangential_speed must be finite and >= 0");
+  if (!finite_nonneg(birth_sigma_radial))
+    return Fail(error, "birth_sigma_radial must be finite and >= 0");
+  if (!finite_pos(sigma_f)) return Fail(error, "sigma_f must be finite and > 0");
+  if (!finite_pos(sigma_static_distance))
+    return Fail(error, "sigma_static_distance must be finite and > 0");
+  if (!finite_pos(sigma_static_velocity))
+    return Fail(error, "sigma_static_velocity must be finite and > 0");
+  if (!finite_pos(sigma_v)) return Fail(error, "sigma_v must be finite and > 0");
+  if (!finite_pos(cutoff_sigmas)) return Fail(error, "cutoff_sigmas must be finite and > 0");
+  // Masses of 1 would allow total conflict (1 - K = 0) in the Dempster-Shafer fusion.
+  if (!prob(occupied_mass) || occupied_mass >= 1.0)
+    return Fail(error, "occupied_mass must be in [0, 1)");
+  if (!prob(free_mass) || free_mass >= 1.0) return Fail(error, "free_mass must be in [0, 1)");
+  if (!prob(free_mass_no_return) || free_mass_no_return > free_mass)
+    return Fail(error, "free_mass_no_return must be in [0, free_mass]");
+  if (!finite_pos(free_angle_bin) || free_angle_bin > 1.0)
+    return Fail(error, "free_angle_bin must be in (0, 1] rad");
+  if (free_bin_dilation < 0) return Fail(error, "free_bin_dilation must be >= 0");
+  if (!prob(free_decay)) return Fail(error, "free_decay must be in [0, 1]");
+  if (!prob(static_persistence)) return Fail(error, "static_persistence must be in [0, 1]");
+  if (!finite_nonneg(static_gain)) return Fail(error, "static_gain must be finite and >= 0");
+  if (!finite_nonneg(static_speed)) return Fail(error, "static_speed must be finite and >= 0");
+  if (!prob(decay_eps) || decay_eps >= 1.0) return Fail(error, "decay_eps must be in [0, 1)");
+  if (mode != WeightMode::kPosition && mode != WeightMode::kVelocity && mode != WeightMode::kDual)
+    return Fail(error, "mode is not a WeightMode");
+  return true;
+}
+
+}  // namespace dualgrid::filter

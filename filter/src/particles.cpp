@@ -1,0 +1,132 @@
+#include "dualgrid/filter/particles.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "dualgrid/core/random.hpp"
+#include "fast_normal.hpp"
+
+namespace dualgrid::filter {
+
+void ParticleSet::resize(std::size_t n) {
+  x.resize(n);
+  y.resize(n);
+  for (auto* v : {&vx, &vy, &w_position, &w_velocity, &weight}) v->resize(n);
+}
+
+void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_vel,
+                      double persistence, std::uint64_t seed, std::uint64_t step) {
+  const float sp = static_cast<float>(sigma_pos * std::sqrt(dt));
+  const float sv = static_cast<float>(sigma_vel * std::sqrt(dt));
+  const bool noisy = sp > 0.0f || sv > 0.0f;
+  const std::int64_t n = static_cast<std::int64_t>(p.size());
+  // Blocks of particles: raw Philox draws first, then the Box-Muller transform as straight-line
+  // array code the compiler vectorises (the scalar transform cost ~4x more per particle).
+  constexpr std::int64_t kBlock = 256;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t lo = b * kBlock, m = std::min(kBlock, n - lo);
+    alignas(64) float u[4][kBlock], g[4][kBlock];
+    if (noisy) {
+      for (std::int64_t k = 0; k < m; ++k) {
+        CounterRng rng(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(lo + k));
+        for (int c = 0; c < 4; ++c) u[c][k] = detail::ToUnit24(rng.NextU32());
+      }
+      for (int pair = 0; pair < 2; ++pair) {
+        detail::BoxMuller(u[2 * pair], u[2 * pair + 1], g[2 * pair], g[2 * pair + 1], m);
+      }
+    } else {
+      for (int c = 0; c < 4; ++c) std::fill_n(g[c], m, 0.0f);
+    }
+    for (std::int64_t k = 0; k < m; ++k) {
+      const std::int64_t i = lo + k;
+      p.x[i] += p.vx[i] * dt + sp * g[0][k];
+      p.y[i] += p.vy[i] * dt + sp * g[1][k];
+      p.vx[i] += sv * g[2][k];
+      p.vy[i] += sv * g[3][k];
+      p.weight[i] *= persistence;
+      p.w_position[i] *= persistence;
+      p.w_velocity[i] *= persistence;
+    }
+  }
+}
+
+namespace {
+
+// Fixed block size: the summation tree depends on the input size only.
+constexpr std::int64_t kScanBlock = 1 << 14;
+
+template <typename T>
+void ExclusiveScanImpl(std::span<const T> in, std::span<T> out) {
+  assert(out.size() == in.size() + 1);
+  const std::int64_t n = static_cast<std::int64_t>(in.size());
+  const std::int64_t blocks = (n + kScanBlock - 1) / kScanBlock;
+  if (blocks <= 1) {
+    T acc = T(0);
+    for (std::int64_t i = 0; i < n; ++i) {
+      out[i] = acc;
+      acc += in[i];
+    }
+    out[n] = acc;
+    return;
+  }
+  // Block totals live apart from `out` (adjacent blocks would otherwise share a slot). The small
+  // vector grows once per thread and is then reused, keeping the cycle allocation-free.
+  static thread_local std::vector<T> base;
+  if (base.size() < static_cast<std::size_t>(blocks) + 1) base.resize(blocks + 1);
+  T* const tot = base.data();  // the caller's copy, shared with the team below
+  // Pass 1: block totals.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t lo = b * kScanBlock, hi = std::min(n, lo + kScanBlock);
+    T acc = T(0);
+    for (std::int64_t i = lo; i < hi; ++i) acc += in[i];
+    tot[b + 1] = acc;
+  }
+  // Serial scan over block totals (few entries).
+  tot[0] = T(0);
+  for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
+    // Pass 2: local scans from each block's base.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t lo = b * kScanBlock, hi = std::min(n, lo + kScanBlock);
+    T acc = tot[b];
+    for (std::int64_t i = lo; i < hi; ++i) {
+      out[i] = acc;
+      acc += in[i];
+    }
+  }
+  out[n] = tot[blocks];
+}
+
+}  // namespace
+
+void ExclusiveScan(std::span<const double> in, std::span<double> out) {
+  ExclusiveScanImpl<double>(in, out);
+}
+void ExclusiveScan(std::span<const std::int64_t> in, std::span<std::int64_t> out) {
+  ExclusiveScanImpl<std::int64_t>(in, out);
+}
+
+void SystematicRanges(std::span<const double> cumulative, std::size_t n_out, double u,
+                      std::span<std::int64_t> start) {
+  assert(start.size() == cumulative.size());
+  const std::int64_t n_src = static_cast<std::int64_t>(cumulative.size()) - 1;
+  const double total = cumulative[n_src];
+  assert(total > 0.0);
+  const double scale = static_cast<double>(n_out) / total;
+  const std::int64_t n = static_cast<std::int64_t>(n_out);
+  // Slot k is drawn from the source whose interval holds (k + u) * total / n_out, i.e. source i
+  // owns slots k with cumulative[i] * scale - u <= k < cumulative[i + 1] * scale - u.
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i <= n_src; ++i) {
+    const double k = std::ceil(cumulative[i] * scale - u);
+    start[i] = std::clamp(static_cast<std::int64_t>(k), std::int64_t{0}, n);
+  }
+  start[0] = 0;
+  start[n_src] = n;
+}
+
+}  // namespace dualgrid::filter

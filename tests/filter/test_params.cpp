@@ -1,0 +1,54 @@
+#include <catch2/catch.hpp>
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "dualgrid/filter/dynamic_grid.hpp"
+#include "dualgrid/filter/params.hpp"
+
+using dualgrid::filter::DynamicGrid;
+using dualgrid::filter::FilterParams;
+using dualgrid::filter::ParseWeightMode;
+using dualgrid::filter::WeightMode;
+
+TEST_CASE("default FilterParams are the paper's configuration and valid", "[filter][params]") {
+  const FilterParams p;
+  std::string error;
+  CHECK(p.IsValid(&error));
+  CHECK(p.CellsX() == 400);
+  CHECK(p.CellsY() == 50);
+  CHECK(p.num_particles == 10000);
+  CHECK(p.mode == WeightMode::kDual);
+}
+
+TEST_CASE("IsValid names the offending field", "[filter][params]") {
+  using Mutation = std::pair<std::string, std::function<void(FilterParams&)>>;
+  const Mutation m = GENERATE(
+      Mutation{"resolution", [](FilterParams& p) { p.resolution = 0.0; }},
+      Mutation{"length_x", [](FilterParams& p) { p.length_x = -1.0; }},
+      Mutation{"width_y", [](FilterParams& p) { p.width_y = 0.1; }},
+      Mutation{"num_particles", [](FilterParams& p) { p.num_particles = 0; }},
+      Mutation{"num_birth", [](FilterParams& p) { p.num_birth = -1; }},
+      Mutation{"persistence", [](FilterParams& p) { p.persistence = 1.5; }},
+      Mutation{"birth_probability", [](FilterParams& p) { p.birth_probability = -0.1; }},
+      Mutation{"sigma_f", [](FilterParams& p) { p.sigma_f = 0.0; }},
+      Mutation{"sigma_v", [](FilterParams& p) { p.sigma_v = std::nan(""); }},
+      Mutation{"occupied_mass", [](FilterParams& p) { p.occupied_mass = 1.0; }},
+      Mutation{"free_mass_no_return", [](FilterParams& p) { p.free_mass_no_return = 0.9; }},
+      Mutation{"decay_eps", [](FilterParams& p) { p.decay_eps = 1.0; }},
+      Mutation{"static_gain", [](FilterParams& p) { p.static_gain = -1.0; }});
+  FilterParams p;
+  m.second(p);
+  std::string error;
+  CHECK_FALSE(p.IsValid(&error));
+  CHECK(error.find(m.first) != std::string::npos);
+  CHECK_THROWS_AS(DynamicGrid(p, 1), std::invalid_argument);
+}
+
+TEST_CASE("weight mode names round-trip", "[filter][params]") {
+  const WeightMode m = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
+  CHECK(ParseWeightMode(ToString(m)) == m);
+  CHECK_FALSE(ParseWeightMode("Dual").has_value());
+  CHECK_FALSE(ParseWeightMode("").has_value());
+}

@@ -1,0 +1,140 @@
+// Synthetic single targets with exact detections: the three weight modes on the paper's cases.
+#include <catch2/catch.hpp>
+
+#include <vector>
+
+#include "dualgrid/filter/dynamic_grid.hpp"
+#include "synthetic.hpp"
+
+using namespace dualgrid;
+using namespace dualgrid::filter;
+using namespace dualgrid::filter::testing;
+
+namespace {
+
+enum class Case { kRadial, kTangential, kStatic };
+
+struct Trace {
+  std::vector<TargetView> views;  // one per cycle
+};
+
+// dt = 0.05 s (the radar cycle of the project), 3 s. Car 4.5 m x 1.8 m at 25 m/s (90 km/h).
+//  kRadial: ego at rest, target ahead driving away along the long-range radar's line of sight
+//           (compensated radial speed = 25 m/s), detections on its rear face.
+//  kTangential: ego and target both at 25 m/s along x, target 9 m to the left, seen by the left
+//           radar abeam: the line of sight is perpendicular to the motion, detections near the
+//           foot point of the side face (+-0.6 m, so |v_r| <= 25 * 0.6 / 8 = 1.9 m/s).
+//  kStatic: parked box 30 m ahead of the resting ego, zero Doppler.
+Trace Run(Case c, WeightMode mode, std::uint64_t seed, int cycles = 60) {
+  FilterParams fp;
+  fp.mode = mode;
+  DynamicGrid g(fp, seed);
+  const double dt = 0.05;
+  Trace tr;
+  for (int k = 0; k < cycles; ++k) {
+    const double t = k * dt;
+    Pose2 ego;
+    Velocity ego_v = Velocity::Zero();
+    OrientedBox box{{0, 0}, 0.0, 4.5, 1.8};
+    Velocity v = Velocity::Zero();
+    SensorCoverage cov;
+    double half_span = 1.0;
+    switch (c) {
+      case Case::kRadial:
+        box.center = {20.0 + 25.0 * t, 0.3};
+        v = {25.0, 0.0};
+        cov = ForwardRadar(ego);
+        break;
+      case Case::kTangential:
+        ego.position = {25.0 * t, 0.0};
+        ego_v = {25.0, 0.0};
+        box.center = {25.0 * t, 9.0};
+        v = {25.0, 0.0};
+        cov = LeftRadar(ego);
+        half_span = 0.6;
+        break;
+      case Case::kStatic:
+        box.center = {30.0, 1.0};
+        cov = ForwardRadar(ego);
+        break;
+    }
+    std::vector<Measurement> z;
+    for (const Position& p : NearFacePoints(box, cov.origin, half_span, 0.5)) {
+      z.push_back(Detect(p, v, cov.origin));
+    }
+    g.Update({ego, ego_v}, z, std::span<const SensorCoverage>(&cov, 1), dt);
+    TargetView view = LookAt(g, box, 0.5);
+    view.mean_velocity -= v;  // store the error vector
+    tr.views.push_back(view);
+  }
+  return tr;
+}
+
+// Mean velocity error norm over cycles [from, to).
+double MeanVelocityError(const Trace& t, int from, int to) {
+  double s = 0.0;
+  for (int k = from; k < to; ++k) s += t.views[k].mean_velocity.norm();
+  return s / (to - from);
+}
+
+}  // namespace
+
+TEST_CASE("a target on the radar's line of sight becomes dynamic with the right velocity",
+          "[filter][targets]") {
+  // Within 1 s (20 cycles; the paper's slowest mode needs 0.92 s to a first track) every mode must
+  // show P(dynamic) > 0.6 (the evaluation threshold) in the target's cells, and the particle mean
+  // velocity must be within 1 m/s of the truth: 4 % of the speed, while a birth velocity that is
+  // not yet selected is off by ~U(-40, 40) m/s tangentially (rms 23 m/s), so an unconverged
+  // filter fails this clearly.
+  const WeightMode mode = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
+  const std::uint64_t seed = GENERATE(1, 2, 3);
+  const Trace t = Run(Case::kRadial, mode, seed);
+  for (int k = 20; k < 60; ++k) {
+    INFO("mode " << ToString(mode) << " seed " << seed << " cycle " << k);
+    REQUIRE(t.views[k].max_dynamic > 0.6);
+    REQUIRE(t.views[k].has_particles);
+  }
+  CHECK(MeanVelocityError(t, 20, 60) < 1.0);
+}
+
+TEST_CASE("a static box stays static in every mode", "[filter][targets]") {
+  // After 0.5 s the box's cells must be static (P(static) > 0.6) and never reach the dynamic
+  // threshold; births there carry U(-40, 40) m/s tangential velocities, so a filter that lets
+  // them keep their mass fails the dynamic bound.
+  const WeightMode mode = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
+  const std::uint64_t seed = GENERATE(1, 2, 3);
+  const Trace t = Run(Case::kStatic, mode, seed);
+  for (int k = 0; k < 60; ++k) {
+    INFO("mode " << ToString(mode) << " seed " << seed << " cycle " << k);
+    REQUIRE(t.views[k].max_dynamic < 0.6);
+    if (k >= 10) REQUIRE(t.views[k].max_static > 0.6);
+  }
+}
+
+TEST_CASE("a tangential target is tracked by position and dual weights, not by velocity weights",
+          "[filter][targets]") {
+  // The paper's central claim (Sec. IV, highway "object 3"). The compensated Doppler is ~0, so
+  // eq. (8) rewards particles near v = 0 and the static hypothesis, while eq. (7) ignores the
+  // Doppler. Over the last 2 s (cycles 20-60):
+  //  - position and dual: mean velocity error < 4 m/s (16 % of 25 m/s; the lateral position of
+  //    the detections constrains the velocity only through cell-to-cell consistency, and the box
+  //    margin averages in lagging particles) and P(dynamic) > 0.6 somewhere on the target;
+  //  - velocity: error > 6 m/s and at least twice the dual error, i.e. markedly worse.
+  const std::uint64_t seed = GENERATE(1, 2, 3, 4);
+  const Trace pos = Run(Case::kTangential, WeightMode::kPosition, seed);
+  const Trace vel = Run(Case::kTangential, WeightMode::kVelocity, seed);
+  const Trace dual = Run(Case::kTangential, WeightMode::kDual, seed);
+  const double e_pos = MeanVelocityError(pos, 20, 60);
+  const double e_vel = MeanVelocityError(vel, 20, 60);
+  const double e_dual = MeanVelocityError(dual, 20, 60);
+  INFO("seed " << seed << " errors position " << e_pos << " velocity " << e_vel << " dual "
+               << e_dual);
+  CHECK(e_pos < 4.0);
+  CHECK(e_dual < 4.0);
+  CHECK(e_vel > 6.0);
+  CHECK(e_vel > 2.0 * e_dual);
+  for (int k = 20; k < 60; ++k) {
+    REQUIRE(pos.views[k].max_dynamic > 0.6);
+    REQUIRE(dual.views[k].max_dynamic > 0.6);
+  }
+}
