@@ -265,6 +265,8 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
        [](const ScenarioMetrics& m) { return m.detection_time; }},
       {{std::string(kTrackedFraction), "D", "%", 100.0, 1},
        [](const ScenarioMetrics& m) { return m.tracked_fraction; }},
+      {{std::string(kBoxDistance), "Δx to box surface", "m", 1.0, 2},
+       [](const ScenarioMetrics& m) { return m.box_distance; }},
       {{std::string(kFalseClusters), "false clusters / scan", "", 1.0, 2},
        [](const ScenarioMetrics& m) { return std::optional<double>(m.false_clusters_per_scan); }},
       {{std::string(kDuplicateClusters), "duplicate clusters / scan", "", 1.0, 2},

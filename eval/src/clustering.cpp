@@ -6,6 +6,12 @@
 
 namespace dualgrid::eval {
 
+ParticleClusterer::ParticleClusterer(const DbscanParams& params, double min_cluster_weight)
+    : dbscan_(params), min_cluster_weight_(min_cluster_weight) {
+  if (!(min_cluster_weight >= 0.0 && std::isfinite(min_cluster_weight)))
+    throw std::invalid_argument("ParticleClusterer: min_cluster_weight must be finite and >= 0");
+}
+
 std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> particles) {
   const int n = static_cast<int>(particles.size());
   positions_.resize(n);
@@ -55,6 +61,19 @@ std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> pa
       cl.position = plain_position[c] / cl.size;
       cl.velocity = plain_velocity[c] / cl.size;
     }
+  }
+  if (min_cluster_weight_ > 0.0) {
+    // Drop light clusters and renumber the labels of the kept ones, order preserved.
+    std::vector<int> new_label(k, kNoise);
+    std::vector<Cluster> kept;
+    for (int c = 0; c < k; ++c) {
+      if (clusters[c].weight < min_cluster_weight_) continue;
+      new_label[c] = static_cast<int>(kept.size());
+      kept.push_back(clusters[c]);
+    }
+    for (int& l : labels_)
+      if (l != kNoise) l = new_label[l];
+    return kept;
   }
   return clusters;
 }

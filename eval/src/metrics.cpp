@@ -76,6 +76,11 @@ AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
       s.velocity_error_sum += dv;
       position_error_sum_ += dx;
       velocity_error_sum_ += dv;
+      // Distance to the box: the offset beyond the box's extent in its own frame.
+      const Vector2 local = Rotation(o.box.yaw).transpose() * (clusters[c].position - o.box.center);
+      const Vector2 outside(std::max(0.0, std::abs(local.x()) - 0.5 * o.box.length),
+                            std::max(0.0, std::abs(local.y()) - 0.5 * o.box.width));
+      box_distance_sum_ += outside.norm();
       ++matches_;
     }
     if (!s.clock_start_time && o.in_grid && o.in_coverage) s.clock_start_time = time;
@@ -106,6 +111,7 @@ ScenarioMetrics TrackingMetricsAccumulator::Result() const {
   if (matches_ > 0) {
     m.position_error = position_error_sum_ / static_cast<double>(matches_);
     m.velocity_error = velocity_error_sum_ / static_cast<double>(matches_);
+    m.box_distance = box_distance_sum_ / static_cast<double>(matches_);
   }
   if (frames_ > 0) {
     m.clusters_per_scan = static_cast<double>(clusters_) / frames_;
@@ -186,6 +192,7 @@ void from_json(const nlohmann::json& j, ObjectMetrics& m) {
 void to_json(nlohmann::json& j, const ScenarioMetrics& m) {
   j = nlohmann::json{{"frames", m.frames},
                      {"matches", m.matches},
+                     {"box_distance", OptToJson(m.box_distance)},
                      {"position_error", OptToJson(m.position_error)},
                      {"velocity_error", OptToJson(m.velocity_error)},
                      {"detection_time", OptToJson(m.detection_time)},
@@ -204,6 +211,7 @@ void to_json(nlohmann::json& j, const ScenarioMetrics& m) {
 void from_json(const nlohmann::json& j, ScenarioMetrics& m) {
   j.at("frames").get_to(m.frames);
   j.at("matches").get_to(m.matches);
+  m.box_distance = OptFromJson(j, "box_distance");
   m.position_error = OptFromJson(j, "position_error");
   m.velocity_error = OptFromJson(j, "velocity_error");
   m.detection_time = OptFromJson(j, "detection_time");

@@ -260,6 +260,7 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
   r->Read("dynamic_threshold", &e->dynamic_threshold);
   r->Read("dbscan_eps", &e->dbscan.eps);
   r->Read("dbscan_min_points", &e->dbscan.min_points);
+  r->Read("min_cluster_mass", &e->min_cluster_mass);
   r->Read("gate_box_margin", &e->tracking.association.box_margin);
   r->Read("gate_center", &e->tracking.association.center_gate);
   r->Read("consistent_required", &e->tracking.required);
@@ -277,6 +278,10 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
 bool EvaluationConfig::IsValid(std::string* error) const {
   if (!(dynamic_threshold > 0.0 && dynamic_threshold < 1.0)) {
     if (error) *error = "dynamic_threshold: must be in (0, 1)";
+    return false;
+  }
+  if (!(min_cluster_mass >= 0.0)) {
+    if (error) *error = "min_cluster_mass: must be >= 0";
     return false;
   }
   std::string e;

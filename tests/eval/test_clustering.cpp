@@ -11,6 +11,7 @@ using dualgrid::RngPurpose;
 using dualgrid::Velocity;
 using dualgrid::eval::Cluster;
 using dualgrid::eval::kNoise;
+using dualgrid::eval::DbscanParams;
 using dualgrid::eval::ParticleClusterer;
 using dualgrid::eval::WeightedParticle;
 
@@ -85,4 +86,20 @@ TEST_CASE("Negative or non-finite weights are rejected", "[clustering]") {
   const double bad = GENERATE(-1.0, std::numeric_limits<double>::quiet_NaN());
   const std::vector<WeightedParticle> particles = {{{0.0, 0.0}, {0.0, 0.0}, bad}};
   CHECK_THROWS_AS(clusterer.Run(particles), std::invalid_argument);
+}
+
+TEST_CASE("ParticleClusterer drops clusters below the minimum mass", "[eval][clustering]") {
+  // Two blobs of 5 particles 10 m apart, weights 0.1 and 1.0 each: masses 0.5 and 5.0.
+  std::vector<WeightedParticle> particles;
+  for (int i = 0; i < 5; ++i) particles.push_back({Position(0.1 * i, 0), Velocity(1, 0), 0.1});
+  for (int i = 0; i < 5; ++i) particles.push_back({Position(10 + 0.1 * i, 0), Velocity(2, 0), 1.0});
+  ParticleClusterer all(DbscanParams{}, 0.0), heavy(DbscanParams{}, 1.0);
+  CHECK(all.Run(particles).size() == 2);
+  const auto kept = heavy.Run(particles);
+  REQUIRE(kept.size() == 1);
+  CHECK(kept[0].weight == Approx(5.0));
+  CHECK(kept[0].velocity.x() == Approx(2.0));
+  CHECK(heavy.labels()[0] == kNoise);
+  CHECK(heavy.labels()[9] == 0);
+  CHECK_THROWS_AS(ParticleClusterer(DbscanParams{}, -1.0), std::invalid_argument);
 }

@@ -20,6 +20,7 @@ using dualgrid::eval::TrackingMetricsAccumulator;
 using dualgrid::eval::TrackingMetricsParams;
 using dualgrid::eval::TruthObject;
 
+
 namespace {
 
 constexpr double kDt = 0.05;  // 20 Hz
@@ -257,4 +258,30 @@ TEST_CASE("Metrics params validation and misuse", "[metrics]") {
   CHECK_FALSE(empty.position_error);
   CHECK_FALSE(empty.tracked_fraction);
   CHECK_FALSE(empty.detection_time);
+}
+
+TEST_CASE("Box distance: zero inside the box, the overshoot beyond a face outside", "[metrics]") {
+  const double yaw = GENERATE(0.0, 0.7, -2.0);
+  TrackingMetricsAccumulator acc;
+  TruthObject o;
+  o.id = 1;
+  o.box = OrientedBox{Position(10, 5), yaw, 4.0, 2.0};
+  o.in_grid = o.in_coverage = true;
+  // Frame 1: 1.5 m ahead of the centre (inside). Frame 2: 3 m ahead (1 m beyond the front face).
+  // Frame 3: 2.5 m ahead and 1.5 m to the left (0.5 m beyond both the front and the side face).
+  const dualgrid::Vector2 fwd = dualgrid::UnitVector(yaw);
+  const dualgrid::Vector2 left = dualgrid::UnitVector(yaw + dualgrid::kPi / 2);
+  const std::vector<Position> at = {o.box.center + 1.5 * fwd, o.box.center + 3.0 * fwd,
+                                    o.box.center + 2.5 * fwd + 1.5 * left};
+  for (int f = 0; f < 3; ++f) {
+    Cluster c;
+    c.position = at[f];
+    c.weight = 1.0;
+    c.size = 10;
+    acc.AddFrame(0.05 * (f + 1), std::vector<Cluster>{c}, std::vector<TruthObject>{o});
+  }
+  const ScenarioMetrics m = acc.Result();
+  REQUIRE(m.box_distance);
+  CHECK(*m.box_distance == Approx((0.0 + 1.0 + std::sqrt(0.5)) / 3.0));
+  CHECK(*m.position_error == Approx((1.5 + 3.0 + std::hypot(2.5, 1.5)) / 3.0));
 }

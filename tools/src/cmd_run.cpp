@@ -102,6 +102,7 @@ nlohmann::json ConfigJson(const scenario::ScenarioConfig& c, const FilterRunOpti
   j["filter"] = FilterJson(c.filter);
   j["evaluation"]["dynamic_threshold"] = c.evaluation.dynamic_threshold;
   j["evaluation"]["dbscan"] = c.evaluation.dbscan;
+  j["evaluation"]["min_cluster_mass"] = c.evaluation.min_cluster_mass;
   j["evaluation"]["tracking"] = c.evaluation.tracking;
   j["evaluation"]["focus_object"] = c.evaluation.focus_object;
   return j;
@@ -213,6 +214,22 @@ int RunFilters(const FilterRunOptions& options) {
       RenderGridFigure(mode_names, snaps, f, f.time,
                        out / "figures" / ("grid_t" + Fixed(f.time, 1) + ".png"));
       RenderScene(pipeline, out / "figures" / ("scene_t" + Fixed(f.time, 1) + ".png"), 60, 140, 22);
+      // The particles behind each picture, for closer looks.
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        std::ofstream pc = OpenOutput(out / "figures" /
+                                      ("particles_" + mode_names[m] + "_t" + Fixed(f.time, 1) + ".csv"));
+        pc << "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
+        const auto& ps = pipeline.grid(m).particles();
+        for (std::size_t i = 0; i < ps.size(); ++i) {
+          const auto cell = pipeline.grid(m).CellOf(Position(ps.x[i], ps.y[i]));
+          const double pd =
+              cell ? snaps[m].dynamic[static_cast<std::size_t>(cell->y) * snaps[m].cells_x + cell->x]
+                   : 0.0;
+          pc << Fixed(ps.x[i], 3) << ',' << Fixed(ps.y[i], 3) << ',' << Fixed(ps.vx[i], 3) << ','
+             << Fixed(ps.vy[i], 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
+             << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
+        }
+      }
       ++next_snapshot;
     }
     ++steps;

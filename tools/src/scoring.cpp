@@ -81,7 +81,9 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Fram
 }
 
 ModeScorer::ModeScorer(const scenario::EvaluationConfig& config)
-    : config_(config), clusterer_(config.dbscan), tracking_(config.tracking) {}
+    : config_(config),
+      clusterer_(config.dbscan, config.min_cluster_mass),
+      tracking_(config.tracking) {}
 
 void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                           const GridSnapshot& snapshot,

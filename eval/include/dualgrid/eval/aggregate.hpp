@@ -34,6 +34,7 @@ Summary Summarize(std::span<const double> samples);
 /// Standard metric keys of the comparison table.
 inline constexpr std::string_view kDeltaX = "delta_x";
 inline constexpr std::string_view kDeltaV = "delta_v";
+inline constexpr std::string_view kBoxDistance = "box_distance";
 inline constexpr std::string_view kDetectionTime = "t_d";
 inline constexpr std::string_view kTrackedFraction = "D";
 inline constexpr std::string_view kFalseClusters = "false_clusters_per_scan";

@@ -34,7 +34,9 @@ struct Cluster {
 /// Reuses its buffers across calls.
 class ParticleClusterer {
  public:
-  explicit ParticleClusterer(const DbscanParams& params = {}) : dbscan_(params) {}
+  /// Clusters whose summed particle weight is below `min_cluster_weight` are dropped (their
+  /// particles labelled noise): a tracked object must hold some minimum dynamic mass.
+  explicit ParticleClusterer(const DbscanParams& params = {}, double min_cluster_weight = 0.0);
 
   /// Throws std::invalid_argument for a negative or non-finite weight or a non-finite particle.
   std::vector<Cluster> Run(std::span<const WeightedParticle> particles);
@@ -44,6 +46,7 @@ class ParticleClusterer {
 
  private:
   Dbscan dbscan_;
+  double min_cluster_weight_ = 0.0;
   std::vector<Position> positions_;
   std::vector<double> weights_;
   std::vector<int> labels_;

@@ -61,6 +61,10 @@ struct ScenarioMetrics {
   int frames = 0;
   std::int64_t matches = 0;                ///< (frame, tracked object) pairs behind the errors
   std::optional<double> position_error;    ///< Delta x [m]
+  /// Diagnostic beside Delta x: mean distance from the cluster to the vehicle's box (0 inside).
+  /// Radar sees only the faces turned to it, so clusters sit on a face; this separates that
+  /// offset (up to half a length) from errors of the filter itself.
+  std::optional<double> box_distance;
   std::optional<double> velocity_error;    ///< Delta v [m/s]
   std::optional<double> detection_time;    ///< t_d [s]
   std::optional<double> tracked_fraction;  ///< D in [0, 1]
@@ -97,6 +101,7 @@ class TrackingMetricsAccumulator {
     std::vector<std::pair<double, bool>> window;  // (time, tracked), oldest first, <= window
     double position_error_sum = 0.0, velocity_error_sum = 0.0;
   };
+  double box_distance_sum_ = 0.0;
 
   TrackingMetricsParams params_;
   std::map<int, ObjectState> objects_;

@@ -30,6 +30,9 @@ struct RadarConfig {
 struct EvaluationConfig {
   double dynamic_threshold = 0.6;  ///< a cell is dynamic when P(dynamic) exceeds this
   eval::DbscanParams dbscan;
+  /// Clusters lighter than this summed dynamic mass are not objects: the mass of three cells at
+  /// the dynamic threshold (3 x 0.6), while a vehicle face seen by radar spans >= 4 cells of 0.5 m.
+  double min_cluster_mass = 1.8;
   eval::TrackingMetricsParams tracking;
   /// Vehicle whose particle weights are plotted over time (paper Fig. 4); empty: the vehicle
   /// that stays longest in the grid.
