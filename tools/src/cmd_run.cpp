@@ -185,19 +185,22 @@ int RunFilters(const FilterRunOptions& options) {
       for (const auto& v : f.vehicles) {
         if (!pipeline.grid(trace_mode).CellOf(v.box.center)) continue;
         ++frames_in_grid[v.id];
-        double wp = 0, wv = 0, w = 0;
+        double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
         const OrientedBox grown{v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0};
         for (std::size_t i = 0; i < p.size(); ++i) {
           if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
           wp += p.w_position[i];
           wv += p.w_velocity[i];
           w += p.weight[i];
+          if ((Velocity(p.vx[i], p.vy[i]) - v.velocity).norm() < WeightTrace::kGoodVelocity) {
+            wp_good += p.w_position[i];
+            wv_good += p.w_velocity[i];
+          }
         }
-        double doppler = 0;
-        int n = 0;
+        int n = 0, tangential = 0;
         for (const auto& d : pipeline.detections())
           if (pipeline.ids().Name(d.source_id) == v.id) {
-            doppler += std::abs(d.radial_speed_compensated);
+            tangential += std::abs(d.radial_speed_compensated) < 0.5 * v.velocity.norm();
             ++n;
           }
         auto& t = traces[v.id];
@@ -205,8 +208,9 @@ int RunFilters(const FilterRunOptions& options) {
         t.w_position.push_back(wp);
         t.w_velocity.push_back(wv);
         t.weight.push_back(w);
-        t.radial_speed_ratio.push_back(
-            n > 0 && v.velocity.norm() > 0.1 ? doppler / n / v.velocity.norm() : std::nan(""));
+        t.position_share.push_back(wp > 0 ? wp_good / wp : std::nan(""));
+        t.velocity_share.push_back(wv > 0 ? wv_good / wv : std::nan(""));
+        t.tangential_share.push_back(n > 0 ? static_cast<double>(tangential) / n : std::nan(""));
       }
     }
     if (options.figures && next_snapshot < snapshot_times.size() &&
@@ -216,15 +220,16 @@ int RunFilters(const FilterRunOptions& options) {
       RenderScene(pipeline, out / "figures" / ("scene_t" + Fixed(f.time, 1) + ".png"), 60, 140, 22);
       // The particles behind each picture, for closer looks.
       for (std::size_t m = 0; m < modes.size(); ++m) {
-        std::ofstream pc = OpenOutput(out / "figures" /
-                                      ("particles_" + mode_names[m] + "_t" + Fixed(f.time, 1) + ".csv"));
+        std::ofstream pc = OpenOutput(
+            out / "figures" / ("particles_" + mode_names[m] + "_t" + Fixed(f.time, 1) + ".csv"));
         pc << "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
         const auto& ps = pipeline.grid(m).particles();
         for (std::size_t i = 0; i < ps.size(); ++i) {
           const auto cell = pipeline.grid(m).CellOf(Position(ps.x[i], ps.y[i]));
           const double pd =
-              cell ? snaps[m].dynamic[static_cast<std::size_t>(cell->y) * snaps[m].cells_x + cell->x]
-                   : 0.0;
+              cell
+                  ? snaps[m].dynamic[static_cast<std::size_t>(cell->y) * snaps[m].cells_x + cell->x]
+                  : 0.0;
           pc << Fixed(ps.x[i], 3) << ',' << Fixed(ps.y[i], 3) << ',' << Fixed(ps.vx[i], 3) << ','
              << Fixed(ps.vy[i], 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
              << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
@@ -285,10 +290,12 @@ int RunFilters(const FilterRunOptions& options) {
   if (traces.count(focus)) {
     const WeightTrace& t = traces.at(focus);
     std::ofstream w = OpenOutput(out / "weights.csv");
-    w << "time,object,w_position,w_velocity,w_resample,doppler_ratio\n";
+    w << "time,object,w_position,w_velocity,w_resample,position_share,velocity_share,"
+         "tangential_share\n";
     for (std::size_t i = 0; i < t.time.size(); ++i)
       w << Fixed(t.time[i], 3) << ',' << focus << ',' << t.w_position[i] << ',' << t.w_velocity[i]
-        << ',' << t.weight[i] << ',' << t.radial_speed_ratio[i] << '\n';
+        << ',' << t.weight[i] << ',' << t.position_share[i] << ',' << t.velocity_share[i] << ','
+        << t.tangential_share[i] << '\n';
     if (options.figures)
       RenderWeightTrace(t, focus, mode_names[trace_mode], out / "figures" / "weights.png");
   }

@@ -113,22 +113,22 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
                        const std::filesystem::path& path) {
   if (trace.time.size() < 2) return;
   viz::LineChart chart;
-  chart.title = "Particle weights on " + object + " (" + mode +
-                " filter): summed over the particles inside its box";
-  chart.y_label = "weight mass";
-  chart.log_y = true;
+  chart.title = "Weights on " + object + " (" + mode + " filter): share held by particles within " +
+                Fixed(WeightTrace::kGoodVelocity, 0) + " m/s of its true velocity";
+  chart.y_label = "share of the weight";
+  chart.y_min = 0.0;
+  chart.y_max = 1.0;
   chart.series.push_back(
-      {"w_position", trace.time, trace.w_position, viz::ModeColor(viz::Mode::kPosition)});
+      {"w_position", trace.time, trace.position_share, viz::ModeColor(viz::Mode::kPosition)});
   chart.series.push_back(
-      {"w_velocity", trace.time, trace.w_velocity, viz::ModeColor(viz::Mode::kVelocity)});
-  chart.series.push_back({"w_resample", trace.time, trace.weight, viz::colors::kBlack, 1.0, true});
-  // Shade where the Doppler sees less than half of the object's speed (tangential motion).
+      {"w_velocity", trace.time, trace.velocity_share, viz::ModeColor(viz::Mode::kVelocity)});
+  // Shade where most detections see less than half of the object's speed (tangential motion).
   std::optional<double> start;
   for (std::size_t i = 0; i <= trace.time.size(); ++i) {
-    const bool low = i < trace.time.size() && trace.radial_speed_ratio[i] < 0.5;
+    const bool low = i < trace.time.size() && trace.tangential_share[i] > 0.5;
     if (low && !start) start = trace.time[i];
     if (!low && start) {
-      chart.spans.push_back({*start, trace.time[i - 1], "Doppler < 50 % of speed"});
+      chart.spans.push_back({*start, trace.time[i - 1], "most Doppler < 50 % of speed"});
       start.reset();
     }
   }

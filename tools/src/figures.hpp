@@ -28,10 +28,16 @@ void RenderTrackedShares(const std::vector<std::string>& modes,
                          const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
                          const std::string& title, const std::filesystem::path& path);
 
-/// Particle weight masses on one object over time (paper Fig. 4).
+/// Particle weights on one object over time (paper Fig. 4). The filter normalises both weights
+/// per cell, so their sums over an object are equal; what differs is *which* particles carry
+/// them: the shares are the fraction of each weight held by particles whose velocity is within
+/// `kGoodVelocity` of the object's true velocity.
 struct WeightTrace {
+  static constexpr double kGoodVelocity = 2.0;  ///< [m/s]
   std::vector<double> time, w_position, w_velocity, weight;
-  std::vector<double> radial_speed_ratio;  ///< |compensated Doppler| / |velocity| of the object
+  std::vector<double> position_share, velocity_share;
+  /// Share of the object's detections whose |compensated Doppler| is below half its speed.
+  std::vector<double> tangential_share;
 };
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
                        const std::filesystem::path& path);
