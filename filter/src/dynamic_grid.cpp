@@ -6,6 +6,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#ifdef DG_PROF
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#endif
 
 #include <omp.h>
 
@@ -40,6 +45,72 @@ inline double FastAtan2(double y, double x) {
   return y < 0.0 ? -r : r;
 }
 
+// Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
+constexpr double kAtanError = 5e-4;
+#ifdef DG_PROF
+long g_exact = 0, g_fast = 0, g_seg = 0;
+#endif
+
+// Exclusive prefix sum over the concatenation of a[0..na) and b[0..n - na) (floats, summed in
+// double) into out[0..n], with exactly the summation order of ExclusiveScan (particles.cpp: blocks
+// of kScanBlock, block totals, serial scan, local scans): bit-identical to it, without
+// materialising the concatenated input.
+constexpr std::int64_t kScanBlock = 1 << 14;
+void ConcatScan(const float* a, std::int64_t na, const float* b, std::int64_t n, double* out) {
+  const auto block_sum = [&](std::int64_t lo, std::int64_t hi, double acc) {
+    for (std::int64_t i = lo; i < std::min(hi, na); ++i) acc += static_cast<double>(a[i]);
+    for (std::int64_t i = std::max(lo, na); i < hi; ++i) acc += static_cast<double>(b[i - na]);
+    return acc;
+  };
+  const auto block_scan = [&](std::int64_t lo, std::int64_t hi, double acc) {
+    for (std::int64_t i = lo; i < std::min(hi, na); ++i) {
+      out[i] = acc;
+      acc += static_cast<double>(a[i]);
+    }
+    for (std::int64_t i = std::max(lo, na); i < hi; ++i) {
+      out[i] = acc;
+      acc += static_cast<double>(b[i - na]);
+    }
+    return acc;
+  };
+  const std::int64_t blocks = (n + kScanBlock - 1) / kScanBlock;
+  if (blocks <= 1) {
+    out[n] = block_scan(0, n, 0.0);
+    return;
+  }
+  static thread_local std::vector<double> base;
+  if (base.size() < static_cast<std::size_t>(blocks) + 1) base.resize(blocks + 1);
+  double* const tot = base.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < blocks; ++k) {
+    const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
+    tot[k + 1] = block_sum(lo, hi, 0.0);
+  }
+  tot[0] = 0.0;
+  for (std::int64_t k = 0; k < blocks; ++k) tot[k + 1] += tot[k];
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < blocks; ++k) {
+    const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
+    block_scan(lo, hi, tot[k]);
+  }
+  out[n] = tot[blocks];
+}
+
+// static_cast<int64>(std::ceil(x)) for finite |x| < 2^62 (no libm call without SSE4.1).
+inline std::int64_t CeilToInt(double x) {
+  const std::int64_t i = static_cast<std::int64_t>(x);  // truncation towards zero
+  return static_cast<double>(i) < x ? i + 1 : i;
+}
+
+// SystematicRanges (particles.cpp) for one source: first output slot of source i. The argument
+// of the ceiling lies in [-1, n] (cumulative <= total), so CeilToInt is exact.
+inline std::int64_t SystematicStart(const double* cumulative, std::int64_t i, std::int64_t n_src,
+                                    double scale, double u, std::int64_t n) {
+  if (i == 0) return 0;
+  if (i == n_src) return n;
+  return std::clamp(CeilToInt(cumulative[i] * scale - u), std::int64_t{0}, n);
+}
+
 }  // namespace
 
 DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
@@ -64,13 +135,9 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   births_.resize(b);
   cell_of_.assign(n, 0);
   cell_start_.assign(c + 2, 0);
-  hist_total_.assign(c + 1, 0);
+  hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 14) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
-  scan_in_.assign(n + b, 0.0);
   scan_out_.assign(n + b + 1, 0.0);
-  ranges_.assign(n + b + 1, 0);
-  born_scan_.assign(c + 1, 0.0);
-  born_ranges_.assign(c + 1, 0);
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
   // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
   // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
@@ -192,46 +259,62 @@ void DynamicGrid::SortParticles() {
   const std::int64_t c1 = num_cells_ + 1;  // bucket num_cells_ collects particles off the grid
   const double inv_r = 1.0 / params_.resolution;
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
-    const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
-    const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
-    const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
-    if (!inside) {
-      cell_of_[i] = num_cells_;
-      continue;
-    }
-    // Storage index without integer division (hot loop): wrap once.
-    std::int64_t sx = sx0 + static_cast<std::int64_t>(fx), sy = sy0 + static_cast<std::int64_t>(fy);
-    if (sx >= nx_) sx -= nx_;
-    if (sy >= ny_) sy -= ny_;
-    cell_of_[i] = sy * nx_ + sx;
-  }
   const int chunks = std::clamp(omp_get_max_threads(), 1, kMaxSortChunks);
   // Counting sort, stable: particle order within a cell = order before sorting, for any chunking.
+  // Pass 1 (per chunk): storage cell of each particle and the chunk's histogram.
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < chunks; ++k) {
     std::int32_t* h = hist_.data() + k * c1;
     std::fill_n(h, c1, 0);
-    for (std::int64_t i = k * n / chunks; i < (k + 1) * n / chunks; ++i) ++h[cell_of_[i]];
-  }
-#pragma omp parallel for schedule(static)
-  for (std::int64_t c = 0; c < c1; ++c) {
-    std::int64_t t = 0;
-    for (int k = 0; k < chunks; ++k) t += hist_[k * c1 + c];
-    hist_total_[c] = t;
-  }
-  ExclusiveScan(std::span<const std::int64_t>(hist_total_.data(), c1),
-                std::span<std::int64_t>(cell_start_.data(), c1 + 1));
-#pragma omp parallel for schedule(static)
-  for (std::int64_t c = 0; c < c1; ++c) {
-    std::int64_t run = cell_start_[c];
-    for (int k = 0; k < chunks; ++k) {
-      const std::int64_t t = hist_[k * c1 + c];
-      hist_[k * c1 + c] = static_cast<std::int32_t>(run);
-      run += t;
+    for (std::int64_t i = k * n / chunks; i < (k + 1) * n / chunks; ++i) {
+      const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
+      const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
+      const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
+      std::int64_t c = num_cells_;
+      if (inside) {
+        // Storage index without integer division (hot loop): wrap once.
+        std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
+        std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
+        if (sx >= nx_) sx -= nx_;
+        if (sy >= ny_) sy -= ny_;
+        c = sy * nx_ + sx;
+      }
+      cell_of_[i] = c;
+      ++h[c];
     }
   }
+  // Pass 2: cell starts and per-chunk write offsets in fixed blocks of cells (integers: exact in
+  // any order). Block totals first, then a serial scan over blocks, then the offsets.
+  constexpr std::int64_t kCellBlock = 1 << 14;
+  const std::int64_t nblocks = (c1 + kCellBlock - 1) / kCellBlock;
+  if (static_cast<std::int64_t>(hist_total_.size()) < nblocks + 1) hist_total_.resize(nblocks + 1);
+  std::int64_t* block_base = hist_total_.data();
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < nblocks; ++b) {
+    const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
+    std::int64_t t = 0;
+    for (int k = 0; k < chunks; ++k) {
+      const std::int32_t* h = hist_.data() + k * c1;
+      for (std::int64_t c = lo; c < hi; ++c) t += h[c];
+    }
+    block_base[b + 1] = t;
+  }
+  block_base[0] = 0;
+  for (std::int64_t b = 0; b < nblocks; ++b) block_base[b + 1] += block_base[b];
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < nblocks; ++b) {
+    const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
+    std::int64_t run = block_base[b];
+    for (std::int64_t c = lo; c < hi; ++c) {
+      cell_start_[c] = run;
+      for (int k = 0; k < chunks; ++k) {
+        const std::int64_t t = hist_[k * c1 + c];
+        hist_[k * c1 + c] = static_cast<std::int32_t>(run);
+        run += t;
+      }
+    }
+  }
+  cell_start_[c1] = n;
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < chunks; ++k) {
     std::int32_t* h = hist_.data() + k * c1;
@@ -359,22 +442,119 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
       const double* bins = bin_range_.data() + bin_offset_[k];
       const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
       const double inv_bin = 1.0 / params_.free_angle_bin;
-      for (int lx = lx_lo; lx <= lx_hi; ++lx) {
+      const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
+      // Exact per-cell test (the reference definition of the bits).
+      const auto exact = [&](int lx) {
         const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
         const double d2 = dx * dx + dy * dy;
-        if (d2 < min2 || d2 > max2) continue;
+        if (d2 < min2 || d2 > max2) return;
         const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-        if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) continue;
+        if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) return;
         const double rel = FastAtan2(fy, fx);
-        if (std::abs(rel) > sc.half_fov) continue;
+        if (std::abs(rel) > sc.half_fov) return;
         const std::int64_t sx = sx0 + lx;
         const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
         const int b = std::clamp(static_cast<int>((rel + sc.half_fov) * inv_bin), 0, nbins - 1);
         const double br = bins[b];
-        // Branch-free: free in front of the bin's closest detection, unknown behind it; a bin
-        // without any detection is weakly free over the whole range.
+        // Free in front of the bin's closest detection, unknown behind it; a bin without any
+        // detection is weakly free over the whole range.
         view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
                                               (br != kInf && d2 < br * br ? kFreeRay : 0));
+      };
+      int lo_x = lx_lo, hi_x = lx_hi;
+      if (narrow) {
+        // Cells inside the wedge satisfy three linear conditions in dx (fx > 0, fx tan - fy >= 0,
+        // fx tan + fy >= 0): clip the row to that interval, two cells of margin (the exact test
+        // still decides every cell).
+        double dmin = -kInf, dmax = kInf;
+        for (const auto& [c, d] : {std::pair{cb, dy * sb}, std::pair{cb * tan_hf + sb, dy * (sb * tan_hf - cb)},
+                                   std::pair{cb * tan_hf - sb, dy * (sb * tan_hf + cb)}}) {
+          if (c > 0.0) {
+            dmin = std::max(dmin, -d / c);
+          } else if (c < 0.0) {
+            dmax = std::min(dmax, -d / c);
+          } else if (d < 0.0) {
+            dmax = -kInf;
+          }
+        }
+        if (!(dmin <= dmax)) continue;
+        const double big = 4.0 * nx_;
+        const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
+        const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
+        lo_x = std::max(lo_x, static_cast<int>(l0));
+        hi_x = std::min(hi_x, static_cast<int>(l1));
+      }
+      if (lo_x > hi_x) continue;
+      // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
+      // is within kAtanError of it, so the cells' computed bearings lie within 2 kAtanError of the
+      // hull of the end points' ones and their bins (a monotonic function of the bearing) within
+      // the bins of that hull. If all those bins hold the same range, every cell gets the same bin
+      // value as in the exact test without its atan2; otherwise the segment is split.
+      const auto rel_of = [&](int lx, double* fx_out) {
+        const double dxe = x0 + (lx + 0.5) * r - sc.origin.x();
+        const double fx = dxe * cb + dy * sb, fy = dy * cb - dxe * sb;
+        *fx_out = fx;
+        return FastAtan2(fy, fx);
+      };
+      int stack[128][2];
+      int top = 0;
+      stack[top][0] = lo_x;
+      stack[top][1] = hi_x;
+      ++top;
+      while (top > 0) {
+        --top;
+        const int a = stack[top][0], e = stack[top][1];
+        if (e - a < 4) {
+          for (int lx = a; lx <= e; ++lx) exact(lx);
+#ifdef DG_PROF
+          g_exact += e - a + 1;
+#endif
+          continue;
+        }
+        double fxa, fxe;
+        const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
+        const double lo = std::min(ra, re) - 2.0 * kAtanError, hi = std::max(ra, re) + 2.0 * kAtanError;
+        bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
+        double br = kInf;
+        if (uniform) {
+          const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
+          const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
+          br = bins[b0];
+          for (int b = b0 + 1; b <= b1 && uniform; ++b) uniform = bins[b] == br;
+        }
+        if (!uniform) {
+          const int mid = a + (e - a) / 2;
+          stack[top][0] = mid + 1;
+          stack[top][1] = e;
+          ++top;
+          stack[top][0] = a;
+          stack[top][1] = mid;
+          ++top;
+          continue;
+        }
+#ifdef DG_PROF
+        g_fast += e - a + 1;
+        ++g_seg;
+#endif
+        // Branch-free over the segment (vectorises), split where the storage row wraps.
+        const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
+        const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
+        const double br2 = br * br;
+        const int wrap = static_cast<int>(nx_ - sx0);  // first lx whose storage column wraps
+        for (int part = 0; part < 2; ++part) {
+          const int pa = part == 0 ? a : std::max(a, wrap);
+          const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+          std::uint8_t* dst = view_.data() + row + sx0 - (part == 0 ? 0 : nx_);
+          for (int lx = pa; lx <= pe; ++lx) {
+            const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
+            const double d2 = dx * dx + dy * dy;
+            const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+            const bool in = (d2 >= min2) & (d2 <= max2) &
+                            (!narrow | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
+            const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
+            dst[lx] |= in ? v : 0;
+          }
+        }
       }
     }
   }
@@ -583,9 +763,22 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
 
 void DynamicGrid::Birth(std::span<const Measurement> z) {
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
-  ExclusiveScan(std::span<const double>(born_.data(), num_cells_),
-                std::span<double>(born_scan_.data(), num_cells_ + 1));
-  const double total = born_scan_[num_cells_];
+  const std::int64_t nc = num_cells_;
+  // Prefix sums of the birth masses with the summation order of ExclusiveScan (blocks of
+  // kScanBlock), without materialising them: block totals here, running sums in the loop below.
+  const std::int64_t blocks = (nc + kScanBlock - 1) / kScanBlock;
+  std::vector<double>& tot = born_block_;
+  tot.resize(blocks + 1);
+#pragma omp parallel for schedule(static) if (blocks > 1)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t lo = b * kScanBlock, hi = std::min(nc, lo + kScanBlock);
+    double acc = 0.0;
+    for (std::int64_t s = lo; s < hi; ++s) acc += born_[s];
+    tot[b + 1] = acc;
+  }
+  tot[0] = 0.0;
+  for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
+  const double total = tot[blocks];
   if (nb == 0) return;
   if (!(total > 0.0)) {
     std::fill(births_.weight.begin(), births_.weight.end(), 0.0);
@@ -594,38 +787,78 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
     return;
   }
   // New-born particles are spread over cells in proportion to their birth mass (systematic
-  // allocation); every birth carries the same mass total / num_birth.
+  // allocation, SystematicRanges); every birth carries the same mass total / num_birth.
   CounterRng offset_rng(seed_, RngPurpose::kFilterBirth, step_, 0xFFFFFFFFu);
-  SystematicRanges(std::span<const double>(born_scan_.data(), num_cells_ + 1),
-                   static_cast<std::size_t>(nb), offset_rng.Uniform(),
-                   std::span<std::int64_t>(born_ranges_.data(), num_cells_ + 1));
+  const double u = offset_rng.Uniform();
+  const double scale = static_cast<double>(nb) / total;
   const double mass = total / static_cast<double>(nb);
   const double r = params_.resolution;
   const double vmax = params_.birth_max_tangential_speed;
+  const auto start = [&](std::int64_t i, double cumulative) -> std::int64_t {
+    if (i == 0) return 0;
+    if (i == nc) return nb;
+    return std::clamp(CeilToInt(cumulative * scale - u), std::int64_t{0}, nb);
+  };
 #pragma omp parallel for schedule(static)
-  for (std::int64_t s = 0; s < num_cells_; ++s) {
-    if (born_ranges_[s] == born_ranges_[s + 1]) continue;
-    const int j = near_det_[s];
-    assert(j >= 0);  // birth mass needs a detection nearby
-    const Measurement& m = z[j];
-    Vector2 los = m.position - m.sensor_position;
-    const double los_n = los.norm();
-    los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
-    const Vector2 tangent(-los.y(), los.x());
-    const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
-    // Global cell of storage index s: the unique one inside the current window.
-    const std::int64_t sx = s % nx_, sy = s / nx_;
-    const std::int64_t gx = origin_gx_ + Mod(sx - origin_gx_, nx_);
-    const std::int64_t gy = origin_gy_ + Mod(sy - origin_gy_, ny_);
-    for (std::int64_t k = born_ranges_[s]; k < born_ranges_[s + 1]; ++k) {
-      CounterRng rng(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k));
-      births_.x[k] = (static_cast<double>(gx) + detail::Uniform24(rng)) * r;
-      births_.y[k] = (static_cast<double>(gy) + detail::Uniform24(rng)) * r;
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t lo = b * kScanBlock, hi = std::min(nc, lo + kScanBlock);
+    double acc = tot[b];
+    for (std::int64_t s = lo; s < hi; ++s) {
+      const double born = born_[s];
+      const double cum_s = acc;
+      acc += born;
+      const bool block_end = s + 1 == hi;
+      // Inside a block a zero mass leaves the running sum unchanged: empty range.
+      if (born == 0.0 && !block_end) continue;
+      const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
+      if (k_lo == k_hi) continue;
+      GenerateBirths(z, s, k_lo, k_hi, mass, r, vmax);
+    }
+  }
+}
+
+void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
+                                 std::int64_t k_hi, double mass, double r, double vmax) {
+  const int j = near_det_[s];
+  // Global cell of storage index s: the unique one inside the current window.
+  const std::int64_t sx = s % nx_, sy = s / nx_;
+  const std::int64_t gx = origin_gx_ + Mod(sx - origin_gx_, nx_);
+  const std::int64_t gy = origin_gy_ + Mod(sy - origin_gy_, ny_);
+  if (j < 0) {
+    // Birth mass needs a detection nearby; only a rounding jump of the prefix sums at a block
+    // boundary could land here. Keep the slots harmless (zero mass at the cell centre).
+    for (std::int64_t k = k_lo; k < k_hi; ++k) {
+      births_.x[k] = (static_cast<double>(gx) + 0.5) * r;
+      births_.y[k] = (static_cast<double>(gy) + 0.5) * r;
+      births_.vx[k] = births_.vy[k] = 0.0f;
+      births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = 0.0f;
+    }
+    return;
+  }
+  const Measurement& m = z[j];
+  Vector2 los = m.position - m.sensor_position;
+  const double los_n = los.norm();
+  los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
+  const Vector2 tangent(-los.y(), los.x());
+  const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
+  constexpr std::int64_t kBatch = 64;
+  alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
+  for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
+    const std::int64_t cnt = std::min(kBatch, k_hi - k0);
+    // Draws 0-3 (block 0) and 4 (block 1) of CounterRng(seed, kFilterBirth, step, k).
+    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
+                         cnt, 0, raw[0], raw[1], raw[2], raw[3]);
+    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
+                         cnt, 1, raw2[0], raw2[1], raw2[2], raw2[3]);
+    for (std::int64_t t = 0; t < cnt; ++t) {
+      const std::int64_t k = k0 + t;
+      births_.x[k] = (static_cast<double>(gx) + detail::ToUnit24(raw[0][t])) * r;
+      births_.y[k] = (static_cast<double>(gy) + detail::ToUnit24(raw[1][t])) * r;
       float n0, n1;
-      detail::Normal2(rng, &n0, &n1);
+      detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
       // Radial component from the Doppler, tangential one unobservable: sampled uniformly.
       const Vector2 v = (v_radial + params_.birth_sigma_radial * n0) * los +
-                        vmax * (2.0 * detail::Uniform24(rng) - 1.0) * tangent;
+                        vmax * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
       births_.vx[k] = v.x();
       births_.vy[k] = v.y();
       births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = mass;
@@ -638,13 +871,8 @@ void DynamicGrid::Resample() {
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
   const std::int64_t n_src = n_in + nb;
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
-  const auto src_weight = [&](std::int64_t i) {
-    return i < n_in ? sorted_.weight[i] : births_.weight[i - n_in];
-  };
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n_src; ++i) scan_in_[i] = src_weight(i);
-  ExclusiveScan(std::span<const double>(scan_in_.data(), n_src),
-                std::span<double>(scan_out_.data(), n_src + 1));
+  // Prefix sums straight from the float weights (no separate gather pass).
+  ConcatScan(sorted_.weight.data(), n_in, births_.weight.data(), n_src, scan_out_.data());
   const double total = scan_out_[n_src];
   if (!(total > 0.0)) {
     // No dynamic mass anywhere: keep the particle positions (zero weight), refilled uniformly
@@ -666,22 +894,32 @@ void DynamicGrid::Resample() {
     return;
   }
   CounterRng rng(seed_, RngPurpose::kFilterResample, step_, 0);
-  SystematicRanges(std::span<const double>(scan_out_.data(), n_src + 1),
-                   static_cast<std::size_t>(n), rng.Uniform(),
-                   std::span<std::int64_t>(ranges_.data(), n_src + 1));
+  // Systematic ranges (SystematicRanges) computed inside the copy loop: source i owns output
+  // slots [start(i), start(i + 1)).
+  const double u = rng.Uniform();
+  const double scale = static_cast<double>(n) / total;
   const double share = total / static_cast<double>(n);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n_src; ++i) {
-    if (ranges_[i] == ranges_[i + 1]) continue;
-    const ParticleSet& src = i < n_in ? sorted_ : births_;
-    const std::int64_t si = i < n_in ? i : i - n_in;
-    // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
-    const double ratio = share / src.weight[si];
-    for (std::int64_t k = ranges_[i]; k < ranges_[i + 1]; ++k) {
-      particles_.CopyFrom(src, si, k);
-      particles_.weight[k] = share;
-      particles_.w_position[k] *= ratio;
-      particles_.w_velocity[k] *= ratio;
+  const double* const cum = scan_out_.data();
+#pragma omp parallel
+  {
+    // Contiguous source ranges per thread; each range boundary is computed once.
+    const std::int64_t nt = omp_get_num_threads(), t = omp_get_thread_num();
+    const std::int64_t i_lo = n_src * t / nt, i_hi = n_src * (t + 1) / nt;
+    std::int64_t k1 = SystematicStart(cum, i_lo, n_src, scale, u, n);
+    for (std::int64_t i = i_lo; i < i_hi; ++i) {
+      const std::int64_t k0 = k1;
+      k1 = SystematicStart(cum, i + 1, n_src, scale, u, n);
+      if (k0 == k1) continue;
+      const ParticleSet& src = i < n_in ? sorted_ : births_;
+      const std::int64_t si = i < n_in ? i : i - n_in;
+      // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
+      const double ratio = share / src.weight[si];
+      for (std::int64_t k = k0; k < k1; ++k) {
+        particles_.CopyFrom(src, si, k);
+        particles_.weight[k] = share;
+        particles_.w_position[k] *= ratio;
+        particles_.w_velocity[k] *= ratio;
+      }
     }
   }
 }
@@ -708,13 +946,41 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
+#ifdef DG_PROF
+  static double acc[8] = {0};
+  static int calls = 0;
+  const auto now = [] {
+    timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+  };
+  double t0 = now(), t1;
+#define DG_T(k) t1 = now(); acc[k] += t1 - t0; t0 = t1;
+#else
+#define DG_T(k)
+#endif
   PredictParticles(particles_, dt, params_.process_noise_position, params_.process_noise_velocity,
                    params_.persistence, seed_, step_);  // 2. prediction
+  DG_T(0)
   SortParticles();                                      // 3. assignment
+  DG_T(1)
   BuildMeasurementGrid(measurements, coverage);         // 4. measurement grid
+  DG_T(2)
   UpdateCells(measurements);  // 5.-6. occupancy update, weights, 9. statistics
+  DG_T(3)
   Birth(measurements);        // 7. birth
+  DG_T(4)
   Resample();                 // 8. resampling
+  DG_T(5)
+#ifdef DG_PROF
+  static const int period = getenv("DGP") ? atoi(getenv("DGP")) : 500;
+  if (++calls % period == 0) {
+    fprintf(stderr, "pred %.4f sort %.4f meas %.4f upd %.4f birth %.4f res %.4f ms\n", acc[0] / calls * 1e3,
+            acc[1] / calls * 1e3, acc[2] / calls * 1e3, acc[3] / calls * 1e3, acc[4] / calls * 1e3,
+            acc[5] / calls * 1e3);
+    fprintf(stderr, "exact %ld fast %ld seg %ld per cycle\n", g_exact / calls, g_fast / calls, g_seg / calls);
+  }
+#endif
   ++step_;
 }
 

@@ -30,9 +30,11 @@ void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_
     const std::int64_t lo = b * kBlock, m = std::min(kBlock, n - lo);
     alignas(64) float u[4][kBlock], g[4][kBlock];
     if (noisy) {
-      for (std::int64_t k = 0; k < m; ++k) {
-        CounterRng rng(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(lo + k));
-        for (int c = 0; c < 4; ++c) u[c][k] = detail::ToUnit24(rng.NextU32());
+      alignas(64) std::uint32_t raw[4][kBlock];
+      detail::PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(lo), m,
+                           0, raw[0], raw[1], raw[2], raw[3]);
+      for (int c = 0; c < 4; ++c) {
+        for (std::int64_t k = 0; k < m; ++k) u[c][k] = detail::ToUnit24(raw[c][k]);
       }
       for (int pair = 0; pair < 2; ++pair) {
         detail::BoxMuller(u[2 * pair], u[2 * pair + 1], g[2 * pair], g[2 * pair + 1], m);

@@ -96,6 +96,9 @@ class DynamicGrid {
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
   void Birth(std::span<const Measurement> z);
+  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
+  void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
+                      std::int64_t k_hi, double mass, double r, double vmax);
   void Resample();
   // Detection bucket (clamped to the bucket grid) of a world point.
   std::pair<int, int> BucketOf(double px, double py) const;
@@ -121,10 +124,8 @@ class DynamicGrid {
   std::vector<std::int64_t> cell_start_;  // num_cells_ + 2: particle ranges of sorted_
   std::vector<std::int32_t> hist_;        // per-chunk histograms of the counting sort
   std::vector<std::int64_t> hist_total_;
-  std::vector<double> scan_in_, scan_out_;  // resampling / birth weights and prefix sums
-  std::vector<std::int64_t> ranges_;
-  std::vector<double> born_scan_;
-  std::vector<std::int64_t> born_ranges_;
+  std::vector<double> scan_out_;    // resampling prefix sums of the source weights
+  std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
