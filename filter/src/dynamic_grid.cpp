@@ -419,6 +419,13 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
   // Field of view and ray free space per cell (rows in parallel: each cell has one writer).
   const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
   const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  // Per-sensor trigonometry once per cycle, not per row.
+  sensor_trig_.resize(3 * static_cast<std::size_t>(ns));
+  for (int k = 0; k < ns; ++k) {
+    sensor_trig_[3 * k] = std::cos(cov[k].boresight);
+    sensor_trig_[3 * k + 1] = std::sin(cov[k].boresight);
+    sensor_trig_[3 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+  }
 #pragma omp parallel for schedule(static)
   for (int ly = 0; ly < ny_; ++ly) {
     const std::int64_t row = Mod(origin_gy_ + ly, ny_) * nx_;
@@ -435,9 +442,9 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
           std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
       // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
       // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
-      const double cb = std::cos(sc.boresight), sb = std::sin(sc.boresight);
+      const double cb = sensor_trig_[3 * k], sb = sensor_trig_[3 * k + 1];
       const bool narrow = sc.half_fov < 0.5 * kPi;
-      const double tan_hf = narrow ? std::tan(sc.half_fov) : 0.0;
+      const double tan_hf = sensor_trig_[3 * k + 2];
       const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
       const double* bins = bin_range_.data() + bin_offset_[k];
       const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);

@@ -184,3 +184,18 @@ TEST_CASE("tangential: bad options are rejected", "[cli]") {
   CHECK(r.code != 0);
   CHECK(r.output.find("--spacing") != std::string::npos);
 }
+
+TEST_CASE("experiment: seeds run in separate processes and aggregate into tables", "[cli][run]") {
+  const auto dir = TempDir("experiment");
+  const Result r =
+      Run("experiment scenarios/simple_road.yaml --seeds 2 --duration 3 -q --out " + dir.string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  for (const char* seed : {"seed_1", "seed_2"})
+    CHECK(fs::exists(dir / "seeds" / seed / "metrics.json"));
+  const std::string table = Slurp(dir / "table.csv");
+  // Two seeds per mode behind each D value.
+  CHECK(table.find("simple_road,D,%,dual,2,") != std::string::npos);
+  CHECK(fs::exists(dir / "table.md"));
+  CHECK(fs::exists(dir / "figures" / "tracked_share.png"));
+}

@@ -137,6 +137,7 @@ class DynamicGrid {
   std::vector<double> bin_range_;
   std::vector<std::int64_t> bin_offset_;
   std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
+  std::vector<double> sensor_trig_;       // per sensor: cos, sin of the boresight, tan(half_fov)
 };
 
 }  // namespace dualgrid::filter
