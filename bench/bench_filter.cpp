@@ -111,7 +111,11 @@ void BM_PaperConfig(benchmark::State& state) {
   Scene scene(fp.length_x, fp.width_y, 10, 5, 200.0);
   RunCycles(state, fp, scene);
 }
-BENCHMARK(BM_PaperConfig)->Args({10000, 1})->Args({10000, 2})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_PaperConfig)
+    ->Args({10000, 1})
+    ->Args({10000, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 // At scale: 1000 m x 350 m at 0.5 m (1.4e6 cells), 10 % births, 400 vehicles x 5 detections.
 void BM_Scale(benchmark::State& state) {
@@ -130,7 +134,8 @@ BENCHMARK(BM_Scale)
     ->Args({2000000, 1})
     ->Args({2000000, 2})
     ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0);
+    ->MinTime(2.0)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -6,16 +6,12 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#ifdef DG_PROF
-#include <cstdio>
-#include <cstdlib>
-#include <ctime>
-#endif
 
 #include <omp.h>
 
 #include "dualgrid/core/random.hpp"
 #include "fast_normal.hpp"
+#include "predict.hpp"
 
 namespace dualgrid::filter {
 
@@ -47,9 +43,6 @@ inline double FastAtan2(double y, double x) {
 
 // Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
 constexpr double kAtanError = 5e-4;
-#ifdef DG_PROF
-long g_exact = 0, g_fast = 0, g_seg = 0;
-#endif
 
 // Exclusive prefix sum over the concatenation of a[0..na) and b[0..n - na) (floats, summed in
 // double) into out[0..n], with exactly the summation order of ExclusiveScan (particles.cpp: blocks
@@ -135,7 +128,7 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   births_.resize(b);
   cell_of_.assign(n, 0);
   cell_start_.assign(c + 2, 0);
-  hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 14) + 2), 0);
+  hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 12) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
   scan_out_.assign(n + b + 1, 0.0);
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
@@ -254,38 +247,46 @@ void DynamicGrid::ShiftTo(const Position& ego) {
   origin_gy_ = gy;
 }
 
-void DynamicGrid::SortParticles() {
+void DynamicGrid::PredictAndSort(double dt) {
+  const float sp = static_cast<float>(params_.process_noise_position * std::sqrt(dt));
+  const float sv = static_cast<float>(params_.process_noise_velocity * std::sqrt(dt));
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
   const std::int64_t c1 = num_cells_ + 1;  // bucket num_cells_ collects particles off the grid
   const double inv_r = 1.0 / params_.resolution;
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
   const int chunks = std::clamp(omp_get_max_threads(), 1, kMaxSortChunks);
   // Counting sort, stable: particle order within a cell = order before sorting, for any chunking.
-  // Pass 1 (per chunk): storage cell of each particle and the chunk's histogram.
+  // Pass 1 (per chunk): prediction (step 2, batch by batch while the batch is in cache), storage
+  // cell of each particle and the chunk's histogram.
 #pragma omp parallel for schedule(static)
   for (int k = 0; k < chunks; ++k) {
     std::int32_t* h = hist_.data() + k * c1;
     std::fill_n(h, c1, 0);
-    for (std::int64_t i = k * n / chunks; i < (k + 1) * n / chunks; ++i) {
-      const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
-      const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
-      const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
-      std::int64_t c = num_cells_;
-      if (inside) {
-        // Storage index without integer division (hot loop): wrap once.
-        std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
-        std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
-        if (sx >= nx_) sx -= nx_;
-        if (sy >= ny_) sy -= ny_;
-        c = sy * nx_ + sx;
+    const std::int64_t chunk_hi = (k + 1) * n / chunks;
+    for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
+      const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
+      detail::PredictRange(particles_, b0, b1, dt, sp, sv, params_.persistence, seed_, step_);
+      for (std::int64_t i = b0; i < b1; ++i) {
+        const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
+        const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
+        const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
+        std::int64_t c = num_cells_;
+        if (inside) {
+          // Storage index without integer division (hot loop): wrap once.
+          std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
+          std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
+          if (sx >= nx_) sx -= nx_;
+          if (sy >= ny_) sy -= ny_;
+          c = sy * nx_ + sx;
+        }
+        cell_of_[i] = c;
+        ++h[c];
       }
-      cell_of_[i] = c;
-      ++h[c];
     }
   }
   // Pass 2: cell starts and per-chunk write offsets in fixed blocks of cells (integers: exact in
   // any order). Block totals first, then a serial scan over blocks, then the offsets.
-  constexpr std::int64_t kCellBlock = 1 << 14;
+  constexpr std::int64_t kCellBlock = 1 << 12;
   const std::int64_t nblocks = (c1 + kCellBlock - 1) / kCellBlock;
   if (static_cast<std::int64_t>(hist_total_.size()) < nblocks + 1) hist_total_.resize(nblocks + 1);
   std::int64_t* block_base = hist_total_.data();
@@ -426,7 +427,7 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
     sensor_trig_[3 * k + 1] = std::sin(cov[k].boresight);
     sensor_trig_[3 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 2)
   for (int ly = 0; ly < ny_; ++ly) {
     const std::int64_t row = Mod(origin_gy_ + ly, ny_) * nx_;
     const double cy = y0 + (ly + 0.5) * r;
@@ -474,8 +475,9 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
         // fx tan + fy >= 0): clip the row to that interval, two cells of margin (the exact test
         // still decides every cell).
         double dmin = -kInf, dmax = kInf;
-        for (const auto& [c, d] : {std::pair{cb, dy * sb}, std::pair{cb * tan_hf + sb, dy * (sb * tan_hf - cb)},
-                                   std::pair{cb * tan_hf - sb, dy * (sb * tan_hf + cb)}}) {
+        for (const auto& [c, d] :
+             {std::pair{cb, dy * sb}, std::pair{cb * tan_hf + sb, dy * (sb * tan_hf - cb)},
+              std::pair{cb * tan_hf - sb, dy * (sb * tan_hf + cb)}}) {
           if (c > 0.0) {
             dmin = std::max(dmin, -d / c);
           } else if (c < 0.0) {
@@ -513,14 +515,12 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
         const int a = stack[top][0], e = stack[top][1];
         if (e - a < 4) {
           for (int lx = a; lx <= e; ++lx) exact(lx);
-#ifdef DG_PROF
-          g_exact += e - a + 1;
-#endif
           continue;
         }
         double fxa, fxe;
         const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
-        const double lo = std::min(ra, re) - 2.0 * kAtanError, hi = std::max(ra, re) + 2.0 * kAtanError;
+        const double lo = std::min(ra, re) - 2.0 * kAtanError,
+                     hi = std::max(ra, re) + 2.0 * kAtanError;
         bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
         double br = kInf;
         if (uniform) {
@@ -539,10 +539,6 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
           ++top;
           continue;
         }
-#ifdef DG_PROF
-        g_fast += e - a + 1;
-        ++g_seg;
-#endif
         // Branch-free over the segment (vectorises), split where the storage row wraps.
         const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
         const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
@@ -557,7 +553,7 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
             const double d2 = dx * dx + dy * dy;
             const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
             const bool in = (d2 >= min2) & (d2 <= max2) &
-                            (!narrow | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
+                            ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
             const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
             dst[lx] |= in ? v : 0;
           }
@@ -780,7 +776,11 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
   for (std::int64_t b = 0; b < blocks; ++b) {
     const std::int64_t lo = b * kScanBlock, hi = std::min(nc, lo + kScanBlock);
     double acc = 0.0;
-    for (std::int64_t s = lo; s < hi; ++s) acc += born_[s];
+    // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so skipping them
+    // keeps the sum bit-identical and avoids the add latency chain.
+    for (std::int64_t s = lo; s < hi; ++s) {
+      if (born_[s] != 0.0) acc += born_[s];
+    }
     tot[b + 1] = acc;
   }
   tot[0] = 0.0;
@@ -812,11 +812,11 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
     double acc = tot[b];
     for (std::int64_t s = lo; s < hi; ++s) {
       const double born = born_[s];
-      const double cum_s = acc;
-      acc += born;
       const bool block_end = s + 1 == hi;
       // Inside a block a zero mass leaves the running sum unchanged: empty range.
       if (born == 0.0 && !block_end) continue;
+      const double cum_s = acc;
+      if (born != 0.0) acc += born;
       const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
       if (k_lo == k_hi) continue;
       GenerateBirths(z, s, k_lo, k_hi, mass, r, vmax);
@@ -953,41 +953,11 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
-#ifdef DG_PROF
-  static double acc[8] = {0};
-  static int calls = 0;
-  const auto now = [] {
-    timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-  };
-  double t0 = now(), t1;
-#define DG_T(k) t1 = now(); acc[k] += t1 - t0; t0 = t1;
-#else
-#define DG_T(k)
-#endif
-  PredictParticles(particles_, dt, params_.process_noise_position, params_.process_noise_velocity,
-                   params_.persistence, seed_, step_);  // 2. prediction
-  DG_T(0)
-  SortParticles();                                      // 3. assignment
-  DG_T(1)
-  BuildMeasurementGrid(measurements, coverage);         // 4. measurement grid
-  DG_T(2)
-  UpdateCells(measurements);  // 5.-6. occupancy update, weights, 9. statistics
-  DG_T(3)
-  Birth(measurements);        // 7. birth
-  DG_T(4)
-  Resample();                 // 8. resampling
-  DG_T(5)
-#ifdef DG_PROF
-  static const int period = getenv("DGP") ? atoi(getenv("DGP")) : 500;
-  if (++calls % period == 0) {
-    fprintf(stderr, "pred %.4f sort %.4f meas %.4f upd %.4f birth %.4f res %.4f ms\n", acc[0] / calls * 1e3,
-            acc[1] / calls * 1e3, acc[2] / calls * 1e3, acc[3] / calls * 1e3, acc[4] / calls * 1e3,
-            acc[5] / calls * 1e3);
-    fprintf(stderr, "exact %ld fast %ld seg %ld per cycle\n", g_exact / calls, g_fast / calls, g_seg / calls);
-  }
-#endif
+  PredictAndSort(dt);                            // 2. prediction, 3. assignment
+  BuildMeasurementGrid(measurements, coverage);  // 4. measurement grid
+  UpdateCells(measurements);                     // 5.-6. occupancy update, weights, 9. statistics
+  Birth(measurements);                           // 7. birth
+  Resample();                                    // 8. resampling
   ++step_;
 }
 

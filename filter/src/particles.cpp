@@ -6,6 +6,7 @@
 
 #include "dualgrid/core/random.hpp"
 #include "fast_normal.hpp"
+#include "predict.hpp"
 
 namespace dualgrid::filter {
 
@@ -15,35 +16,33 @@ void ParticleSet::resize(std::size_t n) {
   for (auto* v : {&vx, &vy, &w_position, &w_velocity, &weight}) v->resize(n);
 }
 
-void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_vel,
-                      double persistence, std::uint64_t seed, std::uint64_t step) {
-  const float sp = static_cast<float>(sigma_pos * std::sqrt(dt));
-  const float sv = static_cast<float>(sigma_vel * std::sqrt(dt));
+namespace detail {
+
+void PredictRange(ParticleSet& p, std::int64_t lo, std::int64_t hi, double dt, float sp, float sv,
+                  double persistence, std::uint64_t seed, std::uint64_t step) {
   const bool noisy = sp > 0.0f || sv > 0.0f;
-  const std::int64_t n = static_cast<std::int64_t>(p.size());
   // Blocks of particles: raw Philox draws first, then the Box-Muller transform as straight-line
-  // array code the compiler vectorises (the scalar transform cost ~4x more per particle).
-  constexpr std::int64_t kBlock = 256;
-  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t lo = b * kBlock, m = std::min(kBlock, n - lo);
+  // array code the compiler vectorises (the scalar transform cost ~4x more per particle). Every
+  // particle's noise depends on its index only, so any blocking gives the same result.
+  constexpr std::int64_t kBlock = kPredictBlock;
+  for (std::int64_t b0 = lo; b0 < hi; b0 += kBlock) {
+    const std::int64_t m = std::min(kBlock, hi - b0);
     alignas(64) float u[4][kBlock], g[4][kBlock];
     if (noisy) {
       alignas(64) std::uint32_t raw[4][kBlock];
-      detail::PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(lo), m,
-                           0, raw[0], raw[1], raw[2], raw[3]);
+      PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(b0), m, 0,
+                   raw[0], raw[1], raw[2], raw[3]);
       for (int c = 0; c < 4; ++c) {
-        for (std::int64_t k = 0; k < m; ++k) u[c][k] = detail::ToUnit24(raw[c][k]);
+        for (std::int64_t k = 0; k < m; ++k) u[c][k] = ToUnit24(raw[c][k]);
       }
       for (int pair = 0; pair < 2; ++pair) {
-        detail::BoxMuller(u[2 * pair], u[2 * pair + 1], g[2 * pair], g[2 * pair + 1], m);
+        BoxMuller(u[2 * pair], u[2 * pair + 1], g[2 * pair], g[2 * pair + 1], m);
       }
     } else {
       for (int c = 0; c < 4; ++c) std::fill_n(g[c], m, 0.0f);
     }
     for (std::int64_t k = 0; k < m; ++k) {
-      const std::int64_t i = lo + k;
+      const std::int64_t i = b0 + k;
       p.x[i] += p.vx[i] * dt + sp * g[0][k];
       p.y[i] += p.vy[i] * dt + sp * g[1][k];
       p.vx[i] += sv * g[2][k];
@@ -52,6 +51,22 @@ void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_
       p.w_position[i] *= persistence;
       p.w_velocity[i] *= persistence;
     }
+  }
+}
+
+}  // namespace detail
+
+void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_vel,
+                      double persistence, std::uint64_t seed, std::uint64_t step) {
+  const float sp = static_cast<float>(sigma_pos * std::sqrt(dt));
+  const float sv = static_cast<float>(sigma_vel * std::sqrt(dt));
+  const std::int64_t n = static_cast<std::int64_t>(p.size());
+  constexpr std::int64_t kBlock = detail::kPredictBlock;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    detail::PredictRange(p, b * kBlock, std::min(n, (b + 1) * kBlock), dt, sp, sv, persistence,
+                         seed, step);
   }
 }
 

@@ -91,7 +91,8 @@ class DynamicGrid {
   void ShiftTo(const Position& ego);
   void ResetColumn(std::int64_t gx);
   void ResetRow(std::int64_t gy);
-  void SortParticles();
+  // Prediction (PredictParticles) fused with the counting sort's first pass.
+  void PredictAndSort(double dt);
   void BuildMeasurementGrid(std::span<const Measurement> z, std::span<const SensorCoverage> cov);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
