@@ -581,6 +581,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
   const double keep = 1.0 - p.decay_eps;
   const double slow2 = p.static_speed * p.static_speed;
+  const double max_speed2 = p.max_speed * p.max_speed;
   const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
   ParticleSet& q = sorted_;
   // Cells in parallel; dynamic scheduling only balances load, every value is computed by one
@@ -721,7 +722,10 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
 
     // --- Joint normalisation of the occupied mass (eqs. 9-12 on o_up). ---
     double a_static = (s_pred + slow_mass) * l_static + p.static_gain * p.occupied_mass * static_k;
-    const double a_birth = p.birth_probability * occ_k * (1.0 - o_pred);
+    // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
+    // such returns are clutter; their occupied mass stays unassigned (unknown).
+    const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
+    const double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
     if (a_static + a_dyn + a_birth <= 0.0) {
       // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
       // the measurement cannot arbitrate, so the predicted split is kept.
@@ -848,6 +852,8 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
   const Vector2 tangent(-los.y(), los.x());
   const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
+  const double vt_max = std::min(
+      vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed - v_radial * v_radial)));
   constexpr std::int64_t kBatch = 64;
   alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
   for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
@@ -863,9 +869,10 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
       births_.y[k] = (static_cast<double>(gy) + detail::ToUnit24(raw[1][t])) * r;
       float n0, n1;
       detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
-      // Radial component from the Doppler, tangential one unobservable: sampled uniformly.
+      // Radial component from the Doppler, tangential one unobservable: sampled uniformly, within
+      // what keeps the speed at most max_speed.
       const Vector2 v = (v_radial + params_.birth_sigma_radial * n0) * los +
-                        vmax * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
+                        vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
       births_.vx[k] = v.x();
       births_.vy[k] = v.y();
       births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = mass;

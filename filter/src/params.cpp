@@ -61,6 +61,7 @@ bool FilterParams::IsValid(std::string* error) const {
   if (!prob(birth_probability)) return Fail(error, "birth_probability must be in [0, 1]");
   if (!finite_nonneg(birth_max_tangential_speed))
     return Fail(error, "birth_max_tangential_speed must be finite and >= 0");
+  if (!finite_pos(max_speed)) return Fail(error, "max_speed must be finite and > 0");
   if (!finite_nonneg(birth_sigma_radial))
     return Fail(error, "birth_sigma_radial must be finite and >= 0");
   if (!finite_pos(sigma_f)) return Fail(error, "sigma_f must be finite and > 0");

@@ -161,9 +161,13 @@ void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
 // Turns "field: message" from an IsValid into a ConfigError under `section`.
 [[noreturn]] void Invalid(const std::string& file, const std::string& section,
                           const std::string& error) {
-  const auto colon = error.find(": ");
-  const std::string field = colon == std::string::npos ? "" : error.substr(0, colon);
-  const std::string message = colon == std::string::npos ? error : error.substr(colon + 2);
+  // Validators write "field: message" or "field message".
+  auto colon = error.find(": ");
+  std::size_t skip = 2;
+  if (colon == std::string::npos) colon = error.find(' '), skip = 1;
+  const std::string field = colon == std::string::npos ? error : error.substr(0, colon);
+  const std::string message =
+      colon == std::string::npos ? "is invalid" : error.substr(colon + skip);
   throw ConfigError(file + ": key '" + (section.empty() ? field : section + "." + field) + "' " +
                     message);
 }
@@ -229,6 +233,7 @@ void ReadFilter(MapReader& root, filter::FilterParams* f) {
   r->Read("birth_probability", &f->birth_probability);
   r->Read("birth_max_tangential_speed", &f->birth_max_tangential_speed);
   r->Read("birth_sigma_radial", &f->birth_sigma_radial);
+  r->Read("max_speed", &f->max_speed);
   r->Read("sigma_f", &f->sigma_f);
   r->Read("sigma_static_distance", &f->sigma_static_distance);
   r->Read("sigma_static_velocity", &f->sigma_static_velocity);

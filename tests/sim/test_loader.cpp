@@ -115,3 +115,25 @@ TEST_CASE("Malformed scenarios are rejected naming the key and the expectation",
 TEST_CASE("A missing scenario file is reported", "[loader]") {
   CHECK_THROWS_WITH(LoadScenario("no/such/file.yaml"), Catch::Contains("not found"));
 }
+
+TEST_CASE("Filter and sensor sections are validated by their own structs", "[loader]") {
+  const std::string filter_bad = std::string(kValid) + "filter: {sigma_f: -1}\n";
+  std::string msg = ErrorOf(filter_bad);
+  CHECK(msg.find("'filter.sigma_f'") != std::string::npos);
+  const std::string sensor_bad =
+      std::string(kValid) + "sensors:\n  overrides:\n    front: {max_range: -5}\n";
+  msg = ErrorOf(sensor_bad);
+  CHECK(msg.find("sensors.overrides.front") != std::string::npos);
+  CHECK(msg.find("max_range") != std::string::npos);
+  const std::string mode_bad = std::string(kValid) + "filter: {mode: quantum}\n";
+  msg = ErrorOf(mode_bad);
+  CHECK(msg.find("'filter.mode' expected 'position', 'velocity' or 'dual'") != std::string::npos);
+  const auto ok = LoadScenario(
+      Write("ok2.yaml", std::string(kValid) + "filter: {num_particles: 2000, mode: velocity}\n"
+                                              "sensors: {noise: false, use: [front]}\n"));
+  CHECK(ok.filter.num_particles == 2000);
+  CHECK(ok.filter.mode == filter::WeightMode::kVelocity);
+  CHECK_FALSE(ok.radar.options.noise);
+  REQUIRE(ok.radar.sensors.size() == 1);
+  CHECK(ok.radar.sensors[0].name == "front");
+}

@@ -69,6 +69,7 @@ nlohmann::json FilterJson(const filter::FilterParams& f) {
           {"birth_probability", f.birth_probability},
           {"birth_max_tangential_speed", f.birth_max_tangential_speed},
           {"birth_sigma_radial", f.birth_sigma_radial},
+          {"max_speed", f.max_speed},
           {"sigma_f", f.sigma_f},
           {"sigma_static_distance", f.sigma_static_distance},
           {"sigma_static_velocity", f.sigma_static_velocity},

@@ -90,9 +90,12 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                           const std::vector<eval::TruthObject>& objects,
                           const std::vector<std::uint8_t>& truth_classes) {
   // Paper Sec. V: particles of cells with P(dynamic) above the threshold are clustered.
-  const filter::ParticleSet& p = grid.particles();
+  // The weighted persistent particles (before resampling, when all weights become equal), so
+  // that the cluster means are the paper's weighted averages and exclude this cycle's births.
+  const filter::ParticleSet& p = grid.weighted_particles();
   dynamic_particles_.clear();
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  for (std::size_t i = 0; i < grid.num_weighted_particles(); ++i) {
+    if (!(p.weight[i] > 0.0f)) continue;
     const Position pos(p.x[i], p.y[i]);
     const auto cell = grid.CellOf(pos);
     if (!cell) continue;

@@ -82,6 +82,15 @@ class DynamicGrid {
 
   /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count).
   const ParticleSet& particles() const { return particles_; }
+  /// Persistent particles after the last weight update, before birth and resampling, sorted by
+  /// cell: `weight` is the mode's weight normalised so that each cell's weights sum to its
+  /// dynamic mass (particles slower than static_speed carry 0). The first
+  /// num_weighted_particles() entries are valid. This is the weighted particle set the paper
+  /// clusters (Sec. V); after resampling all weights are equal.
+  const ParticleSet& weighted_particles() const { return sorted_; }
+  std::size_t num_weighted_particles() const {
+    return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
+  }
   const FilterParams& params() const { return params_; }
 
  private:

@@ -36,7 +36,10 @@ struct FilterParams {
   double persistence = 0.99;            ///< p_S: particle weights times this per cycle.
   double birth_probability = 0.1;       ///< p_B: weight of the birth hypothesis vs persistence.
   double birth_max_tangential_speed = 40.0;  ///< Tangential birth speed ~ U(-v, v) [m/s].
-  double birth_sigma_radial = 0.5;           ///< Radial birth speed noise around Doppler [m/s].
+  /// Fastest plausible object over ground [m/s] (180 km/h): no birth from a detection whose
+  /// compensated radial speed exceeds it (clutter), and births never exceed it.
+  double max_speed = 50.0;
+  double birth_sigma_radial = 0.5;  ///< Radial birth speed noise around Doppler [m/s].
 
   // Measurement kernels (all scaled to peak 1, see docs/algorithm.md).
   double sigma_f = 0.6;                ///< f_d width, eq. (2) [m].
