@@ -28,8 +28,8 @@ std::int64_t Mod(std::int64_t a, std::int64_t b) {
   return r < 0 ? r + b : r;
 }
 
-// atan2 with |error| < 2.1e-4 rad (measured 2.04e-4): bearing bins are ~1e-2 rad wide, and std::atan2 per cell and
-// sensor dominated the free-space pass.
+// atan2 with |error| < 2.1e-4 rad (measured 2.04e-4): bearing bins are ~1e-2 rad wide, and
+// std::atan2 per cell and sensor dominated the free-space pass.
 inline double FastAtan2(double y, double x) {
   const double ax = std::abs(x), ay = std::abs(y);
   const double mx = std::max(ax, ay), mn = std::min(ax, ay);
