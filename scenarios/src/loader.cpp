@@ -35,7 +35,6 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
     r.Read("max_speed", &t.max_speed);
     r.Read("accel", &t.accel);
     r.Read("decel", &t.decel);
-    r.Read("speed_factor_dev", &t.speed_factor_dev);
     r.Read("rcs_dbsm", &t.rcs_dbsm);
     r.Read("vclass", &t.vclass);
     r.Read("overtake_right", &t.overtake_right);
@@ -55,6 +54,8 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   s->ego.id = "ego";
   s->ego.lane_change = false;  // the ego keeps its lane unless the scenario says otherwise
   ReadVehicle(*ego, &s->ego);
+  if (s->ego.desired_speed)
+    ego->Fail("desired_speed", "is not used for the ego: set ego.speed_policy.speed");
   if (auto sp = ego->Map("speed_policy")) {
     std::string mode = "cruise";
     sp->Read("mode", &mode);
@@ -280,6 +281,8 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
 
 }  // namespace
 
+void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out);
+
 bool EvaluationConfig::IsValid(std::string* error) const {
   if (!(dynamic_threshold > 0.0 && dynamic_threshold < 1.0)) {
     if (error) *error = "dynamic_threshold: must be in (0, 1)";
@@ -314,16 +317,27 @@ ScenarioConfig LoadScenario(const std::filesystem::path& file) {
   }
   ScenarioConfig config;
   config.file = file;
+  try {
+    ReadAll(doc, name, &config);
+  } catch (const YAML::Exception& e) {
+    // Conversions inside yaml-cpp (e.g. a non-text map key) still get the file and the place.
+    throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
+                      std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  return config;
+}
+
+void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out) {
+  ScenarioConfig& config = *out;
   MapReader root(doc, name, "");
   ReadSim(root, &config.sim);
-  if (config.sim.name.empty()) config.sim.name = file.stem().string();
+  if (config.sim.name.empty()) config.sim.name = std::filesystem::path(name).stem().string();
   std::string error;
   if (!config.sim.IsValid(&error)) Invalid(name, "", error);
   ReadRadar(root, config.sim, &config.radar);
   ReadFilter(root, &config.filter);
   ReadEvaluation(root, &config.evaluation);
   root.Finish();
-  return config;
 }
 
 }  // namespace dualgrid::scenario

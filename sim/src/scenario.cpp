@@ -38,7 +38,8 @@ int ScenarioSpec::StepCount() const {
 
 bool ScenarioSpec::IsValid(std::string* error) const {
   if (network.empty()) return Fail(error, "network", "must name a network");
-  if (!(duration > 0.0)) return Fail(error, "duration", "must be > 0 s");
+  if (!(duration > 0.0 && duration <= 3600.0))
+    return Fail(error, "duration", "must be in (0, 3600] s");
   if (!(step_length > 0.0 && step_length <= 1.0))
     return Fail(error, "step_length", "must be in (0, 1] s");
   if (std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) > 1e-6)
@@ -53,13 +54,15 @@ bool ScenarioSpec::IsValid(std::string* error) const {
       return Fail(error, f + ".max_speed", "must be in (0, 70] m/s");
     if (!(t.accel > 0.0)) return Fail(error, f + ".accel", "must be > 0 m/s^2");
     if (!(t.decel > 0.0)) return Fail(error, f + ".decel", "must be > 0 m/s^2");
-    if (!(t.speed_factor_dev >= 0.0 && t.speed_factor_dev < 1.0))
-      return Fail(error, f + ".speed_factor_dev", "must be in [0, 1)");
     if (!std::isfinite(t.rcs_dbsm)) return Fail(error, f + ".rcs_dbsm", "must be finite");
   }
   for (const auto& [name, edges] : routes)
     if (edges.empty()) return Fail(error, "routes." + name, "must list at least one edge");
+  if (!(duration >= step_length))
+    return Fail(error, "duration", "must be at least one step_length");
   if (!CheckVehicle(ego, "ego", *this, error)) return false;
+  if (!(ego.depart < duration))
+    return Fail(error, "ego.depart", "must be before the end (duration)");
   if (!(ego_speed.speed > 0.0 && ego_speed.speed <= kMaxTrafficSpeed))
     return Fail(error, "ego.speed_policy.speed", "must be in (0, 70] m/s");
   std::set<std::string> ids{ego.id};

@@ -246,7 +246,7 @@ void SumoSimulation::ApplyActions() {
   const double now = libsumo::Simulation::getTime();
   while (next_action_ < spec_.actions.size() && spec_.actions[next_action_].time <= now + 1e-9) {
     const ActionSpec& a = spec_.actions[next_action_++];
-    const auto ids = libsumo::Vehicle::getIDList();
+    const std::vector<std::string> ids = libsumo::Vehicle::getIDList();
     if (std::find(ids.begin(), ids.end(), a.vehicle) == ids.end())
       throw std::runtime_error("scenario '" + spec_.name + "': action at t=" + Num(a.time) +
                                " s names vehicle '" + a.vehicle +
@@ -257,30 +257,30 @@ void SumoSimulation::ApplyActions() {
 }
 
 bool SumoSimulation::Step() {
-  if (step_ >= spec_.StepCount()) return false;
   try {
-    libsumo::Simulation::step();
-    ++step_;
-    ApplyDepartures();
-    ApplyActions();
-    if (spec_.ego_speed.mode == SpeedPolicy::Mode::kFixed) {
-      const auto ids = libsumo::Vehicle::getIDList();
-      if (std::find(ids.begin(), ids.end(), spec_.ego.id) != ids.end())
-        libsumo::Vehicle::setSpeed(spec_.ego.id, spec_.ego_speed.speed);
+    std::vector<std::string> ids;
+    // Until the ego has departed, steps only advance SUMO: frames start with the ego.
+    for (;;) {
+      if (step_ >= spec_.StepCount()) {
+        if (frame_.step == 0)
+          throw std::runtime_error("ego '" + spec_.ego.id +
+                                   "' never entered the network before t=" + Num(spec_.duration) +
+                                   " s (lane " + std::to_string(spec_.ego.lane) + ", position " +
+                                   Num(spec_.ego.position) + " m of route '" + spec_.ego.route +
+                                   "' blocked or invalid, or departure too late; see sumo.log)");
+        return false;
+      }
+      libsumo::Simulation::step();
+      ++step_;
+      ApplyDepartures();
+      ApplyActions();
+      ids = libsumo::Vehicle::getIDList();
+      std::sort(ids.begin(), ids.end());
+      if (std::binary_search(ids.begin(), ids.end(), spec_.ego.id)) break;
+      if (frame_.step != 0) return false;  // the ego reached the end of its route
     }
-    std::vector<std::string> ids = libsumo::Vehicle::getIDList();
-    std::sort(ids.begin(), ids.end());
-    const bool ego_present = std::binary_search(ids.begin(), ids.end(), spec_.ego.id);
-    if (!ego_present) {
-      if (libsumo::Simulation::getTime() < spec_.ego.depart + spec_.step_length * 0.5)
-        return Step();  // ego not departed yet: keep stepping
-      if (frame_.step == 0)
-        throw std::runtime_error("ego '" + spec_.ego.id + "' could not depart (lane " +
-                                 std::to_string(spec_.ego.lane) + ", position " +
-                                 Num(spec_.ego.position) + " m of route '" + spec_.ego.route +
-                                 "' blocked or invalid; see " + "sumo.log)");
-      return false;  // the ego reached the end of its route
-    }
+    if (spec_.ego_speed.mode == SpeedPolicy::Mode::kFixed)
+      libsumo::Vehicle::setSpeed(spec_.ego.id, spec_.ego_speed.speed);
     Frame f;
     f.step = step_;
     f.time = libsumo::Simulation::getTime();
@@ -299,6 +299,9 @@ bool SumoSimulation::Step() {
     return true;
   } catch (const libsumo::TraCIException& e) {
     throw std::runtime_error("SUMO error at t=" + Num(libsumo::Simulation::getTime()) +
+                             " s: " + OneLine(e.what()));
+  } catch (const libsumo::FatalTraCIError& e) {
+    throw std::runtime_error("SUMO failed at t=" + Num(libsumo::Simulation::getTime()) +
                              " s: " + OneLine(e.what()));
   }
 }

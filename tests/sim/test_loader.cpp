@@ -92,7 +92,7 @@ TEST_CASE("Malformed scenarios are rejected naming the key and the expectation",
   };
   const Case c = GENERATE(values<Case>({
       {"duration: 5.0", "duration: five", "'duration'", "expected a number"},
-      {"duration: 5.0", "duration: -5", "'duration'", "> 0"},
+      {"duration: 5.0", "duration: -5", "'duration'", "must be in (0, 3600] s"},
       {"duration: 5.0", "duraton: 5.0", "'duraton'", "not a known setting"},
       {"network: highway\n", "", "'network'", "required"},
       {"lane: 1,", "lane: one,", "'ego.lane'", "expected an integer"},

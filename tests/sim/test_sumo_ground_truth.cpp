@@ -61,7 +61,8 @@ TEST_CASE("Highway ground truth: velocities match position differences, lane cha
     previous = std::move(current);
   }
   CHECK(steps == config.sim.StepCount());
-  CHECK(checked > 10000);
+  // 1000 steps with 4-8 vehicles on the road at a time.
+  CHECK(checked > 4000);
   // The merger changes lanes twice (ramp merge, cut-in); each takes 3 s = 60 steps.
   CHECK(lane_changers.count("merger") == 1);
   CHECK(lane_change_steps >= 100);

@@ -54,12 +54,12 @@ TEST_CASE("--help lists the subcommands", "[cli]") {
 
 TEST_CASE("Same scenario and seed give identical ground truth; another seed differs", "[cli]") {
   const auto a = TempDir("a"), b = TempDir("b"), c = TempDir("c");
-  const std::string common = "sim scenarios/highway.yaml --duration 12 -q ";
+  const std::string common = "sim scenarios/simple_road.yaml --duration 12 -q ";
   REQUIRE(Run(common + "--out " + a.string()).code == 0);
   REQUIRE(Run(common + "--out " + b.string()).code == 0);
   REQUIRE(Run(common + "--seed 7 --out " + c.string()).code == 0);
   const std::string ta = Slurp(a / "ground_truth.csv");
-  CHECK(CountLines(ta) > 240 * 5);  // 240 steps, several vehicles each
+  CHECK(CountLines(ta) > 240 * 4);  // 240 steps, at least the ego, lead, follower, oncoming
   CHECK(ta == Slurp(b / "ground_truth.csv"));
   // The seed draws the oncoming flow's desired speeds.
   CHECK(ta != Slurp(c / "ground_truth.csv"));
@@ -198,4 +198,37 @@ TEST_CASE("experiment: seeds run in separate processes and aggregate into tables
   CHECK(table.find("simple_road,D,%,dual,2,") != std::string::npos);
   CHECK(fs::exists(dir / "table.md"));
   CHECK(fs::exists(dir / "figures" / "tracked_share.png"));
+}
+
+TEST_CASE("experiment forwards the picture options to its runs", "[cli][run]") {
+  const auto with = TempDir("exp_fig"), without = TempDir("exp_nofig");
+  const std::string common = "experiment scenarios/simple_road.yaml --seeds 1 --duration 2 -q ";
+  REQUIRE(Run(common + "--snapshots 1 --out " + with.string()).code == 0);
+  CHECK(fs::exists(with / "seeds" / "seed_1" / "figures" / "grid_t1.00.png"));
+  CHECK(fs::exists(with / "figures" / "grid_t1.00.png"));
+  REQUIRE(Run(common + "--no-figures --out " + without.string()).code == 0);
+  CHECK_FALSE(fs::exists(without / "figures" / "tracked_share.png"));
+  CHECK(fs::is_empty(without / "seeds" / "seed_1" / "figures"));
+  CHECK(Run(common + "--seed 4 --out " + without.string()).code != 0);
+}
+
+TEST_CASE("Runs that cannot produce a frame are errors, not empty results", "[cli]") {
+  const auto dir = TempDir("noframe");
+  // The ego departs after the end.
+  std::string text = Slurp("scenarios/simple_road.yaml");
+  const auto pos = text.find("  position: 300\n");
+  REQUIRE(pos != std::string::npos);
+  text.insert(pos, "  depart: 70\n");
+  std::ofstream(dir / "late.yaml") << text;
+  Result r = Run("run " + (dir / "late.yaml").string() + " -q --out " + (dir / "o").string());
+  CHECK(r.code != 0);
+  CHECK(r.output.find("ego.depart") != std::string::npos);
+  // Shorter than one step.
+  r = Run("run scenarios/simple_road.yaml --duration 0.01 -q --out " + (dir / "o2").string());
+  CHECK(r.code != 0);
+  CHECK(r.output.find("duration") != std::string::npos);
+  // A picture before the first step.
+  r = Run("snapshot scenarios/simple_road.yaml --time 0.01 -q --out " + (dir / "x.png").string());
+  CHECK(r.code != 0);
+  CHECK(CountLines(r.output) == 1);
 }

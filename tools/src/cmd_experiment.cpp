@@ -43,6 +43,12 @@ pid_t StartRun(const ExperimentOptions& o, int seed, const std::filesystem::path
   for (const auto& m : o.run.modes) modes += (modes.empty() ? "" : ",") + m;
   args.insert(args.end(), {"--modes", modes});
   if (!figures) args.push_back("--no-figures");
+  if (!o.run.snapshots.empty()) {
+    std::string times;
+    for (double t : o.run.snapshots) times += (times.empty() ? "" : ",") + std::to_string(t);
+    args.insert(args.end(), {"--snapshots", times});
+  }
+  if (o.run.write_detections) args.push_back("--write-detections");
   if (o.run.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.run.threads)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
@@ -71,6 +77,10 @@ std::string FirstLine(const std::filesystem::path& p) {
 
 int RunExperiment(const ExperimentOptions& o) {
   if (o.seeds < 1) throw std::invalid_argument("--seeds must be >= 1");
+  if (o.run.run.seed)
+    throw std::invalid_argument(
+        "experiment runs seeds --first-seed .. --first-seed + --seeds - 1; "
+        "--seed is for single runs");
   ParseModes(o.run.modes);  // fail early on a bad mode
   scenario::ScenarioConfig config = LoadConfig(o.run.run);
   const auto& out = o.run.run.out;
@@ -86,7 +96,7 @@ int RunExperiment(const ExperimentOptions& o) {
     while (next < o.seeds && static_cast<int>(running.size()) < jobs) {
       const int seed = o.first_seed + next++;
       const auto dir = out / "seeds" / ("seed_" + std::to_string(seed));
-      running[StartRun(o, seed, dir, seed == o.first_seed)] = seed;
+      running[StartRun(o, seed, dir, o.run.figures && seed == o.first_seed)] = seed;
     }
     int status = 0;
     const pid_t pid = wait(&status);
@@ -125,9 +135,9 @@ int RunExperiment(const ExperimentOptions& o) {
     }
   }
   const eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
-  std::ofstream(out / "table.md") << table.ToMarkdown();
-  std::ofstream(out / "table.csv") << table.ToCsv();
-  std::ofstream(out / "table.json") << table.ToJson().dump(2) << "\n";
+  OpenOutput(out / "table.md") << table.ToMarkdown();
+  OpenOutput(out / "table.csv") << table.ToCsv();
+  OpenOutput(out / "table.json") << table.ToJson().dump(2) << "\n";
 
   // Per-object tracked share over seeds (paper Fig. 6).
   viz::BarChart chart;
@@ -144,7 +154,7 @@ int RunExperiment(const ExperimentOptions& o) {
       per_object[names.Name(id)][runs[m].mode] = s;
     }
   }
-  std::ofstream(out / "per_object.json") << per_object.dump(2) << "\n";
+  OpenOutput(out / "per_object.json") << per_object.dump(2) << "\n";
   for (const auto& [id, r] : rows) chart.categories.push_back(names.Name(id));
   for (std::size_t m = 0; m < runs.size(); ++m) {
     viz::BarSeries s{runs[m].mode, {}, std::nullopt};
@@ -153,13 +163,15 @@ int RunExperiment(const ExperimentOptions& o) {
   }
   chart.value_labels = rows.size() <= 12;
   chart.width = std::max(1000, 60 * static_cast<int>(rows.size() * runs.size()) + 200);
-  if (!rows.empty()) viz::RenderBarChart(chart, (out / "figures" / "tracked_share.png").string());
+  if (!rows.empty() && o.run.figures)
+    viz::RenderBarChart(chart, (out / "figures" / "tracked_share.png").string());
   // The first seed's pictures (grids, scene, weights) are the experiment's examples.
   const auto first = out / "seeds" / ("seed_" + std::to_string(o.first_seed)) / "figures";
-  for (const auto& e : std::filesystem::directory_iterator(first))
-    if (e.path().filename() != "tracked_share.png")
-      std::filesystem::copy_file(e.path(), out / "figures" / e.path().filename(),
-                                 std::filesystem::copy_options::overwrite_existing);
+  if (o.run.figures)
+    for (const auto& e : std::filesystem::directory_iterator(first))
+      if (e.path().filename() != "tracked_share.png")
+        std::filesystem::copy_file(e.path(), out / "figures" / e.path().filename(),
+                                   std::filesystem::copy_options::overwrite_existing);
 
   if (!o.run.run.quiet) {
     std::cout << table.ToMarkdown() << "\n"

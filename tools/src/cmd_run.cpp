@@ -120,7 +120,7 @@ int RunFilters(const FilterRunOptions& options) {
   const auto& out = options.run.out;
   std::filesystem::create_directories(out / "figures");
   CopyScenario(config, out);
-  std::ofstream(out / "config.json") << ConfigJson(config, options).dump(2) << "\n";
+  OpenOutput(out / "config.json") << ConfigJson(config, options).dump(2) << "\n";
 
   const auto wall_start = std::chrono::steady_clock::now();
   Pipeline pipeline(config, options.run.network_dir, out, modes);
@@ -134,10 +134,20 @@ int RunFilters(const FilterRunOptions& options) {
   std::ofstream clusters = OpenOutput(out / "clusters.csv");
   clusters << "step,time,mode,x,y,vx,vy,weight,particles,role,object,x_ego,y_ego\n";
   std::vector<double> snapshot_times = options.snapshots;
-  if (snapshot_times.empty()) snapshot_times = config.evaluation.snapshot_times;
+  // The scenario's picture times are defaults: those past a shortened run are dropped; times
+  // asked for on the command line must lie in the run (checked below).
+  if (snapshot_times.empty())
+    for (double t : config.evaluation.snapshot_times)
+      if (t > 0.0 && t <= config.sim.duration) snapshot_times.push_back(t);
   if (snapshot_times.empty())
     for (double f : {0.25, 0.5, 0.75}) snapshot_times.push_back(f * config.sim.duration);
   std::sort(snapshot_times.begin(), snapshot_times.end());
+  snapshot_times.erase(std::unique(snapshot_times.begin(), snapshot_times.end()),
+                       snapshot_times.end());
+  for (double t : snapshot_times)
+    if (!(t > 0.0 && t <= config.sim.duration))
+      throw std::invalid_argument("snapshot time " + Fixed(t, 2) + " s is outside the run (0, " +
+                                  Fixed(config.sim.duration, 2) + "] s");
   std::size_t next_snapshot = 0;
 
   // Weight traces (paper Fig. 4) of the dual filter, or of the last mode if dual is not run.
@@ -199,8 +209,9 @@ int RunFilters(const FilterRunOptions& options) {
           }
         }
         int n = 0, tangential = 0;
+        const int vehicle_id = pipeline.ids().Id(v.id);
         for (const auto& d : pipeline.detections())
-          if (pipeline.ids().Name(d.source_id) == v.id) {
+          if (d.source_id == vehicle_id) {
             tangential += std::abs(d.radial_speed_compensated) < 0.5 * v.velocity.norm();
             ++n;
           }
@@ -214,15 +225,21 @@ int RunFilters(const FilterRunOptions& options) {
         t.tangential_share.push_back(n > 0 ? static_cast<double>(tangential) / n : std::nan(""));
       }
     }
-    if (options.figures && next_snapshot < snapshot_times.size() &&
-        f.time + 1e-9 >= snapshot_times[next_snapshot]) {
-      RenderGridFigure(mode_names, snaps, f, f.time,
-                       out / "figures" / ("grid_t" + Fixed(f.time, 1) + ".png"));
-      RenderScene(pipeline, out / "figures" / ("scene_t" + Fixed(f.time, 1) + ".png"), 60, 140, 22);
+    // Several requested times may fall into one step: one picture for all of them.
+    bool picture = false;
+    while (next_snapshot < snapshot_times.size() &&
+           f.time + 1e-9 >= snapshot_times[next_snapshot]) {
+      picture = true;
+      ++next_snapshot;
+    }
+    if (options.figures && picture) {
+      const std::string stamp = Fixed(f.time, 2);
+      RenderGridFigure(mode_names, snaps, f, f.time, out / "figures" / ("grid_t" + stamp + ".png"));
+      RenderScene(pipeline, out / "figures" / ("scene_t" + stamp + ".png"), 60, 140, 22);
       // The particles behind each picture, for closer looks.
       for (std::size_t m = 0; m < modes.size(); ++m) {
-        std::ofstream pc = OpenOutput(
-            out / "figures" / ("particles_" + mode_names[m] + "_t" + Fixed(f.time, 1) + ".csv"));
+        std::ofstream pc =
+            OpenOutput(out / "figures" / ("particles_" + mode_names[m] + "_t" + stamp + ".csv"));
         pc << "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
         const auto& ps = pipeline.grid(m).particles();
         for (std::size_t i = 0; i < ps.size(); ++i) {
@@ -236,7 +253,6 @@ int RunFilters(const FilterRunOptions& options) {
              << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
         }
       }
-      ++next_snapshot;
     }
     ++steps;
     progress.Update(steps, "t=" + Fixed(f.time, 1) + " s");
@@ -261,7 +277,7 @@ int RunFilters(const FilterRunOptions& options) {
   mj["detections_per_step"] = steps ? static_cast<double>(total_detections) / steps : 0.0;
   for (const auto& [id, n] : frames_in_grid)
     (void)n, mj["object_names"][std::to_string(pipeline.ids().Id(id))] = id;
-  std::ofstream(out / "metrics.json") << mj.dump(2) << "\n";
+  OpenOutput(out / "metrics.json") << mj.dump(2) << "\n";
 
   {
     std::ofstream objects = OpenOutput(out / "objects.csv");
@@ -277,9 +293,9 @@ int RunFilters(const FilterRunOptions& options) {
     }
   }
   const eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
-  std::ofstream(out / "table.md") << table.ToMarkdown();
-  std::ofstream(out / "table.csv") << table.ToCsv();
-  std::ofstream(out / "table.json") << table.ToJson().dump(2) << "\n";
+  OpenOutput(out / "table.md") << table.ToMarkdown();
+  OpenOutput(out / "table.csv") << table.ToCsv();
+  OpenOutput(out / "table.json") << table.ToJson().dump(2) << "\n";
 
   // Focus object: the scenario's choice, else the vehicle longest in the grid.
   std::string focus = config.evaluation.focus_object;

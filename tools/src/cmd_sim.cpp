@@ -70,7 +70,7 @@ int RunSim(const RunOptions& options) {
                                {"last_s", s.last},
                                {"min_distance_to_ego_m", s.min_distance}};
   }
-  std::ofstream(options.out / "summary.json") << summary.dump(2) << "\n";
+  OpenOutput(options.out / "summary.json") << summary.dump(2) << "\n";
   if (!options.quiet) {
     std::cout << spec.name << ": " << steps << " steps (" << Fixed(steps * spec.step_length, 1)
               << " s simulated in " << Fixed(wall, 1) << " s), " << seen.size()

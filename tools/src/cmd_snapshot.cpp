@@ -11,9 +11,9 @@ namespace dualgrid::tools {
 int RunSnapshot(const SnapshotOptions& options) {
   RunOptions run = options.run;
   scenario::ScenarioConfig config = LoadConfig(run);
-  if (!(options.time > 0.0 && options.time <= config.sim.duration))
-    throw std::invalid_argument("--time must be in (0, " + Fixed(config.sim.duration, 2) +
-                                "] s, the scenario's duration");
+  if (!(options.time >= config.sim.step_length && options.time <= config.sim.duration))
+    throw std::invalid_argument("--time must be in [" + Fixed(config.sim.step_length, 2) + ", " +
+                                Fixed(config.sim.duration, 2) + "] s (one step to the duration)");
   config.sim.duration = options.time;
   // SUMO's route file and log go next to the picture.
   const std::filesystem::path png = run.out;

@@ -15,10 +15,12 @@ std::string Fixed(double v, int decimals) {
 scenario::ScenarioConfig LoadConfig(const RunOptions& options) {
   scenario::ScenarioConfig config = scenario::LoadScenario(options.scenario);
   if (options.seed) config.sim.seed = *options.seed;
-  if (options.duration) {
-    if (!(*options.duration > 0.0)) throw std::invalid_argument("--duration must be > 0 s");
-    config.sim.duration = *options.duration;
-  }
+  if (options.duration) config.sim.duration = *options.duration;
+  // The overrides go through the same validation as the file.
+  std::string error;
+  if (!config.sim.IsValid(&error))
+    throw std::invalid_argument(config.file.string() +
+                                " with the command-line overrides: " + error);
   return config;
 }
 

@@ -46,7 +46,8 @@ bool Pipeline::Step() {
   if (!simulation_.Step()) return false;
   const sim::Frame& f = frame();
   ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate};
-  const double dt = f.time - last_time_;
+  // The first filter cycle (the ego may depart late) predicts over one step.
+  const double dt = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
   last_time_ = f.time;
 
   detections_ = radar_.Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,

@@ -17,7 +17,6 @@ struct VehicleTypeSpec {
   double max_speed = 40.0;           ///< [m/s] vehicle limit
   double accel = 2.6;                ///< [m/s^2]
   double decel = 4.5;                ///< [m/s^2]
-  double speed_factor_dev = 0.1;     ///< std of SUMO's speed factor (desired speed spread)
   double rcs_dbsm = 10.0;            ///< radar cross-section [dBsm]
   std::string vclass = "passenger";  ///< SUMO vClass
   bool overtake_right = false;  ///< SUMO lcOvertakeRight: may pass slower vehicles on their right
@@ -41,7 +40,8 @@ struct VehicleSpec {
   int lane = 0;           ///< departure lane index (0 = rightmost)
   double position = 0.0;  ///< [m] departure position of the front bumper along the first edge
   double speed = 27.78;   ///< [m/s] departure speed
-  std::optional<double> desired_speed;  ///< [m/s] cruise speed; default: SUMO's speed factor
+  std::optional<double> desired_speed;  ///< [m/s] cruise speed; default: the type's max_speed
+                                        ///< (the ego's comes from its speed policy)
   bool lane_change = true;              ///< false: SUMO never changes its lane on its own
 };
 
