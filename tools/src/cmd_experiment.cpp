@@ -14,7 +14,7 @@
 
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
-#include "dualgrid/viz/charts.hpp"
+#include "figures.hpp"
 #include "output.hpp"
 #include "progress.hpp"
 
@@ -140,12 +140,6 @@ int RunExperiment(const ExperimentOptions& o) {
   OpenOutput(out / "table.json") << table.ToJson().dump(2) << "\n";
 
   // Per-object tracked share over seeds (paper Fig. 6).
-  viz::BarChart chart;
-  chart.title = config.sim.name + ": tracked share D per object, mean over " +
-                std::to_string(o.seeds) + " seeds";
-  chart.x_label = "object";
-  chart.y_label = "tracked share D";
-  chart.percent = true;
   std::map<int, std::vector<double>> rows;
   nlohmann::json per_object;
   for (std::size_t m = 0; m < runs.size(); ++m) {
@@ -155,16 +149,13 @@ int RunExperiment(const ExperimentOptions& o) {
     }
   }
   OpenOutput(out / "per_object.json") << per_object.dump(2) << "\n";
-  for (const auto& [id, r] : rows) chart.categories.push_back(names.Name(id));
-  for (std::size_t m = 0; m < runs.size(); ++m) {
-    viz::BarSeries s{runs[m].mode, {}, std::nullopt};
-    for (const auto& [id, r] : rows) s.values.push_back(r[m]);
-    chart.series.push_back(s);
-  }
-  chart.value_labels = rows.size() <= 12;
-  chart.width = std::max(1000, 60 * static_cast<int>(rows.size() * runs.size()) + 200);
-  if (!rows.empty() && o.run.figures)
-    viz::RenderBarChart(chart, (out / "figures" / "tracked_share.png").string());
+  TrackedShares shares;
+  for (const auto& [id, r] : rows) shares.emplace_back(names.Name(id), r);
+  if (o.run.figures)
+    RenderTrackedShares(o.run.modes, shares,
+                        config.sim.name + ": tracked share D per object, mean over " +
+                            std::to_string(o.seeds) + " seeds",
+                        out / "figures" / "tracked_share.png");
   // The first seed's pictures (grids, scene, weights) are the experiment's examples.
   const auto first = out / "seeds" / ("seed_" + std::to_string(o.first_seed)) / "figures";
   if (o.run.figures)

@@ -317,7 +317,7 @@ int RunFilters(const FilterRunOptions& options) {
       RenderWeightTrace(t, focus, mode_names[trace_mode], out / "figures" / "weights.png");
   }
   if (options.figures)
-    RenderTrackedShares(mode_names, metrics, pipeline.ids(),
+    RenderTrackedShares(mode_names, RunTrackedShares(metrics, pipeline.ids()),
                         config.sim.name + ": tracked share D per object (seed " +
                             std::to_string(config.sim.seed) + ")",
                         out / "figures" / "tracked_share.png");

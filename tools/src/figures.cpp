@@ -80,32 +80,38 @@ void RenderGridFigure(const std::vector<std::string>& modes,
   viz::RenderGridPanels(panels, path.string(), options);
 }
 
-void RenderTrackedShares(const std::vector<std::string>& modes,
-                         const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
-                         const std::string& title, const std::filesystem::path& path) {
-  std::map<int, std::vector<double>> per_object;
+TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
+                               const IdRegistry& ids) {
+  std::map<int, std::vector<double>> per_object;  // by id: order of first appearance
   for (std::size_t m = 0; m < metrics.size(); ++m) {
     for (const auto& o : metrics[m].objects) {
       if (!o.scored) continue;
-      auto& row = per_object.try_emplace(o.id, modes.size(), std::nan("")).first->second;
+      auto& row = per_object.try_emplace(o.id, metrics.size(), std::nan("")).first->second;
       row[m] = o.tracked_fraction.value_or(0.0);
     }
   }
+  TrackedShares out;
+  for (const auto& [id, row] : per_object) out.emplace_back(ids.Name(id), row);
+  return out;
+}
+
+void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
+                         const std::string& title, const std::filesystem::path& path) {
+  if (shares.empty()) return;  // nothing scored (very short run)
   viz::BarChart chart;
   chart.title = title;
   chart.x_label = "object";
   chart.y_label = "tracked share D";
   chart.percent = true;
-  chart.value_labels = per_object.size() <= 12;
-  chart.width = std::max(1000, 60 * static_cast<int>(per_object.size() * modes.size()) + 200);
-  for (const auto& [id, row] : per_object) chart.categories.push_back(ids.Name(id));
+  chart.value_labels = shares.size() <= 12;
+  chart.width = std::max(1000, 60 * static_cast<int>(shares.size() * modes.size()) + 200);
+  for (const auto& [name, row] : shares) chart.categories.push_back(name);
   for (std::size_t m = 0; m < modes.size(); ++m) {
     viz::BarSeries s;
     s.name = modes[m];
-    for (const auto& [id, row] : per_object) s.values.push_back(row[m]);
+    for (const auto& [name, row] : shares) s.values.push_back(row[m]);
     chart.series.push_back(std::move(s));
   }
-  if (chart.categories.empty()) return;  // nothing scored (very short run)
   viz::RenderBarChart(chart, path.string());
 }
 
