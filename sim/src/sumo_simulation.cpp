@@ -36,6 +36,30 @@ std::string Num(double v) {
 // immediate collisions (SUMO docs, "lane change mode" bits 8-9).
 constexpr int kLaneChangeModeScriptedOnly = 256;
 
+// Scenario names and ids go into XML attributes.
+std::string Xml(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::filesystem::path DefaultNetworkDir() {
@@ -65,15 +89,15 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
   // Desired speeds are set per vehicle through maxSpeed (see ApplyDepartures); a speed factor of
   // 1.5 keeps the lane limits from capping them below 130 km/h.
   for (const auto& [name, t] : spec.vehicle_types) {
-    out << "  <vType id=\"" << name << "\" length=\"" << Num(t.length) << "\" width=\""
+    out << "  <vType id=\"" << Xml(name) << "\" length=\"" << Num(t.length) << "\" width=\""
         << Num(t.width) << "\" maxSpeed=\"" << Num(t.max_speed) << "\" accel=\"" << Num(t.accel)
         << "\" decel=\"" << Num(t.decel) << "\" speedFactor=\"1.5\" speedDev=\"0\" sigma=\"0\""
-        << " vClass=\"" << t.vclass << "\" minGap=\"2.5\" lcOvertakeRight=\""
+        << " vClass=\"" << Xml(t.vclass) << "\" minGap=\"2.5\" lcOvertakeRight=\""
         << (t.overtake_right ? 1 : 0) << "\"/>\n";
   }
   for (const auto& [name, edges] : spec.routes) {
-    out << "  <route id=\"" << name << "\" edges=\"";
-    for (std::size_t i = 0; i < edges.size(); ++i) out << (i ? " " : "") << edges[i];
+    out << "  <route id=\"" << Xml(name) << "\" edges=\"";
+    for (std::size_t i = 0; i < edges.size(); ++i) out << (i ? " " : "") << Xml(edges[i]);
     out << "\"/>\n";
   }
   // SUMO requires vehicles and flows sorted by departure time.
@@ -83,17 +107,18 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
   };
   std::vector<Entry> entries;
   auto vehicle_xml = [](const VehicleSpec& v) {
-    return "  <vehicle id=\"" + v.id + "\" type=\"" + v.type + "\" route=\"" + v.route +
-           "\" depart=\"" + Num(v.depart) + "\" departLane=\"" + std::to_string(v.lane) +
-           "\" departPos=\"" + Num(v.position) + "\" departSpeed=\"" + Num(v.speed) + "\"/>\n";
+    return "  <vehicle id=\"" + Xml(v.id) + "\" type=\"" + Xml(v.type) + "\" route=\"" +
+           Xml(v.route) + "\" depart=\"" + Num(v.depart) + "\" departLane=\"" +
+           std::to_string(v.lane) + "\" departPos=\"" + Num(v.position) + "\" departSpeed=\"" +
+           Num(v.speed) + "\"/>\n";
   };
   entries.push_back({spec.ego.depart, vehicle_xml(spec.ego)});
   for (const VehicleSpec& v : spec.vehicles) entries.push_back({v.depart, vehicle_xml(v)});
   for (const FlowSpec& f : spec.flows) {
-    entries.push_back({f.begin, "  <flow id=\"" + f.id + "\" type=\"" + f.type + "\" route=\"" +
-                                    f.route + "\" begin=\"" + Num(f.begin) + "\" end=\"" +
-                                    Num(f.end) + "\" period=\"" + Num(f.period) +
-                                    "\" departLane=\"" + f.lane + "\" departPos=\"" +
+    entries.push_back({f.begin, "  <flow id=\"" + Xml(f.id) + "\" type=\"" + Xml(f.type) +
+                                    "\" route=\"" + Xml(f.route) + "\" begin=\"" + Num(f.begin) +
+                                    "\" end=\"" + Num(f.end) + "\" period=\"" + Num(f.period) +
+                                    "\" departLane=\"" + Xml(f.lane) + "\" departPos=\"" +
                                     Num(f.position) + "\" departSpeed=\"" +
                                     Num(0.5 * (f.speed_min + f.speed_max)) + "\"/>\n"});
   }
