@@ -174,7 +174,7 @@ int RunFilters(const FilterRunOptions& options) {
       snaps.push_back(TakeSnapshot(grid));
       if (m == 0) truth_classes = TruthClasses(snaps[0], f, config.sim);
       const std::vector<eval::TruthObject> objects = pipeline.TruthObjects(grid);
-      scorers[m].AddFrame(f.time, grid, snaps[m], objects, truth_classes);
+      scorers[m].AddFrame(f.time, grid, snaps[m], objects, truth_classes, f.ego.box);
       const auto& a = scorers[m].association();
       for (std::size_t c = 0; c < scorers[m].clusters().size(); ++c) {
         const eval::Cluster& cl = scorers[m].clusters()[c];

@@ -56,8 +56,13 @@ bool Pipeline::Step() {
 
   if (filters_.empty()) return true;
   measurements_.clear();
-  for (const radar::Detection& d : detections_)
+  // Nothing but the ego can be inside the ego's own footprint: returns there (clutter drawn down
+  // to the sensors' minimum range) would feed particles that ride along with the ego.
+  const OrientedBox ego_box = f.ego.box;
+  for (const radar::Detection& d : detections_) {
+    if (ego_box.Contains(d.position_world)) continue;
     measurements_.push_back({d.position_world, d.radial_velocity_world, d.sensor_position_world});
+  }
   coverage_.clear();
   for (int s : scanned_) {
     const radar::SensorParams& p = radar_.sensors()[s];

@@ -88,7 +88,8 @@ ModeScorer::ModeScorer(const scenario::EvaluationConfig& config)
 void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                           const GridSnapshot& snapshot,
                           const std::vector<eval::TruthObject>& objects,
-                          const std::vector<std::uint8_t>& truth_classes) {
+                          const std::vector<std::uint8_t>& truth_classes,
+                          const OrientedBox& ego_box) {
   // Paper Sec. V: particles of cells with P(dynamic) above the threshold are clustered.
   // The weighted persistent particles (before resampling, when all weights become equal), so
   // that the cluster means are the paper's weighted averages and exclude this cycle's births.
@@ -97,6 +98,7 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   for (std::size_t i = 0; i < grid.num_weighted_particles(); ++i) {
     if (!(p.weight[i] > 0.0f)) continue;
     const Position pos(p.x[i], p.y[i]);
+    if (ego_box.Contains(pos)) continue;
     const auto cell = grid.CellOf(pos);
     if (!cell) continue;
     const std::size_t k = static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x;
