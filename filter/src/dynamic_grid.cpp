@@ -41,6 +41,11 @@ inline double FastAtan2(double y, double x) {
   return y < 0.0 ? -r : r;
 }
 
+// std::exp with the underflow range short-cut: glibc takes a slow path (errno handling) below
+// ~-103.97 (float) / ~-745.13 (double), where the correctly rounded result is +0 anyway.
+inline float ExpUnder(float x) { return x < -104.0f ? 0.0f : std::exp(x); }
+inline double ExpUnder(double x) { return x < -746.0 ? 0.0 : std::exp(x); }
+
 // Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
 constexpr double kAtanError = 5e-4;
 
@@ -584,11 +589,49 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double max_speed2 = p.max_speed * p.max_speed;
   const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
   ParticleSet& q = sorted_;
-  // Cells in parallel; dynamic scheduling only balances load, every value is computed by one
-  // thread from the same inputs, so results do not depend on the thread count.
-#pragma omp parallel for schedule(dynamic, 512)
-  for (std::int64_t s = 0; s < num_cells_; ++s) {
-    const std::int64_t lo = cell_start_[s], hi = cell_start_[s + 1];
+  const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
+  const double static_persistence = p.static_persistence, free_decay = p.free_decay;
+  const std::int64_t* const start = cell_start_.data();
+  const int* const near = near_det_.data();
+  const std::uint8_t* const view_bits = view_.data();
+  double* const free_l = free_.data();
+  double* const static_l = static_.data();
+  double* const dynamic_l = dynamic_.data();
+  double* const born_l = born_.data();
+  // Blocks of cells in parallel; dynamic scheduling only balances load, every value is computed by
+  // one thread from the same inputs, so results do not depend on the thread count.
+  constexpr std::int64_t kCellChunk = 512;
+  const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t ch = 0; ch < chunks; ++ch) {
+    const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
+    // Fast path (most cells): no particle, no detection. The general equations below reduce to a
+    // free/static Dempster update with the whole occupied mass static and no dynamic mass (same
+    // operations with d_pred = 0, occ_k = 0). Branch-free over the block so that it vectorises;
+    // the other cells keep their values here and are updated in the loop below.
+    for (std::int64_t s = c_lo; s < c_hi; ++s) {
+      const bool fast = (start[s] == start[s + 1]) & (near[s] < 0);
+      const std::uint8_t view = view_bits[s];
+      // z_free of the general path, as 0/1 selectors (fm * 1 + fm_nr * 0 = fm exactly).
+      const int obs = view & kObserved, ray = (view >> 1) & 1, none = (view >> 2) & 1;
+      const double z_free = static_cast<double>(obs & ray) * fm +
+                            static_cast<double>(obs & (ray ^ 1) & none) * fm_nr;
+      const double st = static_l[s], fr = free_l[s];
+      const double s_pred = std::min(static_persistence * st, 1.0 - 0.0);
+      const double f_pred = std::max(0.0, std::min(free_decay * fr, 1.0 - 0.0 - s_pred));
+      const double o_pred = 0.0 + s_pred;
+      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
+      const double norm0 = 1.0 / (1.0 - s_pred * z_free);
+      const double nf = (f_pred + u_pred * z_free) * norm0;
+      const double ns = s_pred * (1.0 - z_free) * norm0;
+      free_l[s] = fast ? nf : fr;
+      static_l[s] = fast ? ns : st;
+      dynamic_l[s] = fast ? 0.0 : dynamic_l[s];
+      born_l[s] = fast ? 0.0 : born_l[s];
+    }
+    for (std::int64_t s = c_lo; s < c_hi; ++s) {
+    const std::int64_t lo = start[s], hi = start[s + 1];
+    if (lo == hi && near[s] < 0) continue;  // done above
     const std::uint8_t view = view_[s];
     const bool observed = (view & kObserved) != 0;
 
@@ -608,7 +651,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     if (j >= 0) {
       const double d2 = near_d2_[s];
       occ_k = std::exp(-d2 * inv_2sf2);
-      static_k = std::exp(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
+      static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
     }
     const double z_occ = p.occupied_mass * occ_k;
     double z_free = 0.0;
@@ -620,16 +663,6 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       }
     }
     const double z_unk = 1.0 - z_occ - z_free;
-    if (hi == lo && j < 0) {
-      // Fast path (most cells): no particle, no detection. The general equations reduce to a
-      // free/static Dempster update with the whole occupied mass static and no dynamic mass.
-      const double norm0 = 1.0 / (1.0 - s_pred * z_free);
-      free_[s] = (f_pred + u_pred * z_free) * norm0;
-      static_[s] = s_pred * (1.0 - z_free) * norm0;
-      dynamic_[s] = 0.0;
-      born_[s] = 0.0;
-      continue;
-    }
 
     // --- Temporal fusion (Dempster's rule on {free, occupied}). ---
     const double conflict = o_pred * z_free + f_pred * z_occ;
@@ -698,7 +731,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         if (jn >= 0) {
           const double ex = q.vx[i] - z[jn].radial_velocity.x();
           const double ey = q.vy[i] - z[jn].radial_velocity.y();
-          fv = std::exp(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
+          fv = ExpUnder(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
         }
         lp = fd * keep;                    // eq. (7)
         lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
@@ -714,7 +747,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     // The static hypothesis is scored like a particle with v = 0 at the cell centre.
     double ls_pos = keep, ls_vel = keep;
     if (j >= 0 || observed) {
-      const double fv0 = j >= 0 ? std::exp(-z[j].radial_velocity.squaredNorm() * inv_2v2) : 0.0;
+      const double fv0 = j >= 0 ? ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2) : 0.0;
       ls_pos = occ_k * keep;
       ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
     }
@@ -765,6 +798,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     // until its particles survive a cycle (docs/algorithm.md, step 5).
     dynamic_[s] = rho_p;
     born_[s] = rho_b;
+    }
   }
 }
 
