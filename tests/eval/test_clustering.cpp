@@ -10,8 +10,8 @@ using dualgrid::Position;
 using dualgrid::RngPurpose;
 using dualgrid::Velocity;
 using dualgrid::eval::Cluster;
-using dualgrid::eval::kNoise;
 using dualgrid::eval::DbscanParams;
+using dualgrid::eval::kNoise;
 using dualgrid::eval::ParticleClusterer;
 using dualgrid::eval::WeightedParticle;
 

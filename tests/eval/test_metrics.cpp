@@ -20,7 +20,6 @@ using dualgrid::eval::TrackingMetricsAccumulator;
 using dualgrid::eval::TrackingMetricsParams;
 using dualgrid::eval::TruthObject;
 
-
 namespace {
 
 constexpr double kDt = 0.05;  // 20 Hz

@@ -59,8 +59,8 @@ struct ObjectMetrics {
 
 struct ScenarioMetrics {
   int frames = 0;
-  std::int64_t matches = 0;                ///< (frame, tracked object) pairs behind the errors
-  std::optional<double> position_error;    ///< Delta x [m]
+  std::int64_t matches = 0;              ///< (frame, tracked object) pairs behind the errors
+  std::optional<double> position_error;  ///< Delta x [m]
   /// Diagnostic beside Delta x: mean distance from the cluster to the vehicle's box (0 inside).
   /// Radar sees only the faces turned to it, so clusters sit on a face; this separates that
   /// offset (up to half a length) from errors of the filter itself.
