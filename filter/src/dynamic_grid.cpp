@@ -54,6 +54,9 @@ constexpr double kAtanError = 5e-4;
 // of kScanBlock, block totals, serial scan, local scans): bit-identical to it, without
 // materialising the concatenated input.
 constexpr std::int64_t kScanBlock = 1 << 14;
+// Cells per UpdateCells work item; divides kScanBlock (Birth walks the per-chunk birth lists).
+constexpr std::int64_t kCellChunk = 512;
+static_assert(kScanBlock % kCellChunk == 0);
 void ConcatScan(const float* a, std::int64_t na, const float* b, std::int64_t n, double* out) {
   const auto block_sum = [&](std::int64_t lo, std::int64_t hi, double acc) {
     for (std::int64_t i = lo; i < std::min(hi, na); ++i) acc += static_cast<double>(a[i]);
@@ -133,7 +136,10 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   births_.resize(b);
   cell_of_.assign(n, 0);
   cell_start_.assign(c + 2, 0);
-  hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 12) + 2), 0);
+  born_cells_.assign(c, 0);
+  born_count_.assign(static_cast<std::size_t>((num_cells_ + kCellChunk - 1) / kCellChunk), 0);
+  born_chunk_acc_.assign(born_count_.size(), 0.0);
+  hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 10) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
   scan_out_.assign(n + b + 1, 0.0);
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
@@ -260,72 +266,80 @@ void DynamicGrid::PredictAndSort(double dt) {
   const double inv_r = 1.0 / params_.resolution;
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
   const int chunks = std::clamp(omp_get_max_threads(), 1, kMaxSortChunks);
-  // Counting sort, stable: particle order within a cell = order before sorting, for any chunking.
-  // Pass 1 (per chunk): prediction (step 2, batch by batch while the batch is in cache), storage
-  // cell of each particle and the chunk's histogram.
-#pragma omp parallel for schedule(static)
-  for (int k = 0; k < chunks; ++k) {
-    std::int32_t* h = hist_.data() + k * c1;
-    std::fill_n(h, c1, 0);
-    const std::int64_t chunk_hi = (k + 1) * n / chunks;
-    for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
-      const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
-      detail::PredictRange(particles_, b0, b1, dt, sp, sv, params_.persistence, seed_, step_);
-      for (std::int64_t i = b0; i < b1; ++i) {
-        const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
-        const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
-        const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
-        std::int64_t c = num_cells_;
-        if (inside) {
-          // Storage index without integer division (hot loop): wrap once.
-          std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
-          std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
-          if (sx >= nx_) sx -= nx_;
-          if (sy >= ny_) sy -= ny_;
-          c = sy * nx_ + sx;
-        }
-        cell_of_[i] = c;
-        ++h[c];
-      }
-    }
-  }
-  // Pass 2: cell starts and per-chunk write offsets in fixed blocks of cells (integers: exact in
-  // any order). Block totals first, then a serial scan over blocks, then the offsets.
-  constexpr std::int64_t kCellBlock = 1 << 12;
+  // Blocks of cells for pass 2 (small enough to balance two threads at the paper size).
+  constexpr std::int64_t kCellBlock = 1 << 10;
   const std::int64_t nblocks = (c1 + kCellBlock - 1) / kCellBlock;
   if (static_cast<std::int64_t>(hist_total_.size()) < nblocks + 1) hist_total_.resize(nblocks + 1);
   std::int64_t* block_base = hist_total_.data();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < nblocks; ++b) {
-    const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
-    std::int64_t t = 0;
+  // All passes in one parallel region (the implicit barriers of the worksharing loops order them).
+#pragma omp parallel
+  {
+    // Counting sort, stable: particle order within a cell = order before sorting, for any chunking.
+    // Pass 1 (per chunk): prediction (step 2, batch by batch while the batch is in cache), storage
+    // cell of each particle and the chunk's histogram.
+#pragma omp for schedule(static)
     for (int k = 0; k < chunks; ++k) {
-      const std::int32_t* h = hist_.data() + k * c1;
-      for (std::int64_t c = lo; c < hi; ++c) t += h[c];
-    }
-    block_base[b + 1] = t;
-  }
-  block_base[0] = 0;
-  for (std::int64_t b = 0; b < nblocks; ++b) block_base[b + 1] += block_base[b];
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < nblocks; ++b) {
-    const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
-    std::int64_t run = block_base[b];
-    for (std::int64_t c = lo; c < hi; ++c) {
-      cell_start_[c] = run;
-      for (int k = 0; k < chunks; ++k) {
-        const std::int64_t t = hist_[k * c1 + c];
-        hist_[k * c1 + c] = static_cast<std::int32_t>(run);
-        run += t;
+      std::int32_t* h = hist_.data() + k * c1;
+      std::fill_n(h, c1, 0);
+      const std::int64_t chunk_hi = (k + 1) * n / chunks;
+      for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
+        const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
+        detail::PredictRange(particles_, b0, b1, dt, sp, sv, params_.persistence, seed_, step_);
+        for (std::int64_t i = b0; i < b1; ++i) {
+          const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
+          const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
+          const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
+          std::int64_t c = num_cells_;
+          if (inside) {
+            // Storage index without integer division (hot loop): wrap once.
+            std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
+            std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
+            if (sx >= nx_) sx -= nx_;
+            if (sy >= ny_) sy -= ny_;
+            c = sy * nx_ + sx;
+          }
+          cell_of_[i] = c;
+          ++h[c];
+        }
       }
     }
-  }
-  cell_start_[c1] = n;
-#pragma omp parallel for schedule(static)
-  for (int k = 0; k < chunks; ++k) {
-    std::int32_t* h = hist_.data() + k * c1;
-    for (std::int64_t i = k * n / chunks; i < (k + 1) * n / chunks; ++i) {
-      sorted_.CopyFrom(particles_, i, h[cell_of_[i]]++);
+    // Pass 2: cell starts and per-chunk write offsets in fixed blocks of cells (integers: exact in
+    // any order). Block totals first, then a serial scan over blocks, then the offsets.
+#pragma omp for schedule(static)
+    for (std::int64_t b = 0; b < nblocks; ++b) {
+      const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
+      std::int64_t t = 0;
+      for (int k = 0; k < chunks; ++k) {
+        const std::int32_t* h = hist_.data() + k * c1;
+        for (std::int64_t c = lo; c < hi; ++c) t += h[c];
+      }
+      block_base[b + 1] = t;
+    }
+#pragma omp single
+    {
+      block_base[0] = 0;
+      for (std::int64_t b = 0; b < nblocks; ++b) block_base[b + 1] += block_base[b];
+      cell_start_[c1] = n;
+    }
+#pragma omp for schedule(static)
+    for (std::int64_t b = 0; b < nblocks; ++b) {
+      const std::int64_t lo = b * kCellBlock, hi = std::min(c1, lo + kCellBlock);
+      std::int64_t run = block_base[b];
+      for (std::int64_t c = lo; c < hi; ++c) {
+        cell_start_[c] = run;
+        for (int k = 0; k < chunks; ++k) {
+          const std::int64_t t = hist_[k * c1 + c];
+          hist_[k * c1 + c] = static_cast<std::int32_t>(run);
+          run += t;
+        }
+      }
+    }
+#pragma omp for schedule(static)
+    for (int k = 0; k < chunks; ++k) {
+      std::int32_t* h = hist_.data() + k * c1;
+      for (std::int64_t i = k * n / chunks; i < (k + 1) * n / chunks; ++i) {
+        sorted_.CopyFrom(particles_, i, h[cell_of_[i]]++);
+      }
     }
   }
 }
@@ -426,11 +440,24 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
   const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
   const std::int64_t sx0 = Mod(origin_gx_, nx_);
   // Per-sensor trigonometry once per cycle, not per row.
-  sensor_trig_.resize(3 * static_cast<std::size_t>(ns));
+  sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
   for (int k = 0; k < ns; ++k) {
-    sensor_trig_[3 * k] = std::cos(cov[k].boresight);
-    sensor_trig_[3 * k + 1] = std::sin(cov[k].boresight);
-    sensor_trig_[3 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+    sensor_trig_[4 * k] = std::cos(cov[k].boresight);
+    sensor_trig_[4 * k + 1] = std::sin(cov[k].boresight);
+    sensor_trig_[4 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+    // Inner wedge (half_fov - 4 kAtanError): its cells pass the segment test below at once.
+    const double inner = cov[k].half_fov - 4.0 * kAtanError;
+    sensor_trig_[4 * k + 3] = inner > 0.0 && cov[k].half_fov < 0.5 * kPi ? std::tan(inner) : -1.0;
+  }
+  // Last bin of the run of equal ranges each bin belongs to (per sensor): O(1) uniformity test.
+  bin_run_end_.resize(bin_range_.size());
+  for (int k = 0; k < ns; ++k) {
+    const std::int64_t b_lo = bin_offset_[k], b_hi = bin_offset_[k + 1];
+    for (std::int64_t b = b_hi - 1; b >= b_lo; --b) {
+      bin_run_end_[b] = b + 1 < b_hi && bin_range_[b + 1] == bin_range_[b]
+                            ? bin_run_end_[b + 1]
+                            : static_cast<int>(b - b_lo);
+    }
   }
 #pragma omp parallel for schedule(dynamic, 2)
   for (int ly = 0; ly < ny_; ++ly) {
@@ -448,9 +475,10 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
           std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
       // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
       // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
-      const double cb = sensor_trig_[3 * k], sb = sensor_trig_[3 * k + 1];
+      const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
       const bool narrow = sc.half_fov < 0.5 * kPi;
-      const double tan_hf = sensor_trig_[3 * k + 2];
+      const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
+      const int* const run_end = bin_run_end_.data() + bin_offset_[k];
       const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
       const double* bins = bin_range_.data() + bin_offset_[k];
       const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
@@ -475,28 +503,44 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
                                               (br != kInf && d2 < br * br ? kFreeRay : 0));
       };
       int lo_x = lx_lo, hi_x = lx_hi;
-      if (narrow) {
-        // Cells inside the wedge satisfy three linear conditions in dx (fx > 0, fx tan - fy >= 0,
-        // fx tan + fy >= 0): clip the row to that interval, two cells of margin (the exact test
-        // still decides every cell).
-        double dmin = -kInf, dmax = kInf;
+      // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
+      // (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0): their interval of dx.
+      const auto wedge = [&](double tan_w, double* dmin, double* dmax) {
+        *dmin = -kInf;
+        *dmax = kInf;
         for (const auto& [c, d] :
-             {std::pair{cb, dy * sb}, std::pair{cb * tan_hf + sb, dy * (sb * tan_hf - cb)},
-              std::pair{cb * tan_hf - sb, dy * (sb * tan_hf + cb)}}) {
+             {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
+              std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
           if (c > 0.0) {
-            dmin = std::max(dmin, -d / c);
+            *dmin = std::max(*dmin, -d / c);
           } else if (c < 0.0) {
-            dmax = std::min(dmax, -d / c);
+            *dmax = std::min(*dmax, -d / c);
           } else if (d < 0.0) {
-            dmax = -kInf;
+            *dmax = -kInf;
           }
         }
-        if (!(dmin <= dmax)) continue;
-        const double big = 4.0 * nx_;
+        return *dmin <= *dmax;
+      };
+      const double big = 4.0 * nx_;
+      int in_lo = 1, in_hi = 0;  // cells well inside the wedge (empty unless narrow)
+      if (narrow) {
+        // Clip the row to the wedge, two cells of margin (the exact test still decides every
+        // cell).
+        double dmin, dmax;
+        if (!wedge(tan_hf, &dmin, &dmax)) continue;
         const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
         const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
         lo_x = std::max(lo_x, static_cast<int>(l0));
         hi_x = std::min(hi_x, static_cast<int>(l1));
+        // The cells of the inner wedge (half_fov - 4 kAtanError, one cell of margin) pass the
+        // field-of-view part of the segment test below: segmenting the row there first saves the
+        // bisection down to the wedge edges. Only the segmentation changes, not any cell's bits.
+        if (tan_in > 0.0 && wedge(tan_in, &dmin, &dmax)) {
+          in_lo = std::max(
+              lo_x, static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big)));
+          in_hi = std::min(
+              hi_x, static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big)));
+        }
       }
       if (lo_x > hi_x) continue;
       // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
@@ -512,9 +556,19 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
       };
       int stack[128][2];
       int top = 0;
-      stack[top][0] = lo_x;
-      stack[top][1] = hi_x;
-      ++top;
+      if (in_lo <= in_hi) {
+        for (const auto& [sa, se] :
+             {std::pair{lo_x, in_lo - 1}, std::pair{in_lo, in_hi}, std::pair{in_hi + 1, hi_x}}) {
+          if (sa > se) continue;
+          stack[top][0] = sa;
+          stack[top][1] = se;
+          ++top;
+        }
+      } else {
+        stack[top][0] = lo_x;
+        stack[top][1] = hi_x;
+        ++top;
+      }
       while (top > 0) {
         --top;
         const int a = stack[top][0], e = stack[top][1];
@@ -532,7 +586,7 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
           const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
           const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
           br = bins[b0];
-          for (int b = b0 + 1; b <= b1 && uniform; ++b) uniform = bins[b] == br;
+          uniform = run_end[b0] >= b1;
         }
         if (!uniform) {
           const int mid = a + (e - a) / 2;
@@ -597,10 +651,8 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   double* const free_l = free_.data();
   double* const static_l = static_.data();
   double* const dynamic_l = dynamic_.data();
-  double* const born_l = born_.data();
   // Blocks of cells in parallel; dynamic scheduling only balances load, every value is computed by
   // one thread from the same inputs, so results do not depend on the thread count.
-  constexpr std::int64_t kCellChunk = 512;
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t ch = 0; ch < chunks; ++ch) {
@@ -614,8 +666,8 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       const std::uint8_t view = view_bits[s];
       // z_free of the general path, as 0/1 selectors (fm * 1 + fm_nr * 0 = fm exactly).
       const int obs = view & kObserved, ray = (view >> 1) & 1, none = (view >> 2) & 1;
-      const double z_free = static_cast<double>(obs & ray) * fm +
-                            static_cast<double>(obs & (ray ^ 1) & none) * fm_nr;
+      const double z_free =
+          static_cast<double>(obs & ray) * fm + static_cast<double>(obs & (ray ^ 1) & none) * fm_nr;
       const double st = static_l[s], fr = free_l[s];
       const double s_pred = std::min(static_persistence * st, 1.0 - 0.0);
       const double f_pred = std::max(0.0, std::min(free_decay * fr, 1.0 - 0.0 - s_pred));
@@ -627,178 +679,183 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       free_l[s] = fast ? nf : fr;
       static_l[s] = fast ? ns : st;
       dynamic_l[s] = fast ? 0.0 : dynamic_l[s];
-      born_l[s] = fast ? 0.0 : born_l[s];
     }
+    // Cells with birth mass, in cell order (Birth reads only these).
+    std::int64_t* const born_list = born_cells_.data() + c_lo;
+    std::int32_t n_born = 0;
     for (std::int64_t s = c_lo; s < c_hi; ++s) {
-    const std::int64_t lo = start[s], hi = start[s + 1];
-    if (lo == hi && near[s] < 0) continue;  // done above
-    const std::uint8_t view = view_[s];
-    const bool observed = (view & kObserved) != 0;
+      const std::int64_t lo = start[s], hi = start[s + 1];
+      if (lo == hi && near[s] < 0) continue;  // done above
+      const std::uint8_t view = view_[s];
+      const bool observed = (view & kObserved) != 0;
 
-    // --- Prediction: predicted masses (dynamic = sum of persistent particle weights). ---
-    double d_pred = 0.0;
-    for (std::int64_t i = lo; i < hi; ++i) d_pred += q.weight[i];
-    const double cap = d_pred > 1.0 ? 1.0 / d_pred : 1.0;  // dynamic mass is a probability
-    d_pred *= cap;
-    const double s_pred = std::min(p.static_persistence * static_[s], 1.0 - d_pred);
-    const double f_pred = std::max(0.0, std::min(p.free_decay * free_[s], 1.0 - d_pred - s_pred));
-    const double o_pred = d_pred + s_pred;
-    const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
+      // --- Prediction: predicted masses (dynamic = sum of persistent particle weights). ---
+      double d_pred = 0.0;
+      for (std::int64_t i = lo; i < hi; ++i) d_pred += q.weight[i];
+      const double cap = d_pred > 1.0 ? 1.0 / d_pred : 1.0;  // dynamic mass is a probability
+      d_pred *= cap;
+      const double s_pred = std::min(p.static_persistence * static_[s], 1.0 - d_pred);
+      const double f_pred = std::max(0.0, std::min(p.free_decay * free_[s], 1.0 - d_pred - s_pred));
+      const double o_pred = d_pred + s_pred;
+      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
 
-    // --- Measurement grid: occupied (f_d, eq. 2), static (eq. 4), free (eq. 3 on rays). ---
-    double occ_k = 0.0, static_k = 0.0;
-    const int j = near_det_[s];
-    if (j >= 0) {
-      const double d2 = near_d2_[s];
-      occ_k = std::exp(-d2 * inv_2sf2);
-      static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
-    }
-    const double z_occ = p.occupied_mass * occ_k;
-    double z_free = 0.0;
-    if (observed) {
-      if (view & kFreeRay) {
-        z_free = p.free_mass * (1.0 - occ_k);
-      } else if (view & kNoReturn) {
-        z_free = p.free_mass_no_return * (1.0 - occ_k);
+      // --- Measurement grid: occupied (f_d, eq. 2), static (eq. 4), free (eq. 3 on rays). ---
+      double occ_k = 0.0, static_k = 0.0;
+      const int j = near_det_[s];
+      if (j >= 0) {
+        const double d2 = near_d2_[s];
+        occ_k = std::exp(-d2 * inv_2sf2);
+        static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
       }
-    }
-    const double z_unk = 1.0 - z_occ - z_free;
-
-    // --- Temporal fusion (Dempster's rule on {free, occupied}). ---
-    const double conflict = o_pred * z_free + f_pred * z_occ;
-    const double norm = 1.0 / (1.0 - conflict);
-    double o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
-    double f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
-    if (o_up + f_up > 1.0) {  // rounding only
-      const double k = 1.0 / (o_up + f_up);
-      o_up *= k;
-      f_up *= k;
-    }
-
-    // --- Particle weights, eqs. (7) and (8), unnormalised. The per-cycle factors double as the
-    // likelihood of each hypothesis in the joint normalisation below. ---
-    const auto mode_factor = [&](double lp, double lv) {
-      return p.mode == WeightMode::kPosition   ? lp
-             : p.mode == WeightMode::kVelocity ? lv
-                                               : std::max(lp, lv);  // eq. (14)
-    };
-    double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
-    // Candidate detections of all particles of the cell: the three contiguous item ranges of the
-    // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
-    std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
-    bool any_candidate = false;
-    if (hi > lo) {
-      const auto [bx, by] = BucketOf(q.x[lo], q.y[lo]);
-      const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx_ - 1, bx + 1);
-      for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++r) {
-        const std::int64_t row = static_cast<std::int64_t>(yy) * nbx_;
-        cand[r][0] = bucket_start_[row + x_lo];
-        cand[r][1] = bucket_start_[row + x_hi + 1];
-        any_candidate = any_candidate || cand[r][1] > cand[r][0];
+      const double z_occ = p.occupied_mass * occ_k;
+      double z_free = 0.0;
+      if (observed) {
+        if (view & kFreeRay) {
+          z_free = p.free_mass * (1.0 - occ_k);
+        } else if (view & kNoReturn) {
+          z_free = p.free_mass_no_return * (1.0 - occ_k);
+        }
       }
-    }
-    for (std::int64_t i = lo; i < hi; ++i) {
-      const double m = q.weight[i] * cap;
-      q.weight[i] = m;
-      if (q.vx[i] * q.vx[i] + q.vy[i] * q.vy[i] < slow2) {
-        // A particle at (almost) zero speed is the static hypothesis (occ and v = 0): its mass
-        // votes static and the particle dies at resampling.
-        slow_mass += m;
-        q.w_position[i] = q.w_velocity[i] = q.weight[i] = 0.0;
-        continue;
+      const double z_unk = 1.0 - z_occ - z_free;
+
+      // --- Temporal fusion (Dempster's rule on {free, occupied}). ---
+      const double conflict = o_pred * z_free + f_pred * z_occ;
+      const double norm = 1.0 / (1.0 - conflict);
+      double o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
+      double f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
+      if (o_up + f_up > 1.0) {  // rounding only
+        const double k = 1.0 / (o_up + f_up);
+        o_up *= k;
+        f_up *= k;
       }
-      // Nearest detection within the cutoff (ties to the lower detection index).
-      int jn = -1;
-      double d2 = cutoff2;
-      if (any_candidate) {
-        const double px = q.x[i], py = q.y[i];
-        for (const auto& range : cand) {
-          for (std::int64_t k = range[0]; k < range[1]; ++k) {
-            const double ex = det_x_[k] - px, ey = det_y_[k] - py;
-            const double e2 = ex * ex + ey * ey;
-            if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items_[k] < jn)) {
-              d2 = e2;
-              jn = bucket_items_[k];
+
+      // --- Particle weights, eqs. (7) and (8), unnormalised. The per-cycle factors double as the
+      // likelihood of each hypothesis in the joint normalisation below. ---
+      const auto mode_factor = [&](double lp, double lv) {
+        return p.mode == WeightMode::kPosition   ? lp
+               : p.mode == WeightMode::kVelocity ? lv
+                                                 : std::max(lp, lv);  // eq. (14)
+      };
+      double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
+      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
+      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
+      std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+      bool any_candidate = false;
+      if (hi > lo) {
+        const auto [bx, by] = BucketOf(q.x[lo], q.y[lo]);
+        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx_ - 1, bx + 1);
+        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++r) {
+          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx_;
+          cand[r][0] = bucket_start_[row + x_lo];
+          cand[r][1] = bucket_start_[row + x_hi + 1];
+          any_candidate = any_candidate || cand[r][1] > cand[r][0];
+        }
+      }
+      for (std::int64_t i = lo; i < hi; ++i) {
+        const double m = q.weight[i] * cap;
+        q.weight[i] = m;
+        if (q.vx[i] * q.vx[i] + q.vy[i] * q.vy[i] < slow2) {
+          // A particle at (almost) zero speed is the static hypothesis (occ and v = 0): its mass
+          // votes static and the particle dies at resampling.
+          slow_mass += m;
+          q.w_position[i] = q.w_velocity[i] = q.weight[i] = 0.0;
+          continue;
+        }
+        // Nearest detection within the cutoff (ties to the lower detection index).
+        int jn = -1;
+        double d2 = cutoff2;
+        if (any_candidate) {
+          const double px = q.x[i], py = q.y[i];
+          for (const auto& range : cand) {
+            for (std::int64_t k = range[0]; k < range[1]; ++k) {
+              const double ex = det_x_[k] - px, ey = det_y_[k] - py;
+              const double e2 = ex * ex + ey * ey;
+              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items_[k] < jn)) {
+                d2 = e2;
+                jn = bucket_items_[k];
+              }
             }
           }
         }
-      }
-      double lp = keep, lv = keep;  // unobserved: decayed prior
-      if (jn >= 0 || observed) {
-        // Float exp: kernel values need no double precision and this runs per particle.
-        const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
-        double fv = 0.0;
-        if (jn >= 0) {
-          const double ex = q.vx[i] - z[jn].radial_velocity.x();
-          const double ey = q.vy[i] - z[jn].radial_velocity.y();
-          fv = ExpUnder(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
+        double lp = keep, lv = keep;  // unobserved: decayed prior
+        if (jn >= 0 || observed) {
+          // Float exp: kernel values need no double precision and this runs per particle.
+          const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
+          double fv = 0.0;
+          if (jn >= 0) {
+            const double ex = q.vx[i] - z[jn].radial_velocity.x();
+            const double ey = q.vy[i] - z[jn].radial_velocity.y();
+            fv = ExpUnder(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
+          }
+          lp = fd * keep;                    // eq. (7)
+          lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
         }
-        lp = fd * keep;                    // eq. (7)
-        lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
+        const double wp = lp * q.w_position[i], wv = lv * q.w_velocity[i];
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        fast_mass += m;
+        sum_pos += wp;
+        sum_vel += wv;
+        a_dyn += m * mode_factor(lp, lv);
       }
-      const double wp = lp * q.w_position[i], wv = lv * q.w_velocity[i];
-      q.w_position[i] = wp;
-      q.w_velocity[i] = wv;
-      fast_mass += m;
-      sum_pos += wp;
-      sum_vel += wv;
-      a_dyn += m * mode_factor(lp, lv);
-    }
-    // The static hypothesis is scored like a particle with v = 0 at the cell centre.
-    double ls_pos = keep, ls_vel = keep;
-    if (j >= 0 || observed) {
-      const double fv0 = j >= 0 ? ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2) : 0.0;
-      ls_pos = occ_k * keep;
-      ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
-    }
-    const double l_static = mode_factor(ls_pos, ls_vel);
+      // The static hypothesis is scored like a particle with v = 0 at the cell centre.
+      double ls_pos = keep, ls_vel = keep;
+      if (j >= 0 || observed) {
+        const double fv0 = j >= 0 ? ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2) : 0.0;
+        ls_pos = occ_k * keep;
+        ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
+      }
+      const double l_static = mode_factor(ls_pos, ls_vel);
 
-    // --- Joint normalisation of the occupied mass (eqs. 9-12 on o_up). ---
-    double a_static = (s_pred + slow_mass) * l_static + p.static_gain * p.occupied_mass * static_k;
-    // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
-    // such returns are clutter; their occupied mass stays unassigned (unknown).
-    const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
-    const double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
-    if (a_static + a_dyn + a_birth <= 0.0) {
-      // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
-      // the measurement cannot arbitrate, so the predicted split is kept.
-      a_static = s_pred + slow_mass;
-      a_dyn = fast_mass;
-    }
-    const double q_norm = a_static + a_dyn + a_birth;
-    double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
-    if (q_norm > 0.0) {
-      s_up = o_up * a_static / q_norm;
-      rho_p = o_up * a_dyn / q_norm;
-      rho_b = o_up * a_birth / q_norm;
-    }
+      // --- Joint normalisation of the occupied mass (eqs. 9-12 on o_up). ---
+      double a_static =
+          (s_pred + slow_mass) * l_static + p.static_gain * p.occupied_mass * static_k;
+      // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
+      // such returns are clutter; their occupied mass stays unassigned (unknown).
+      const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
+      const double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
+      if (a_static + a_dyn + a_birth <= 0.0) {
+        // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
+        // the measurement cannot arbitrate, so the predicted split is kept.
+        a_static = s_pred + slow_mass;
+        a_dyn = fast_mass;
+      }
+      const double q_norm = a_static + a_dyn + a_birth;
+      double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
+      if (q_norm > 0.0) {
+        s_up = o_up * a_static / q_norm;
+        rho_p = o_up * a_dyn / q_norm;
+        rho_b = o_up * a_birth / q_norm;
+      }
 
-    // --- Normalise weights so that they sum to rho_p in the cell; w_resample by mode. ---
-    double sum_res = 0.0;
-    for (std::int64_t i = lo; i < hi; ++i) {
-      if (q.weight[i] == 0.0) continue;
-      const double m = q.weight[i];
-      const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
-      const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
-      q.w_position[i] = wp;
-      q.w_velocity[i] = wv;
-      const double wr = mode_factor(wp, wv);  // w_resample
-      q.weight[i] = wr;
-      sum_res += wr;
+      // --- Normalise weights so that they sum to rho_p in the cell; w_resample by mode. ---
+      double sum_res = 0.0;
+      for (std::int64_t i = lo; i < hi; ++i) {
+        if (q.weight[i] == 0.0) continue;
+        const double m = q.weight[i];
+        const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
+        const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        const double wr = mode_factor(wp, wv);  // w_resample
+        q.weight[i] = wr;
+        sum_res += wr;
+      }
+      if (sum_res > 0.0) {
+        const double k = rho_p / sum_res;
+        for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
+      }
+      free_[s] = f_up;
+      static_[s] = s_up;
+      // Reported dynamic mass: persistent particles only. New-born mass is occupied mass whose
+      // motion no prediction has confirmed yet; counting it as dynamic would mark every new
+      // detection with a Doppler (clutter included) dynamic at once. It stays in the unknown share
+      // of the cell until its particles survive a cycle (docs/algorithm.md, step 5).
+      dynamic_[s] = rho_p;
+      born_[s] = rho_b;
+      if (rho_b != 0.0) born_list[n_born++] = s;
     }
-    if (sum_res > 0.0) {
-      const double k = rho_p / sum_res;
-      for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
-    }
-    free_[s] = f_up;
-    static_[s] = s_up;
-    // Reported dynamic mass: persistent particles only. New-born mass is occupied mass whose motion
-    // no prediction has confirmed yet; counting it as dynamic would mark every new detection with
-    // a Doppler (clutter included) dynamic at once. It stays in the unknown share of the cell
-    // until its particles survive a cycle (docs/algorithm.md, step 5).
-    dynamic_[s] = rho_p;
-    born_[s] = rho_b;
-    }
+    born_count_[ch] = n_born;
   }
 }
 
@@ -810,15 +867,21 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
   const std::int64_t blocks = (nc + kScanBlock - 1) / kScanBlock;
   std::vector<double>& tot = born_block_;
   tot.resize(blocks + 1);
-#pragma omp parallel for schedule(static) if (blocks > 1)
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t lo = b * kScanBlock, hi = std::min(nc, lo + kScanBlock);
-    double acc = 0.0;
-    // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so skipping them
-    // keeps the sum bit-identical and avoids the add latency chain.
-    for (std::int64_t s = lo; s < hi; ++s) {
-      if (born_[s] != 0.0) acc += born_[s];
+  // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so only the cells of
+  // UpdateCells' per-chunk lists (non-zero mass, in cell order) are visited: same sums.
+  const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
+  constexpr std::int64_t kChunksPerBlock = kScanBlock / kCellChunk;
+  const auto for_each_born = [&](std::int64_t b, auto&& f) {
+    for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
+         ++ch) {
+      const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+      for (std::int32_t t = 0; t < born_count_[ch]; ++t) f(list[t]);
     }
+  };
+#pragma omp parallel for schedule(static) if (blocks > 8)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    double acc = 0.0;
+    for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
     tot[b + 1] = acc;
   }
   tot[0] = 0.0;
@@ -844,21 +907,40 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
     if (i == nc) return nb;
     return std::clamp(CeilToInt(cumulative * scale - u), std::int64_t{0}, nb);
   };
-#pragma omp parallel for schedule(static)
+  // Running sum at each chunk start (sequential from the block base, as in the loop below), so
+  // that the births can be generated chunk by chunk (load balance: births cluster in few blocks).
+  double* const chunk_acc = born_chunk_acc_.data();
+#pragma omp parallel for schedule(static) if (blocks > 8)
   for (std::int64_t b = 0; b < blocks; ++b) {
-    const std::int64_t lo = b * kScanBlock, hi = std::min(nc, lo + kScanBlock);
     double acc = tot[b];
-    for (std::int64_t s = lo; s < hi; ++s) {
-      const double born = born_[s];
-      const bool block_end = s + 1 == hi;
-      // Inside a block a zero mass leaves the running sum unchanged: empty range.
-      if (born == 0.0 && !block_end) continue;
+    for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
+         ++ch) {
+      chunk_acc[ch] = acc;
+      const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+      for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t ch = 0; ch < n_chunks; ++ch) {
+    const std::int64_t b = ch / kChunksPerBlock;
+    const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;
+    const bool has_last = last < (ch + 1) * kCellChunk;  // the block's last cell is in this chunk
+    double acc = chunk_acc[ch];
+    bool last_seen = false;
+    // Inside a block a zero mass leaves the running sum unchanged: empty range. Only the cells
+    // with mass and the block's last cell (where the block total takes over) can get births.
+    const auto visit = [&](std::int64_t s, double born) {
+      const bool block_end = s == last;
+      last_seen = last_seen || block_end;
       const double cum_s = acc;
       if (born != 0.0) acc += born;
       const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
-      if (k_lo == k_hi) continue;
+      if (k_lo == k_hi) return;
       GenerateBirths(z, s, k_lo, k_hi, mass, r, vmax);
-    }
+    };
+    const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+    for (std::int32_t t = 0; t < born_count_[ch]; ++t) visit(list[t], born_[list[t]]);
+    if (has_last && !last_seen) visit(last, 0.0);
   }
 }
 

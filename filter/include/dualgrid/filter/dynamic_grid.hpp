@@ -136,6 +136,10 @@ class DynamicGrid {
   std::vector<std::int64_t> hist_total_;
   std::vector<double> scan_out_;    // resampling prefix sums of the source weights
   std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
+  // Cells with non-zero birth mass, per UpdateCells chunk (slots [chunk * size, + count)).
+  std::vector<std::int64_t> born_cells_;
+  std::vector<std::int32_t> born_count_;
+  std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
@@ -147,7 +151,8 @@ class DynamicGrid {
   std::vector<double> bin_range_;
   std::vector<std::int64_t> bin_offset_;
   std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
-  std::vector<double> sensor_trig_;       // per sensor: cos, sin of the boresight, tan(half_fov)
+  std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
+  std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
 };
 
 }  // namespace dualgrid::filter
