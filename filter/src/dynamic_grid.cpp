@@ -643,6 +643,13 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double max_speed2 = p.max_speed * p.max_speed;
   const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
   ParticleSet& q = sorted_;
+  // f_v of the static hypothesis (v = 0) per detection: once per detection, not per cell.
+  const int nz = static_cast<int>(z.size());
+  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grows only
+  for (int j = 0; j < nz; ++j) {
+    det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
+  }
+  const double* const fv0_of = det_fv0_.data();
   const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
   const double static_persistence = p.static_persistence, free_decay = p.free_decay;
   const std::int64_t* const start = cell_start_.data();
@@ -801,7 +808,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       // The static hypothesis is scored like a particle with v = 0 at the cell centre.
       double ls_pos = keep, ls_vel = keep;
       if (j >= 0 || observed) {
-        const double fv0 = j >= 0 ? ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2) : 0.0;
+        const double fv0 = j >= 0 ? fv0_of[j] : 0.0;
         ls_pos = occ_k * keep;
         ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
       }
