@@ -1,6 +1,7 @@
 #include "dualgrid/scenario/loader.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 #include "yaml_reader.hpp"
 
@@ -134,6 +135,91 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   }
 }
 
+// One table per parameter struct: the YAML key, the member, and whether the file gives it in
+// degrees. The loader reads and ConfigToJson writes through the same tables, so a new parameter
+// is one line here.
+template <typename S, typename T>
+struct Field {
+  const char* key;
+  T S::*member;
+  bool degrees = false;
+};
+using FP = filter::FilterParams;
+using SP = radar::SensorParams;
+const Field<FP, double> kFilterDoubles[] = {
+    {"length_x", &FP::length_x},
+    {"width_y", &FP::width_y},
+    {"resolution", &FP::resolution},
+    {"process_noise_position", &FP::process_noise_position},
+    {"process_noise_velocity", &FP::process_noise_velocity},
+    {"persistence", &FP::persistence},
+    {"birth_probability", &FP::birth_probability},
+    {"birth_max_tangential_speed", &FP::birth_max_tangential_speed},
+    {"birth_sigma_radial", &FP::birth_sigma_radial},
+    {"max_speed", &FP::max_speed},
+    {"sigma_f", &FP::sigma_f},
+    {"sigma_static_distance", &FP::sigma_static_distance},
+    {"sigma_static_velocity", &FP::sigma_static_velocity},
+    {"sigma_v", &FP::sigma_v},
+    {"cutoff_sigmas", &FP::cutoff_sigmas},
+    {"occupied_mass", &FP::occupied_mass},
+    {"free_mass", &FP::free_mass},
+    {"free_mass_no_return", &FP::free_mass_no_return},
+    {"free_angle_bin_deg", &FP::free_angle_bin, true},
+    {"free_decay", &FP::free_decay},
+    {"static_persistence", &FP::static_persistence},
+    {"static_gain", &FP::static_gain},
+    {"static_speed", &FP::static_speed},
+    {"decay_eps", &FP::decay_eps},
+};
+const Field<FP, int> kFilterInts[] = {
+    {"num_particles", &FP::num_particles},
+    {"num_birth", &FP::num_birth},
+    {"free_bin_dilation", &FP::free_bin_dilation},
+};
+const Field<SP, double> kSensorDoubles[] = {
+    {"fov_deg", &SP::fov, true},
+    {"min_range", &SP::min_range},
+    {"max_range", &SP::max_range},
+    {"min_range_rate", &SP::min_range_rate},
+    {"max_range_rate", &SP::max_range_rate},
+    {"range_resolution", &SP::range_resolution},
+    {"azimuth_resolution_deg", &SP::azimuth_resolution, true},
+    {"range_rate_resolution", &SP::range_rate_resolution},
+    {"range_bias_fraction", &SP::range_bias_fraction},
+    {"azimuth_bias_fraction", &SP::azimuth_bias_fraction},
+    {"range_rate_bias_fraction", &SP::range_rate_bias_fraction},
+    {"reference_range", &SP::reference_range},
+    {"reference_rcs_dbsm", &SP::reference_rcs_dbsm},
+    {"reference_pd", &SP::reference_pd},
+    {"false_alarm_rate", &SP::false_alarm_rate},
+    {"update_period", &SP::update_period},
+};
+
+template <typename S, typename T, std::size_t N>
+void ReadFields(MapReader& r, const Field<S, T> (&fields)[N], S* out) {
+  for (const auto& f : fields) {
+    if constexpr (std::is_same_v<T, double>) {
+      if (f.degrees) {
+        r.ReadDegrees(f.key, &(out->*f.member));
+        continue;
+      }
+    }
+    r.Read(f.key, &(out->*f.member));
+  }
+}
+
+template <typename S, typename T, std::size_t N>
+void WriteFields(const Field<S, T> (&fields)[N], const S& in, nlohmann::json* j) {
+  for (const auto& f : fields) {
+    if constexpr (std::is_same_v<T, double>) {
+      (*j)[f.key] = f.degrees ? RadToDeg(in.*f.member) : in.*f.member;
+    } else {
+      (*j)[f.key] = in.*f.member;
+    }
+  }
+}
+
 void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
   if (auto m = r.Map("mount")) {
     m->Read("x", &p->mount.position.x());
@@ -141,22 +227,7 @@ void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
     m->ReadDegrees("yaw_deg", &p->mount.yaw);
     m->Finish();
   }
-  r.ReadDegrees("fov_deg", &p->fov);
-  r.Read("min_range", &p->min_range);
-  r.Read("max_range", &p->max_range);
-  r.Read("min_range_rate", &p->min_range_rate);
-  r.Read("max_range_rate", &p->max_range_rate);
-  r.Read("range_resolution", &p->range_resolution);
-  r.ReadDegrees("azimuth_resolution_deg", &p->azimuth_resolution);
-  r.Read("range_rate_resolution", &p->range_rate_resolution);
-  r.Read("range_bias_fraction", &p->range_bias_fraction);
-  r.Read("azimuth_bias_fraction", &p->azimuth_bias_fraction);
-  r.Read("range_rate_bias_fraction", &p->range_rate_bias_fraction);
-  r.Read("reference_range", &p->reference_range);
-  r.Read("reference_rcs_dbsm", &p->reference_rcs_dbsm);
-  r.Read("reference_pd", &p->reference_pd);
-  r.Read("false_alarm_rate", &p->false_alarm_rate);
-  r.Read("update_period", &p->update_period);
+  ReadFields(r, kSensorDoubles, p);
 }
 
 // Turns "field: message" from an IsValid into a ConfigError under `section`.
@@ -223,33 +294,8 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
 void ReadFilter(MapReader& root, filter::FilterParams* f) {
   auto r = root.Map("filter");
   if (!r) return;
-  r->Read("length_x", &f->length_x);
-  r->Read("width_y", &f->width_y);
-  r->Read("resolution", &f->resolution);
-  r->Read("num_particles", &f->num_particles);
-  r->Read("num_birth", &f->num_birth);
-  r->Read("process_noise_position", &f->process_noise_position);
-  r->Read("process_noise_velocity", &f->process_noise_velocity);
-  r->Read("persistence", &f->persistence);
-  r->Read("birth_probability", &f->birth_probability);
-  r->Read("birth_max_tangential_speed", &f->birth_max_tangential_speed);
-  r->Read("birth_sigma_radial", &f->birth_sigma_radial);
-  r->Read("max_speed", &f->max_speed);
-  r->Read("sigma_f", &f->sigma_f);
-  r->Read("sigma_static_distance", &f->sigma_static_distance);
-  r->Read("sigma_static_velocity", &f->sigma_static_velocity);
-  r->Read("sigma_v", &f->sigma_v);
-  r->Read("cutoff_sigmas", &f->cutoff_sigmas);
-  r->Read("occupied_mass", &f->occupied_mass);
-  r->Read("free_mass", &f->free_mass);
-  r->Read("free_mass_no_return", &f->free_mass_no_return);
-  r->ReadDegrees("free_angle_bin_deg", &f->free_angle_bin);
-  r->Read("free_bin_dilation", &f->free_bin_dilation);
-  r->Read("free_decay", &f->free_decay);
-  r->Read("static_persistence", &f->static_persistence);
-  r->Read("static_gain", &f->static_gain);
-  r->Read("static_speed", &f->static_speed);
-  r->Read("decay_eps", &f->decay_eps);
+  ReadFields(*r, kFilterDoubles, f);
+  ReadFields(*r, kFilterInts, f);
   std::string mode(filter::ToString(f->mode));
   r->Read("mode", &mode);
   const auto parsed = filter::ParseWeightMode(mode);
@@ -325,6 +371,38 @@ ScenarioConfig LoadScenario(const std::filesystem::path& file) {
                       std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   return config;
+}
+
+nlohmann::json ConfigToJson(const ScenarioConfig& c) {
+  nlohmann::json j;
+  j["scenario_file"] = c.file.string();
+  j["scenario"] = c.sim.name;
+  j["seed"] = c.sim.seed;
+  j["duration_s"] = c.sim.duration;
+  j["step_length_s"] = c.sim.step_length;
+  j["sensors"]["noise"] = c.radar.options.noise;
+  j["sensors"]["false_alarms"] = c.radar.options.false_alarms;
+  j["sensors"]["occlusion"] = c.radar.options.occlusion;
+  for (const auto& s : c.radar.sensors) {
+    nlohmann::json sj = {{"name", s.name},
+                         {"mount",
+                          {{"x", s.mount.position.x()},
+                           {"y", s.mount.position.y()},
+                           {"yaw_deg", RadToDeg(s.mount.yaw)}}}};
+    WriteFields(kSensorDoubles, s, &sj);
+    j["sensors"]["rig"].push_back(sj);
+  }
+  WriteFields(kFilterDoubles, c.filter, &j["filter"]);
+  WriteFields(kFilterInts, c.filter, &j["filter"]);
+  j["filter"]["mode"] = filter::ToString(c.filter.mode);
+  auto& e = j["evaluation"];
+  e["dynamic_threshold"] = c.evaluation.dynamic_threshold;
+  e["min_cluster_mass"] = c.evaluation.min_cluster_mass;
+  e["dbscan"] = c.evaluation.dbscan;
+  e["tracking"] = c.evaluation.tracking;
+  e["focus_object"] = c.evaluation.focus_object;
+  e["snapshot_times"] = c.evaluation.snapshot_times;
+  return j;
 }
 
 void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out) {

@@ -139,3 +139,30 @@ TEST_CASE("Filter and sensor sections are validated by their own structs", "[loa
   REQUIRE(ok.radar.sensors.size() == 1);
   CHECK(ok.radar.sensors[0].name == "front");
 }
+
+TEST_CASE("config.json keys read back as scenario keys with the same values", "[loader]") {
+  // Change a few values, write the resolved configuration, feed its filter and sensor sections
+  // back as YAML (JSON is YAML) and expect the same parameters: one key table serves both ways.
+  const auto first = LoadScenario(Write(
+      "rt1.yaml", std::string(kValid) +
+                      "filter: {num_particles: 3000, sigma_f: 0.45, free_angle_bin_deg: 2.0}\n"
+                      "sensors:\n  overrides:\n    front: {max_range: 150, fov_deg: 16}\n"));
+  const nlohmann::json j = ConfigToJson(first);
+  std::string yaml =
+      std::string(kValid) + "filter: " + j.at("filter").dump() + "\nsensors:\n" + "  overrides:\n";
+  for (auto s : j.at("sensors").at("rig")) {
+    const std::string name = s.at("name");
+    s.erase("name");
+    yaml += "    " + name + ": " + s.dump() + "\n";
+  }
+  const auto second = LoadScenario(Write("rt2.yaml", yaml));
+  CHECK(second.filter.num_particles == 3000);
+  CHECK(second.filter.sigma_f == Approx(0.45));
+  CHECK(second.filter.free_angle_bin == Approx(first.filter.free_angle_bin));
+  CHECK(ConfigToJson(second).at("filter") == j.at("filter"));
+  for (std::size_t i = 0; i < first.radar.sensors.size(); ++i) {
+    CHECK(second.radar.sensors[i].max_range == Approx(first.radar.sensors[i].max_range));
+    CHECK(second.radar.sensors[i].fov == Approx(first.radar.sensors[i].fov));
+    CHECK(second.radar.sensors[i].mount.yaw == Approx(first.radar.sensors[i].mount.yaw));
+  }
+}

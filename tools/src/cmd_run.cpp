@@ -33,79 +33,10 @@ std::vector<filter::WeightMode> ParseModes(const std::vector<std::string>& names
 
 namespace {
 
-nlohmann::json SensorJson(const radar::SensorParams& s) {
-  return {{"name", s.name},
-          {"mount",
-           {{"x", s.mount.position.x()},
-            {"y", s.mount.position.y()},
-            {"yaw_deg", RadToDeg(s.mount.yaw)}}},
-          {"fov_deg", RadToDeg(s.fov)},
-          {"min_range", s.min_range},
-          {"max_range", s.max_range},
-          {"min_range_rate", s.min_range_rate},
-          {"max_range_rate", s.max_range_rate},
-          {"range_resolution", s.range_resolution},
-          {"azimuth_resolution_deg", RadToDeg(s.azimuth_resolution)},
-          {"range_rate_resolution", s.range_rate_resolution},
-          {"range_bias_fraction", s.range_bias_fraction},
-          {"azimuth_bias_fraction", s.azimuth_bias_fraction},
-          {"range_rate_bias_fraction", s.range_rate_bias_fraction},
-          {"reference_range", s.reference_range},
-          {"reference_rcs_dbsm", s.reference_rcs_dbsm},
-          {"reference_pd", s.reference_pd},
-          {"false_alarm_rate", s.false_alarm_rate},
-          {"update_period", s.update_period}};
-}
-
-nlohmann::json FilterJson(const filter::FilterParams& f) {
-  return {{"length_x", f.length_x},
-          {"width_y", f.width_y},
-          {"resolution", f.resolution},
-          {"num_particles", f.num_particles},
-          {"num_birth", f.num_birth},
-          {"process_noise_position", f.process_noise_position},
-          {"process_noise_velocity", f.process_noise_velocity},
-          {"persistence", f.persistence},
-          {"birth_probability", f.birth_probability},
-          {"birth_max_tangential_speed", f.birth_max_tangential_speed},
-          {"birth_sigma_radial", f.birth_sigma_radial},
-          {"max_speed", f.max_speed},
-          {"sigma_f", f.sigma_f},
-          {"sigma_static_distance", f.sigma_static_distance},
-          {"sigma_static_velocity", f.sigma_static_velocity},
-          {"sigma_v", f.sigma_v},
-          {"cutoff_sigmas", f.cutoff_sigmas},
-          {"occupied_mass", f.occupied_mass},
-          {"free_mass", f.free_mass},
-          {"free_mass_no_return", f.free_mass_no_return},
-          {"free_angle_bin_deg", RadToDeg(f.free_angle_bin)},
-          {"free_bin_dilation", f.free_bin_dilation},
-          {"free_decay", f.free_decay},
-          {"static_persistence", f.static_persistence},
-          {"static_gain", f.static_gain},
-          {"static_speed", f.static_speed},
-          {"decay_eps", f.decay_eps}};
-}
-
 // Everything the run actually used, so any result can be rerun or compared.
 nlohmann::json ConfigJson(const scenario::ScenarioConfig& c, const FilterRunOptions& o) {
-  nlohmann::json j;
-  j["scenario_file"] = c.file.string();
-  j["scenario"] = c.sim.name;
-  j["seed"] = c.sim.seed;
-  j["duration_s"] = c.sim.duration;
-  j["step_length_s"] = c.sim.step_length;
+  nlohmann::json j = scenario::ConfigToJson(c);
   j["modes"] = o.modes;
-  j["radar"]["noise"] = c.radar.options.noise;
-  j["radar"]["false_alarms"] = c.radar.options.false_alarms;
-  j["radar"]["occlusion"] = c.radar.options.occlusion;
-  for (const auto& s : c.radar.sensors) j["radar"]["sensors"].push_back(SensorJson(s));
-  j["filter"] = FilterJson(c.filter);
-  j["evaluation"]["dynamic_threshold"] = c.evaluation.dynamic_threshold;
-  j["evaluation"]["dbscan"] = c.evaluation.dbscan;
-  j["evaluation"]["min_cluster_mass"] = c.evaluation.min_cluster_mass;
-  j["evaluation"]["tracking"] = c.evaluation.tracking;
-  j["evaluation"]["focus_object"] = c.evaluation.focus_object;
   return j;
 }
 

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "dualgrid/eval/dbscan.hpp"
 #include "dualgrid/eval/metrics.hpp"
 #include "dualgrid/filter/params.hpp"
@@ -49,6 +51,9 @@ struct ScenarioConfig {
   filter::FilterParams filter;
   EvaluationConfig evaluation;
 };
+
+/// Every resolved parameter, for the run folder's config.json (same keys and units as the file).
+nlohmann::json ConfigToJson(const ScenarioConfig& config);
 
 /// Loads and validates a scenario file. Throws ConfigError.
 ScenarioConfig LoadScenario(const std::filesystem::path& file);
