@@ -44,21 +44,28 @@ Dbscan::Dbscan(const DbscanParams& params) : params_(params) {
 }
 
 template <typename F>
-void Dbscan::ForEachNeighbour(std::span<const Position> points, int i, F&& f) const {
-  const double eps2 = params_.eps * params_.eps;
-  const Position& p = points[i];
+void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
   const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
   for (std::int64_t dx = -1; dx <= 1; ++dx) {
     for (std::int64_t dy = -1; dy <= 1; ++dy) {
       const auto it = bucket_of_key_.find(PackKey(ix + dx, iy + dy));
-      if (it == bucket_of_key_.end()) continue;
-      for (int s = start_[it->second]; s < start_[it->second + 1]; ++s) {
-        const int j = sorted_[s];
-        if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return;
-      }
+      if (it != bucket_of_key_.end() && !f(it->second)) return;
     }
   }
+}
+
+template <typename F>
+void Dbscan::ForEachNeighbour(std::span<const Position> points, int i, F&& f) const {
+  const double eps2 = params_.eps * params_.eps;
+  const Position& p = points[i];
+  ForEachNearBucket(p, [&](int b) {
+    for (int s = start_[b]; s < start_[b + 1]; ++s) {
+      const int j = sorted_[s];
+      if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return false;
+    }
+    return true;
+  });
 }
 
 std::span<const int> Dbscan::Run(std::span<const Position> points,
@@ -150,25 +157,19 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
       const int i = stack_.back();
       stack_.pop_back();
       const Position& p = points[i];
-      const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
-      const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        for (std::int64_t dy = -1; dy <= 1; ++dy) {
-          const auto it = bucket_of_key_.find(PackKey(ix + dx, iy + dy));
-          if (it == bucket_of_key_.end()) continue;
-          const int b = it->second;
-          for (int s = core_start_[b]; s < core_start_[b] + core_live_[b];) {
-            const int j = core_sorted_[s];
-            if ((points[j] - p).squaredNorm() <= eps2) {
-              component_[j] = c;
-              stack_.push_back(j);
-              remove_core(j);  // slot s now holds another live point (or the range shrank)
-            } else {
-              ++s;
-            }
+      ForEachNearBucket(p, [&](int b) {
+        for (int s = core_start_[b]; s < core_start_[b] + core_live_[b];) {
+          const int j = core_sorted_[s];
+          if ((points[j] - p).squaredNorm() <= eps2) {
+            component_[j] = c;
+            stack_.push_back(j);
+            remove_core(j);  // slot s now holds another live point (or the range shrank)
+          } else {
+            ++s;
           }
         }
-      }
+        return true;
+      });
     }
   }
 

@@ -99,12 +99,14 @@ int RunFilters(const FilterRunOptions& options) {
     if (detections) detections->Write(pipeline);
     total_detections += pipeline.detections().size();
     std::vector<GridSnapshot> snaps;
+    // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
+    // and per object is computed once for the first and holds for every mode.
     std::vector<std::uint8_t> truth_classes;
+    const std::vector<eval::TruthObject> objects = pipeline.TruthObjects(pipeline.grid(0));
     for (std::size_t m = 0; m < modes.size(); ++m) {
       const auto& grid = pipeline.grid(m);
       snaps.push_back(TakeSnapshot(grid));
       if (m == 0) truth_classes = TruthClasses(snaps[0], f, config.sim);
-      const std::vector<eval::TruthObject> objects = pipeline.TruthObjects(grid);
       scorers[m].AddFrame(f.time, grid, snaps[m], objects, truth_classes, f.ego.box);
       const auto& a = scorers[m].association();
       for (std::size_t c = 0; c < scorers[m].clusters().size(); ++c) {

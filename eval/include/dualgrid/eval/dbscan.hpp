@@ -66,6 +66,9 @@ class Dbscan {
   // Calls f(j) for every point j within eps of points[i] (i itself included).
   template <typename F>
   void ForEachNeighbour(std::span<const Position> points, int i, F&& f) const;
+  // Calls f(bucket) for the existing buckets of the 3 x 3 hash cells around p until f is false.
+  template <typename F>
+  void ForEachNearBucket(const Position& p, F&& f) const;
 
   DbscanParams params_;
   double inv_eps_ = 1.0;
