@@ -49,7 +49,10 @@ int CountLines(const std::string& s) {
 TEST_CASE("--help lists the subcommands", "[cli]") {
   const Result r = Run("--help");
   CHECK(r.code == 0);
-  CHECK(r.output.find("sim") != std::string::npos);
+  // Each subcommand on its own line of the Subcommands section.
+  for (const char* name :
+       {"\n  sim ", "\n  snapshot ", "\n  run ", "\n  experiment ", "\n  tangential "})
+    CHECK(r.output.find(name) != std::string::npos);
 }
 
 TEST_CASE("Same scenario and seed give identical ground truth; another seed differs", "[cli]") {
