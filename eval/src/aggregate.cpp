@@ -195,8 +195,19 @@ std::string ComparisonTable::ToMarkdown() const {
     }
     os << '\n';
   }
-  os << "\nMean ± half-width of the 95 % confidence interval of the mean over " << max_n << " seed"
-     << (max_n == 1 ? "" : "s") << " (Student t).\n";
+  if (max_n > 1)
+    os << "\nMean ± half-width of the 95 % confidence interval of the mean over " << max_n
+       << " seeds (Student t).\n";
+  else
+    os << "\nOne seed: values of a single run, no confidence interval.\n";
+  bool any_empty = false;
+  for (const auto& row : ours_)
+    for (const auto& cell : row) any_empty = any_empty || !cell || cell->n == 0;
+  if (any_empty)
+    os << "\n— : not defined in this run: Δx, Δv and the distance to the box need at least one "
+          "tracked frame, t_d an object that was consistently tracked, D a scored object (one "
+          "in the grid for at least `evaluation.min_frames_in_grid` frames).\n";
+  for (const std::string& note : notes_) os << "\n" << note << "\n";
   return os.str();
 }
 
@@ -244,7 +255,7 @@ nlohmann::json ComparisonTable::ToJson() const {
     }
     metrics.push_back({{"key", m.key}, {"label", m.label}, {"unit", m.unit}, {"values", values}});
   }
-  return {{"scenario", scenario_}, {"modes", modes_}, {"metrics", metrics}};
+  return {{"scenario", scenario_}, {"modes", modes_}, {"metrics", metrics}, {"notes", notes_}};
 }
 
 ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const ModeRuns> runs) {
@@ -273,9 +284,17 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
        [](const ScenarioMetrics& m) {
          return std::optional<double>(m.duplicate_clusters_per_scan);
        }},
+      {{std::string(kScored), "objects scored", "", 1.0, 1},
+       [](const ScenarioMetrics& m) {
+         return std::optional<double>(static_cast<double>(m.objects_scored));
+       }},
       {{std::string(kNeverTracked), "objects never tracked", "", 1.0, 1},
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_never_tracked));
+       }},
+      {{std::string(kNeverObservable), "… of which never in radar coverage", "", 1.0, 1},
+       [](const ScenarioMetrics& m) {
+         return std::optional<double>(static_cast<double>(m.objects_never_observable));
        }},
   };
   bool any_cells = false;

@@ -141,10 +141,9 @@ ScenarioMetrics TrackingMetricsAccumulator::Result() const {
       if (o.detection_time) {
         ++m.objects_detected;
         td_sum += *o.detection_time;
-      } else if (o.clock_start_time) {
-        ++m.objects_never_tracked;
       } else {
-        ++m.objects_never_observable;
+        ++m.objects_never_tracked;
+        if (!o.clock_start_time) ++m.objects_never_observable;
       }
     }
     m.objects.push_back(o);

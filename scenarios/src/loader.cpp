@@ -24,6 +24,12 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   root.Read("name", &s->name);
   root.Read("description", &s->description);
   root.Require("network", &s->network);
+  // A network given as a file (ending in .xml) is read relative to the scenario file, so a
+  // scenario and its network can move together; a bare name is one of the built networks.
+  if (const std::filesystem::path net(s->network); net.extension() == ".xml" && net.is_relative())
+    s->network = std::filesystem::absolute(std::filesystem::path(root.file()).parent_path() / net)
+                     .lexically_normal()
+                     .string();
   root.Read("duration", &s->duration);
   root.Read("step_length", &s->step_length);
   root.Read("seed", &s->seed);

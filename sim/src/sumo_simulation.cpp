@@ -75,10 +75,22 @@ std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir) {
   std::filesystem::path p = network;
   if (p.extension() != ".xml") p = network_dir / (network + ".net.xml");
-  if (!std::filesystem::is_regular_file(p))
-    throw std::runtime_error("network '" + network + "' not found: no file " + p.string() +
-                             " (build the project, or set DUALGRID_NETWORK_DIR)");
-  return p;
+  if (std::filesystem::is_regular_file(p)) return p;
+  if (std::filesystem::path(network).extension() == ".xml")
+    throw std::invalid_argument("network '" + network + "' not found: no file " + p.string() +
+                                " (a path in a scenario is read relative to the scenario file)");
+  std::string built;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(network_dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > 8 && name.ends_with(".net.xml"))
+      built += (built.empty() ? "" : ", ") + name.substr(0, name.size() - 8);
+  }
+  throw std::invalid_argument(
+      "network '" + network + "' not found: no file " + p.string() + " (" +
+      (built.empty() ? "no networks built there: build the project, or set DUALGRID_NETWORK_DIR"
+                     : "built networks: " + built) +
+      "; or give a path to a .net.xml file, relative to the scenario file)");
 }
 
 void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path) {
@@ -131,7 +143,7 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
 
 SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                                const std::filesystem::path& work_dir)
-    : spec_(spec) {
+    : spec_(spec), log_path_(work_dir / "sumo.log") {
   std::string error;
   if (!spec_.IsValid(&error))
     throw std::invalid_argument("scenario '" + spec_.name + "': " + error);
@@ -163,7 +175,7 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
                                            "--duration-log.disable",
                                            "true",
                                            "--message-log",
-                                           (work_dir / "sumo.log").string(),
+                                           log_path_.string(),
                                            "--no-warnings",
                                            "true",
                                            "--time-to-teleport",
@@ -292,7 +304,8 @@ bool SumoSimulation::Step() {
                                    "' never entered the network before t=" + Num(spec_.duration) +
                                    " s (lane " + std::to_string(spec_.ego.lane) + ", position " +
                                    Num(spec_.ego.position) + " m of route '" + spec_.ego.route +
-                                   "' blocked or invalid, or departure too late; see sumo.log)");
+                                   "' blocked or invalid, or departure too late; see " +
+                                   log_path_.string() + ")");
         return false;
       }
       libsumo::Simulation::step();

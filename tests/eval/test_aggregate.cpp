@@ -93,6 +93,9 @@ TEST_CASE("Comparison table renders ours beside the paper's", "[aggregate]") {
   CHECK_FALSE(t.Ours("dynamic_cell_f1", "dual"));  // no run had cell metrics
 
   const std::string md = t.ToMarkdown();
+  CHECK(md.find("over 3 seeds (Student t)") != std::string::npos);
+  // t_d is empty for velocity: the table says what a blank means.
+  CHECK(md.find("— : not defined in this run") != std::string::npos);
   CHECK(md.find("| dual | dual (paper) |") != std::string::npos);
   CHECK(md.find("| D [%] | 90.0 ± 0.0 | 34.0 |") != std::string::npos);
   CHECK(md.find("| t_d [s] | 0.40 ± 0.00 | — | — | — |") != std::string::npos);
@@ -115,6 +118,29 @@ TEST_CASE("Comparison table renders ours beside the paper's", "[aggregate]") {
   REQUIRE(per_object.count(3) == 1);
   CHECK(per_object.at(3).n == 3);
   CHECK(per_object.at(3).mean == Approx(0.6));
+}
+
+TEST_CASE("A single run claims no confidence interval; notes are printed", "[aggregate]") {
+  ScenarioMetrics m;
+  m.tracked_fraction = 0.5;
+  m.position_error = 1.0;
+  m.velocity_error = 1.0;
+  m.box_distance = 0.0;
+  m.detection_time = 0.2;
+  m.objects_scored = 2;
+  m.objects_never_tracked = 1;
+  m.objects_never_observable = 1;
+  const std::vector<ModeRuns> runs = {{"dual", {m}}};
+  ComparisonTable t = MakeComparisonTable("x", runs);
+  t.AddNote("Not scored: cross_1 (17 frames).");
+  const std::string md = t.ToMarkdown();
+  CHECK(md.find("confidence interval of the mean over") == std::string::npos);
+  CHECK(md.find("One seed") != std::string::npos);
+  CHECK(md.find("— : not defined") == std::string::npos);  // nothing is blank
+  CHECK(md.find("Not scored: cross_1 (17 frames).") != std::string::npos);
+  CHECK(md.find("| objects never tracked | 1.0 |") != std::string::npos);
+  CHECK(md.find("| … of which never in radar coverage | 1.0 |") != std::string::npos);
+  CHECK(t.ToJson().at("notes").size() == 1);
 }
 
 TEST_CASE("Comparison table misuse", "[aggregate]") {

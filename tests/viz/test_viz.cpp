@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -410,9 +412,6 @@ TEST_CASE("RenderBarChart draws grouped bars in mode colours", "[viz]") {
   BarChart bad = chart;
   bad.series[1].values.pop_back();
   CheckInvalidArgument([&] { RenderBarChart(bad, path.string()); }, "series[1].values");
-  bad = chart;
-  bad.categories.clear();
-  CheckInvalidArgument([&] { RenderBarChart(bad, path.string()); }, "categories");
 }
 
 TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
@@ -456,8 +455,92 @@ TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
   bad.series[0].y.pop_back();
   CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "series[0].y");
   bad = chart;
-  bad.log_y = true;
-  bad.y_min = std::nan("");
-  for (double& y : bad.series[0].y) y = -1.0;
-  CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "positive");
+  bad.y_min = 2.0;
+  bad.y_max = 1.0;
+  CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "y_max");
+}
+
+// Figures are drawn after a run's results from whatever the run produced: a single sample, a
+// shaded span of one sample (zero width), series that are all NaN, no categories at all. None of
+// these may throw; each must give a PNG of the requested size.
+TEST_CASE("Charts render degenerate inputs over generated cases", "[viz][property]") {
+  std::mt19937_64 rng(20261123);
+  std::uniform_int_distribution<int> count(0, 4);
+  std::uniform_real_distribution<double> u(-5.0, 5.0);
+  auto value = [&](bool positive) {
+    switch (rng() % 6) {
+      case 0:
+        return std::nan("");
+      case 1:
+        return std::numeric_limits<double>::infinity();
+      case 2:
+        return 0.0;
+      default:
+        return positive ? std::abs(u(rng)) : u(rng);
+    }
+  };
+  const fs::path path = TempDir() / "degenerate.png";
+  for (int trial = 0; trial < 200; ++trial) {
+    INFO("trial " << trial);
+    LineChart line;
+    line.log_y = trial % 3 == 0;
+    const int nseries = count(rng);
+    for (int i = 0; i < nseries; ++i) {
+      LineSeries s{"s" + std::to_string(i), {}, {}, {}, 2.0, i % 2 == 1};
+      const int n = count(rng);
+      const double x0 = u(rng);
+      for (int k = 0; k < n; ++k) {
+        s.x.push_back(rng() % 5 == 0 ? std::nan("") : x0 + (rng() % 3) * 0.5);
+        s.y.push_back(value(false));
+      }
+      line.series.push_back(s);
+    }
+    for (int k = count(rng); k > 0; --k) {
+      const double a = u(rng);
+      line.spans.push_back({a, rng() % 2 ? a : value(false), "span"});
+    }
+    if (rng() % 4 == 0) line.x_min = u(rng);
+    if (rng() % 4 == 0) line.y_min = line.log_y ? 0.01 : u(rng);
+    fs::remove(path);
+    REQUIRE_NOTHROW(RenderLineChart(line, path.string()));
+    CHECK(Png(path).width() == line.width);
+
+    BarChart bars;
+    const int ncat = count(rng) * (trial % 7 == 0 ? 40 : 1);
+    for (int c = 0; c < ncat; ++c) bars.categories.push_back("object_" + std::to_string(c));
+    const int nbar = count(rng);
+    for (int i = 0; i < nbar; ++i) {
+      BarSeries s{i % 2 ? "dual" : "position", {}, {}};
+      for (int c = 0; c < ncat; ++c) {
+        const double v = value(true);
+        s.values.push_back(std::isinf(v) ? std::nan("") : v);
+      }
+      bars.series.push_back(s);
+    }
+    bars.percent = trial % 2 == 0;
+    fs::remove(path);
+    REQUIRE_NOTHROW(RenderBarChart(bars, path.string()));
+    CHECK(Png(path).height() == bars.height);
+  }
+}
+
+TEST_CASE("A one-sample span and a single point are drawn, not dropped", "[viz]") {
+  LineChart chart;
+  chart.y_min = 0.0;
+  chart.y_max = 1.0;
+  chart.series.push_back({"one", {5.0}, {0.5}, {}, 3.0, false});
+  chart.series.push_back({"frame", {0.0, 10.0}, {std::nan(""), std::nan("")}, {}, 2.0, false});
+  chart.x_min = 0.0;
+  chart.x_max = 10.0;
+  chart.spans.push_back({2.0, 2.0, ""});
+  const fs::path path = TempDir() / "single.png";
+  RenderLineChart(chart, path.string());
+  const Png png(path);
+  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  // The single point is a dot of the series colour at (5, 0.5).
+  CHECK(Near(png.At(Vector2(a.left + 0.5 * a.width, a.top + 0.5 * a.height)), CategoryColor(0), 3));
+  // The zero-width span shades a thin band at x = 2 (grey over white), below the title area.
+  const Rgb8 band = png.At(Vector2(a.left + 0.2 * a.width, a.top + 0.8 * a.height));
+  CHECK(band.r < 250);
+  CHECK(Near(png.At(Vector2(a.left + 0.3 * a.width, a.top + 0.8 * a.height)), colors::kWhite));
 }

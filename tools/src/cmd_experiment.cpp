@@ -5,18 +5,22 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
-#include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
+#include "exit_codes.hpp"
 #include "figures.hpp"
 #include "output.hpp"
 #include "progress.hpp"
+#include "run_outputs.hpp"
 
 extern char** environ;
 
@@ -24,7 +28,14 @@ namespace dualgrid::tools {
 namespace {
 
 // Starts `dualgrid run` for one seed with its output and log in `dir`.
-pid_t StartRun(const ExperimentOptions& o, int seed, const std::filesystem::path& dir,
+// Exact decimal text of a double (std::to_string rounds to 6 decimals).
+std::string Exact(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesystem::path& dir,
                bool figures) {
   std::filesystem::create_directories(dir);
   std::vector<std::string> args = {o.executable,
@@ -37,18 +48,18 @@ pid_t StartRun(const ExperimentOptions& o, int seed, const std::filesystem::path
                                    "--quiet",
                                    "--network-dir",
                                    o.run.run.network_dir.string()};
-  if (o.run.run.duration)
-    args.insert(args.end(), {"--duration", std::to_string(*o.run.run.duration)});
+  if (o.run.run.duration) args.insert(args.end(), {"--duration", Exact(*o.run.run.duration)});
   std::string modes;
   for (const auto& m : o.run.modes) modes += (modes.empty() ? "" : ",") + m;
   args.insert(args.end(), {"--modes", modes});
   if (!figures) args.push_back("--no-figures");
   if (!o.run.snapshots.empty()) {
     std::string times;
-    for (double t : o.run.snapshots) times += (times.empty() ? "" : ",") + std::to_string(t);
+    for (double t : o.run.snapshots) times += (times.empty() ? "" : ",") + Exact(t);
     args.insert(args.end(), {"--snapshots", times});
   }
-  if (o.run.write_detections) args.push_back("--write-detections");
+  args.insert(args.end(), {"--detections", o.run.detections});
+  if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.run.threads)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
@@ -65,7 +76,8 @@ pid_t StartRun(const ExperimentOptions& o, int seed, const std::filesystem::path
   return pid;
 }
 
-std::string FirstLine(const std::filesystem::path& p) {
+// The last non-empty line of a run's log: its error message.
+std::string LastLine(const std::filesystem::path& p) {
   std::ifstream in(p);
   std::string line, last;
   while (std::getline(in, line))
@@ -76,45 +88,57 @@ std::string FirstLine(const std::filesystem::path& p) {
 }  // namespace
 
 int RunExperiment(const ExperimentOptions& o) {
-  if (o.seeds < 1) throw std::invalid_argument("--seeds must be >= 1");
   if (o.run.run.seed)
     throw std::invalid_argument(
         "experiment runs seeds --first-seed .. --first-seed + --seeds - 1; "
         "--seed is for single runs");
+  if (o.first_seed > kMaxSeed - static_cast<std::uint64_t>(o.seeds - 1))
+    throw std::invalid_argument("--first-seed + --seeds - 1 must be <= " +
+                                std::to_string(kMaxSeed));
   ParseModes(o.run.modes);  // fail early on a bad mode
   scenario::ScenarioConfig config = LoadConfig(o.run.run);
+  DetectionPath(o.run.run.out, o.run.detections);  // fail early on a bad format
   const auto& out = o.run.run.out;
   std::filesystem::create_directories(out / "figures");
-  const int jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  const int jobs = o.jobs > 0 ? o.jobs : Cores();
+  auto seed_dir = [&](std::uint64_t seed) {
+    return out / "seeds" / ("seed_" + std::to_string(seed));
+  };
 
   // Run the seeds, `jobs` at a time; seed `first_seed` also draws its figures.
   Progress progress("experiment " + config.sim.name, o.seeds, !o.run.run.quiet);
-  std::map<pid_t, int> running;
-  std::vector<int> failed;
+  std::map<pid_t, std::uint64_t> running;
+  std::vector<std::uint64_t> finished;
+  std::vector<std::pair<std::uint64_t, std::string>> failed;  // seed, its error
   int next = 0, done = 0;
   while (done < o.seeds) {
     while (next < o.seeds && static_cast<int>(running.size()) < jobs) {
-      const int seed = o.first_seed + next++;
-      const auto dir = out / "seeds" / ("seed_" + std::to_string(seed));
-      running[StartRun(o, seed, dir, o.run.figures && seed == o.first_seed)] = seed;
+      const std::uint64_t seed = o.first_seed + next++;
+      running[StartRun(o, seed, seed_dir(seed), o.run.figures && seed == o.first_seed)] = seed;
     }
     int status = 0;
     const pid_t pid = wait(&status);
     if (pid < 0) throw std::runtime_error("lost track of the seed runs");
-    const int seed = running.at(pid);
+    const std::uint64_t seed = running.at(pid);
     running.erase(pid);
     ++done;
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      failed.push_back(seed);
-      std::cerr << "seed " << seed << " failed: "
-                << FirstLine(out / "seeds" / ("seed_" + std::to_string(seed)) / "log.txt") << "\n";
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+      finished.push_back(seed);
+    } else {
+      std::string why = LastLine(seed_dir(seed) / "log.txt");
+      if (WIFSIGNALED(status)) why = "killed by signal " + std::to_string(WTERMSIG(status));
+      if (why.empty()) why = "exit code " + std::to_string(WEXITSTATUS(status));
+      failed.emplace_back(seed, why);
+      std::cerr << "dualgrid: seed " << seed << " failed: " << why << "\n";
     }
     progress.Update(done, std::to_string(done) + "/" + std::to_string(o.seeds) + " seeds");
   }
   progress.Finish();
-  if (!failed.empty())
-    throw std::runtime_error(std::to_string(failed.size()) + " of " + std::to_string(o.seeds) +
-                             " seed runs failed (see " + (out / "seeds").string() + "/*/log.txt)");
+  std::sort(finished.begin(), finished.end());
+  if (finished.empty())
+    throw std::runtime_error("all " + std::to_string(o.seeds) +
+                             " seed runs failed; the first: " + failed.front().second +
+                             " (logs: " + (out / "seeds").string() + "/seed_*/log.txt)");
 
   // Aggregate: per mode, the metrics of every seed; object ids mapped by vehicle name so that
   // per-object results line up across seeds.
@@ -122,8 +146,8 @@ int RunExperiment(const ExperimentOptions& o) {
   std::vector<eval::ModeRuns> runs;
   for (const auto& m : o.run.modes) runs.push_back({m, {}});
   double wall = 0.0;
-  for (int k = 0; k < o.seeds; ++k) {
-    const auto dir = out / "seeds" / ("seed_" + std::to_string(o.first_seed + k));
+  for (const std::uint64_t seed : finished) {
+    const auto dir = seed_dir(seed);
     nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "metrics.json"));
     wall += j.value("wall_s", 0.0);
     for (auto& r : runs) {
@@ -134,10 +158,10 @@ int RunExperiment(const ExperimentOptions& o) {
       r.seeds.push_back(std::move(m));
     }
   }
-  const eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
-  OpenOutput(out / "table.md") << table.ToMarkdown();
-  OpenOutput(out / "table.csv") << table.ToCsv();
-  OpenOutput(out / "table.json") << table.ToJson().dump(2) << "\n";
+  eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
+  for (const auto& [seed, why] : failed)
+    table.AddNote("Seed " + std::to_string(seed) + " failed and is not in the table: " + why);
+  WriteTables(table, out);
 
   // Per-object tracked share over seeds (paper Fig. 6).
   std::map<int, std::vector<double>> rows;
@@ -148,28 +172,52 @@ int RunExperiment(const ExperimentOptions& o) {
       per_object[names.Name(id)][runs[m].mode] = s;
     }
   }
-  OpenOutput(out / "per_object.json") << per_object.dump(2) << "\n";
-  TrackedShares shares;
-  for (const auto& [id, r] : rows) shares.emplace_back(names.Name(id), r);
-  if (o.run.figures)
-    RenderTrackedShares(o.run.modes, shares,
-                        config.sim.name + ": tracked share D per object, mean over " +
-                            std::to_string(o.seeds) + " seeds",
-                        out / "figures" / "tracked_share.png");
-  // The first seed's pictures (grids, scene, weights) are the experiment's examples.
-  const auto first = out / "seeds" / ("seed_" + std::to_string(o.first_seed)) / "figures";
-  if (o.run.figures)
-    for (const auto& e : std::filesystem::directory_iterator(first))
+  WriteTextFile(out / "per_object.json", per_object.dump(2) + "\n");
+  if (!o.run.run.quiet) std::cout << table.ToMarkdown() << "\n";
+
+  std::vector<std::string> warnings;
+  if (o.run.figures) {
+    TrackedShares shares;
+    for (const auto& [id, r] : rows) shares.emplace_back(names.Name(id), r);
+    const auto png = out / "figures" / "tracked_share.png";
+    TryFigure(
+        png,
+        [&] {
+          RenderTrackedShares(o.run.modes, shares,
+                              config.sim.name + ": tracked share D per object, mean over " +
+                                  std::to_string(finished.size()) + " seeds",
+                              png);
+        },
+        &warnings);
+    // The first seed's pictures (grids, scene, weights) are the experiment's examples.
+    const auto first = seed_dir(o.first_seed) / "figures";
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(first, ec))
       if (e.path().filename() != "tracked_share.png")
         std::filesystem::copy_file(e.path(), out / "figures" / e.path().filename(),
                                    std::filesystem::copy_options::overwrite_existing);
-
-  if (!o.run.run.quiet) {
-    std::cout << table.ToMarkdown() << "\n"
-              << o.seeds << " seeds (" << Fixed(wall, 0) << " s of runs); results in "
-              << out.string() << "\n";
   }
-  return 0;
+  nlohmann::json summary = {{"complete", failed.empty()},
+                            {"scenario", config.sim.name},
+                            {"seeds_finished", finished},
+                            {"wall_s_of_runs", wall},
+                            {"warnings", warnings}};
+  for (const auto& [seed, why] : failed)
+    summary["seeds_failed"].push_back({{"seed", seed}, {"error", why}});
+  WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
+  if (!o.run.run.quiet)
+    std::cout << finished.size() << " of " << o.seeds << " seeds (" << Fixed(wall, 0)
+              << " s of runs); results in " << out.string() << "\n";
+  if (!failed.empty()) {
+    std::string list;
+    for (const auto& [seed, why] : failed)
+      list += (list.empty() ? "" : ", ") + std::to_string(seed);
+    std::cerr << "dualgrid: error: " << failed.size() << " of " << o.seeds
+              << " seed runs failed (seeds " << list << "; logs in " << (out / "seeds").string()
+              << "/seed_*/log.txt); the table aggregates the other " << finished.size() << "\n";
+    return kExitSomeSeedsFailed;
+  }
+  return kExitOk;
 }
 
 }  // namespace dualgrid::tools

@@ -1,9 +1,9 @@
 // `dualgrid sim`: SUMO ground truth (and radar detections) per step, written as CSV.
 #include <chrono>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -15,8 +15,10 @@
 
 namespace dualgrid::tools {
 
-int RunSim(const RunOptions& options) {
+int RunSim(const SimOptions& sim_options) {
+  const RunOptions& options = sim_options.run;
   scenario::ScenarioConfig config = LoadConfig(options);
+  const auto detections_path = DetectionPath(options.out, sim_options.detections);
   const sim::ScenarioSpec& spec = config.sim;
   std::filesystem::create_directories(options.out);
   CopyScenario(config, options.out);
@@ -24,7 +26,8 @@ int RunSim(const RunOptions& options) {
   const auto wall_start = std::chrono::steady_clock::now();
   Pipeline pipeline(config, options.network_dir, options.out, {});
   GroundTruthWriter truth(options.out / "ground_truth.csv");
-  DetectionWriter detections(options.out / "detections.csv");
+  std::unique_ptr<DetectionWriter> detections;
+  if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path);
   WriteObstacles(spec, options.out / "obstacles.csv");
 
   struct Seen {
@@ -38,7 +41,7 @@ int RunSim(const RunOptions& options) {
   while (pipeline.Step()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
-    detections.Write(pipeline);
+    if (detections) detections->Write(pipeline);
     detection_count += pipeline.detections().size();
     for (const auto& d : pipeline.detections()) clutter_count += d.is_clutter ? 1 : 0;
     for (const auto& v : f.vehicles) {
@@ -52,10 +55,13 @@ int RunSim(const RunOptions& options) {
         steps, "t=" + Fixed(f.time, 1) + " s, " + std::to_string(f.vehicles.size()) + " vehicles");
   }
   progress.Finish();
+  truth.Close();
+  if (detections) detections->Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
   nlohmann::json summary;
+  summary["complete"] = true;
   summary["scenario"] = spec.name;
   summary["seed"] = spec.seed;
   summary["steps"] = steps;
@@ -70,7 +76,9 @@ int RunSim(const RunOptions& options) {
                                {"last_s", s.last},
                                {"min_distance_to_ego_m", s.min_distance}};
   }
-  OpenOutput(options.out / "summary.json") << summary.dump(2) << "\n";
+  summary["requested_s"] = spec.duration;
+  // Written last: a folder without summary.json did not finish.
+  WriteTextFile(options.out / "summary.json", summary.dump(2) + "\n");
   if (!options.quiet) {
     std::cout << spec.name << ": " << steps << " steps (" << Fixed(steps * spec.step_length, 1)
               << " s simulated in " << Fixed(wall, 1) << " s), " << seen.size()

@@ -10,17 +10,21 @@ namespace dualgrid::tools {
 
 int RunSnapshot(const SnapshotOptions& options) {
   RunOptions run = options.run;
+  const std::filesystem::path png = run.out;
+  if (png.extension() != ".png")
+    throw std::invalid_argument(
+        "--out: the picture is a PNG; give a file name ending in .png, got '" + png.string() + "'");
+  if (std::filesystem::is_directory(png))
+    throw std::invalid_argument("--out: '" + png.string() + "' is a folder; give a .png file name");
   scenario::ScenarioConfig config = LoadConfig(run);
   if (!(options.time >= config.sim.step_length && options.time <= config.sim.duration))
     throw std::invalid_argument("--time must be in [" + Fixed(config.sim.step_length, 2) + ", " +
                                 Fixed(config.sim.duration, 2) + "] s (one step to the duration)");
   config.sim.duration = options.time;
-  // SUMO's route file and log go next to the picture.
-  const std::filesystem::path png = run.out;
-  const std::filesystem::path work = png.has_parent_path()
-                                         ? png.parent_path() / (png.stem().string() + "_sumo")
-                                         : std::filesystem::path(png.stem().string() + "_sumo");
-  Pipeline pipeline(config, run.network_dir, work, {});
+  // SUMO's route file and log are working files of this command only: a temporary folder,
+  // removed afterwards (kept, and named, only if SUMO fails, for its log).
+  TempDir work("snapshot");
+  Pipeline pipeline(config, run.network_dir, work.path(), {});
   while (pipeline.Step()) {
   }
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());

@@ -22,13 +22,22 @@ struct RunOptions {
   bool quiet = false;
 };
 
+/// `dualgrid sim`: ground truth and radar detections, no filter.
+struct SimOptions {
+  RunOptions run;
+  std::string detections = "csv";  ///< "none", "csv" or "csv.gz"
+};
+
 /// `dualgrid run`: the co-simulation with the grid filters, scored against the ground truth.
 struct FilterRunOptions {
   RunOptions run;
   std::vector<std::string> modes = {"position", "velocity", "dual"};
   std::vector<double> snapshots;  ///< grid picture times [s]; empty: from the scenario
   bool figures = true;
-  bool write_detections = false;
+  /// detections.csv: "none", "csv" or "csv.gz" (gzip-compressed, about 3.5x smaller).
+  std::string detections = "none";
+  /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).
+  bool write_particles = false;
   int threads = 0;  ///< OpenMP threads; 0: the OpenMP default
 };
 
@@ -36,15 +45,15 @@ struct FilterRunOptions {
 struct ExperimentOptions {
   FilterRunOptions run;
   int seeds = 10;
-  int first_seed = 1;
+  std::uint64_t first_seed = 1;
   int jobs = 0;            ///< parallel runs; 0: number of cores
   std::string executable;  ///< this program, to start the runs
 };
 
 /// `dualgrid snapshot`: bird's-eye picture of one time of a scenario.
 struct SnapshotOptions {
-  RunOptions run;
-  double time = 10.0;
+  RunOptions run;                                          ///< run.out is the PNG to write
+  double time = 10.0;                                      ///< [s]
   double behind = 60.0, ahead = 140.0, half_width = 22.0;  ///< view around the ego [m]
 };
 
@@ -53,15 +62,18 @@ struct TangentialOptions {
   std::string kind = "crossing";  ///< "crossing" (ahead, across the front radar) or "parallel"
   int count = 4;                  ///< stress vehicles
   double ego_speed = 20.0;        ///< [m/s]
-  double speed = 15.0;            ///< crossing speed, or speed over the ego's for parallel [m/s]
-  double first_distance = 30.0;   ///< crossing: distance ahead of the ego of the first crossing [m]
-  double spacing = 20.0;          ///< crossing: distance between crossings; parallel: offsets [m]
+  /// Stress vehicles' speed over ground [m/s]; default: crossing 15, parallel ego speed + 0.3.
+  std::optional<double> speed;
+  double first_distance = 30.0;  ///< crossing: distance ahead of the ego of the first crossing [m]
+  /// Crossing: distance between crossings (default 20); parallel: between vehicles of a lane
+  /// (default 40) [m].
+  std::optional<double> spacing;
   std::uint64_t seed = 1;
   std::filesystem::path out;
   bool quiet = false;
 };
 
-int RunSim(const RunOptions& options);
+int RunSim(const SimOptions& options);
 int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);
 int RunExperiment(const ExperimentOptions& options);

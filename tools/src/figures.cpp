@@ -1,6 +1,8 @@
 #include "figures.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 
 #include "dualgrid/viz/birds_eye_view.hpp"
 #include "dualgrid/viz/charts.hpp"
@@ -8,6 +10,21 @@
 #include "output.hpp"
 
 namespace dualgrid::tools {
+
+bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
+               std::vector<std::string>* warnings) {
+  try {
+    draw();
+    return true;
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    const std::string warning = "figure " + path.string() + " not drawn: " + what;
+    std::cerr << "dualgrid: warning: " << warning << "\n";
+    if (warnings) warnings->push_back(warning);
+    return false;
+  }
+}
 
 void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width) {
@@ -97,14 +114,15 @@ TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics
 
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::filesystem::path& path) {
-  if (shares.empty()) return;  // nothing scored (very short run)
-  viz::BarChart chart;
+  viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
   chart.x_label = "object";
   chart.y_label = "tracked share D";
   chart.percent = true;
   chart.value_labels = shares.size() <= 12;
-  chart.width = std::max(1000, 60 * static_cast<int>(shares.size() * modes.size()) + 200);
+  // 60 px per bar up to a 4000 px wide image; beyond that the bars narrow (to 1 px) and the
+  // object names are thinned out.
+  chart.width = std::clamp(60 * static_cast<int>(shares.size() * modes.size()) + 200, 1000, 4000);
   for (const auto& [name, row] : shares) chart.categories.push_back(name);
   for (std::size_t m = 0; m < modes.size(); ++m) {
     viz::BarSeries s;
@@ -117,7 +135,6 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
                        const std::filesystem::path& path) {
-  if (trace.time.size() < 2) return;
   viz::LineChart chart;
   chart.title = "Weights on " + object + " (" + mode + " filter): share held by particles within " +
                 Fixed(WeightTrace::kGoodVelocity, 0) + " m/s of its true velocity";

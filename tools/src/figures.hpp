@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -11,6 +12,12 @@
 #include "scoring.hpp"
 
 namespace dualgrid::tools {
+
+/// Figures come after the results they show and never cost them: draws one figure and turns a
+/// failure into a warning naming the file (printed to stderr and appended to `warnings`, which
+/// the run records in summary.json). Returns whether the figure was written.
+bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
+               std::vector<std::string>* warnings);
 
 /// Bird's-eye picture of the current step: lanes, guard rails, parked boxes, vehicles, radar
 /// fields of view and the step's detections with their radial-velocity arrows. The view spans

@@ -1,40 +1,75 @@
 // dualgrid: SUMO traffic -> radar detections -> dynamic occupancy grid, scored against truth.
 #include <unistd.h>
 
+#include <csignal>
+
 #include <iostream>
-#include <thread>
 
 #include <CLI/CLI.hpp>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
+#include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
+#include "exit_codes.hpp"
 
 namespace {
 
 using namespace dualgrid::tools;
 
-void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help) {
+constexpr const char* kExitCodes =
+    "Exit codes: 0 done; 1 the run failed (SUMO error, an output not written); 2 bad input "
+    "(command line, scenario or network file; nothing simulated); 3 experiment: some seed runs "
+    "failed (the others are aggregated). Details: docs/cli.md.";
+
+// An option whose default is shown in --help.
+template <typename T>
+CLI::Option* Opt(CLI::App* cmd, const std::string& name, T* value, const std::string& help) {
+  return cmd->add_option(name, *value, help)->capture_default_str();
+}
+
+void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bool with_seed) {
   cmd->add_option("scenario", o->scenario, "Scenario file (e.g. scenarios/highway.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out,-o", o->out, out_help)->required();
-  cmd->add_option("--seed", o->seed, "Override the scenario's random seed");
-  cmd->add_option("--duration", o->duration, "Override the scenario's duration [s]");
-  cmd->add_option("--network-dir", o->network_dir,
-                  "Folder of the generated .net.xml files (default: the build's networks/)");
+  cmd->add_option("--out,-o", o->out, out_help)->required()->check(NonEmptyPath());
+  if (with_seed)
+    cmd->add_option("--seed", o->seed, "Random seed (default: the scenario's `seed`)")
+        ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  cmd->add_option("--duration", o->duration,
+                  "Simulated time [s] (default: the scenario's `duration`)")
+      ->check(Number(0.0, kMaxDuration, true));
+  Opt(cmd, "--network-dir", &o->network_dir,
+      "Folder of the built networks named in scenarios (`network: highway`)")
+      ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress or summary output");
 }
 
-void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o) {
-  cmd->add_option("--modes", o->modes, "Weight modes to run side by side")
+CLI::Validator DetectionFormat() { return CLI::IsMember({"none", "csv", "csv.gz"}); }
+
+void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
+  cmd->add_option("--modes", o->modes,
+                  "Weight modes to run side by side, comma-separated (default: all three)")
       ->delimiter(',')
       ->check(CLI::IsMember({"position", "velocity", "dual"}));
-  cmd->add_option("--snapshots", o->snapshots, "Times [s] of the grid pictures (comma-separated)")
-      ->delimiter(',');
-  cmd->add_flag("!--no-figures", o->figures, "Skip the pictures");
-  cmd->add_flag("--write-detections", o->write_detections, "Also write detections.csv");
-  cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--snapshots", o->snapshots,
+                  "Times [s] of the grid pictures, comma-separated (default: the scenario's "
+                  "`evaluation.snapshot_times`, else 1/4, 1/2, 3/4 of the run)")
+      ->delimiter(',')
+      ->check(Number(0.0, kMaxDuration, true));
+  cmd->add_flag("--no-figures", *no_figures, "Skip the pictures (metrics and tables only)");
+  cmd->add_flag_callback(
+      "--write-detections", [o] { o->detections = "csv"; }, "Same as --detections csv");
+  Opt(cmd, "--detections", &o->detections,
+      "Write the radar detections: none, csv, or csv.gz (gzip, about 3.5x smaller)")
+      ->check(DetectionFormat());
+  cmd->add_flag("--write-particles", o->write_particles,
+                "Write every particle beside each grid picture (figures/particles_*.csv, several "
+                "MB each)");
+  cmd->add_option("--threads", o->threads,
+                  "OpenMP threads per run (default 0: all cores; at most " +
+                      std::to_string(kMaxThreadsPerCore) + " per core)")
+      ->check(WholeNumber(0, kMaxThreadsPerCore * Cores()));
 }
 
 std::string SelfPath(const char* argv0) {
@@ -43,22 +78,43 @@ std::string SelfPath(const char* argv0) {
   return n > 0 ? std::string(buf, n) : std::string(argv0);
 }
 
+std::string OneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+// The subcommand being parsed when the error happened, for the "see --help" hint.
+std::string HelpHint(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands())
+    return "dualgrid " + sub->get_name() + " --help";
+  return "dualgrid --help";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Past a file-size limit (ulimit -f) a write should fail and be reported naming the file, not
+  // kill the process with SIGXFSZ and leave a half-written run behind silently.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "dualgrid: radar-only dynamic occupancy grid with dual particle weights, "
       "co-simulated with SUMO.\nScenarios are YAML files (see scenarios/ and "
       "docs/scenarios.md)."};
   app.require_subcommand(1);
   app.set_version_flag("--version", "dualgrid 0.1.0");
+  app.footer(kExitCodes);
   const auto network_dir = dualgrid::sim::DefaultNetworkDir();
 
-  RunOptions sim_options;
-  sim_options.network_dir = network_dir;
+  SimOptions sim_options;
+  sim_options.run.network_dir = network_dir;
   auto* sim = app.add_subcommand(
       "sim", "Run SUMO and the radar model; write ground truth and detections (CSV)");
-  AddRunOptions(sim, &sim_options, "Output folder");
+  AddRunOptions(sim, &sim_options.run, "Output folder", true);
+  Opt(sim, "--detections", &sim_options.detections,
+      "Write the radar detections: none, csv, or csv.gz (gzip, about 3.5x smaller)")
+      ->check(DetectionFormat());
 
   SnapshotOptions snap;
   snap.run.network_dir = network_dir;
@@ -66,73 +122,107 @@ int main(int argc, char** argv) {
       "snapshot",
       "Bird's-eye picture (PNG) of a scenario at one time: road, vehicles, radar "
       "fields of view, detections with radial-velocity arrows");
-  AddRunOptions(snapshot, &snap.run, "PNG file to write");
-  snapshot->add_option("--time,-t", snap.time, "Scenario time [s]")->required();
-  snapshot->add_option("--behind", snap.behind, "View behind the ego [m]");
-  snapshot->add_option("--ahead", snap.ahead, "View ahead of the ego [m]");
-  snapshot->add_option("--half-width", snap.half_width, "View to each side of the ego [m]");
+  AddRunOptions(snapshot, &snap.run, "PNG file to write (must end in .png)", true);
+  snapshot->add_option("--time,-t", snap.time, "Scenario time [s]")
+      ->required()
+      ->check(Number(0.0, kMaxDuration, true));
+  Opt(snapshot, "--behind", &snap.behind, "View behind the ego [m]")
+      ->check(Number(0.0, 2000.0, true));
+  Opt(snapshot, "--ahead", &snap.ahead, "View ahead of the ego [m]")
+      ->check(Number(0.0, 2000.0, true));
+  Opt(snapshot, "--half-width", &snap.half_width, "View to each side of the ego [m]")
+      ->check(Number(0.0, 1000.0, true));
 
   FilterRunOptions run_options;
+  bool run_no_figures = false;
   run_options.run.network_dir = network_dir;
   auto* run = app.add_subcommand(
       "run",
       "Run SUMO, the radar and the grid filters (one per weight mode, same detections) "
       "and score them against the ground truth");
-  AddRunOptions(run, &run_options.run, "Run folder (metrics, tables, figures, config)");
-  AddFilterOptions(run, &run_options);
+  AddRunOptions(run, &run_options.run, "Run folder (metrics, tables, figures, config)", true);
+  AddFilterOptions(run, &run_options, &run_no_figures);
 
   ExperimentOptions exp;
+  bool exp_no_figures = false;
   exp.run.run.network_dir = network_dir;
-  auto* experiment =
-      app.add_subcommand("experiment",
-                         "`run` over several seeds (separate processes) and aggregate the tables "
-                         "with 95 % confidence intervals");
-  AddRunOptions(experiment, &exp.run.run, "Experiment folder");
-  AddFilterOptions(experiment, &exp.run);
-  experiment->add_option("--seeds", exp.seeds, "Number of seeds")->check(CLI::PositiveNumber);
-  experiment->add_option("--first-seed", exp.first_seed, "First seed");
-  experiment->add_option("--jobs,-j", exp.jobs, "Parallel runs (default: number of cores)");
+  auto* experiment = app.add_subcommand(
+      "experiment",
+      "`run` over seeds first-seed .. first-seed + seeds - 1 (separate processes) and aggregate "
+      "the tables with 95 % confidence intervals");
+  AddRunOptions(experiment, &exp.run.run, "Experiment folder", false);
+  AddFilterOptions(experiment, &exp.run, &exp_no_figures);
+  Opt(experiment, "--seeds", &exp.seeds, "Number of seeds")->check(WholeNumber(1, kMaxSeeds));
+  Opt(experiment, "--first-seed", &exp.first_seed, "First seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  experiment
+      ->add_option("--jobs,-j", exp.jobs,
+                   "Seed runs at a time (default: one per core, each with one OpenMP thread)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
 
   TangentialOptions tan;
   auto* tangential =
       app.add_subcommand("tangential",
                          "Write a tangential-motion stress scenario (traffic crossing ahead of the "
                          "ego, or driving alongside it), to run with `dualgrid run`");
-  tangential->add_option("--kind", tan.kind, "crossing or parallel")
+  Opt(tangential, "--kind", &tan.kind,
+      "crossing (ahead, across the front radar) or parallel (alongside, across the corner "
+      "radars)")
       ->check(CLI::IsMember({"crossing", "parallel"}));
-  tangential->add_option("--count", tan.count, "Number of stress vehicles");
-  tangential->add_option("--ego-speed", tan.ego_speed, "Ego speed [m/s]");
-  tangential->add_option("--speed", tan.speed,
-                         "Crossing speed [m/s]; parallel: speed over the ego's [m/s]");
-  tangential->add_option("--first-distance", tan.first_distance,
-                         "crossing: distance ahead of the ego of the first crossing [m]");
-  tangential->add_option("--spacing", tan.spacing, "Distance between stress vehicles [m]");
-  tangential->add_option("--seed", tan.seed, "Scenario seed");
-  tangential->add_option("--out,-o", tan.out, "Scenario file to write")->required();
+  Opt(tangential, "--count", &tan.count, "Number of stress vehicles")->check(WholeNumber(1, 12));
+  Opt(tangential, "--ego-speed", &tan.ego_speed, "Ego speed [m/s]")->check(Number(0.0, 40.0, true));
+  tangential
+      ->add_option("--speed", tan.speed,
+                   "Stress vehicles' speed over ground [m/s] (default: crossing 15; parallel "
+                   "ego speed + 0.3, so they stay alongside)")
+      ->check(Number(0.0, 40.0, true));
+  Opt(tangential, "--first-distance", &tan.first_distance,
+      "crossing: distance ahead of the ego of the first crossing [m]")
+      ->check(Number(10.0, 600.0, false));
+  tangential
+      ->add_option("--spacing", tan.spacing,
+                   "crossing: distance between crossings (default 20 m); parallel: distance "
+                   "between vehicles of one lane (default 40 m) [m]")
+      ->check(Number(0.0, 600.0, true));
+  Opt(tangential, "--seed", &tan.seed, "Scenario seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  tangential->add_option("--out,-o", tan.out, "Scenario file to write (.yaml)")
+      ->required()
+      ->check(NonEmptyPath());
   tangential->add_flag("--quiet,-q", tan.quiet, "No summary");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::cerr << "dualgrid: error: " << OneLine(e.what()) << " (see " << HelpHint(app) << ")\n";
+    return kExitBadInput;
+  }
   try {
     if (sim->parsed()) return RunSim(sim_options);
-    if (tangential->parsed()) {
-      // Parallel defaults: nearly the ego's speed, and spacing that leaves SUMO's insertion gap.
-      if (tan.kind == "parallel" && tangential->count("--speed") == 0) tan.speed = 0.3;
-      if (tan.kind == "parallel" && tangential->count("--spacing") == 0) tan.spacing = 40.0;
-      return RunTangential(tan);
-    }
+    if (tangential->parsed()) return RunTangential(tan);
     if (snapshot->parsed()) return RunSnapshot(snap);
-    if (run->parsed()) return RunFilters(run_options);
+    if (run->parsed()) {
+      run_options.figures = !run_no_figures;
+      return RunFilters(run_options);
+    }
     if (experiment->parsed()) {
+      exp.run.figures = !exp_no_figures;
       exp.executable = SelfPath(argv[0]);
       // Parallel runs share the cores: one OpenMP thread each unless told otherwise.
-      const int jobs =
-          exp.jobs > 0 ? exp.jobs : static_cast<int>(std::thread::hardware_concurrency());
+      const int jobs = exp.jobs > 0 ? exp.jobs : Cores();
       if (exp.run.threads == 0 && jobs > 1) exp.run.threads = 1;
       return RunExperiment(exp);
     }
+  } catch (const dualgrid::scenario::ConfigError& e) {
+    std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
+    return kExitBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "dualgrid: error: " << e.what() << "\n";
-    return 1;
+    std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
+    return kExitRunFailed;
   }
-  return 0;
+  return kExitOk;
 }

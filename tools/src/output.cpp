@@ -1,6 +1,13 @@
 #include "output.hpp"
 
+#include <stdlib.h>
+#include <zlib.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <exception>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -26,64 +33,157 @@ scenario::ScenarioConfig LoadConfig(const RunOptions& options) {
 
 void CopyScenario(const scenario::ScenarioConfig& config, const std::filesystem::path& out) {
   std::ifstream in(config.file);
-  std::ofstream copy = OpenOutput(out / "scenario.yaml");
+  std::ostringstream copy;
   copy << "# Copy of " << config.file.string() << " as used for this run; command-line overrides:\n"
        << "#   seed: " << config.sim.seed << ", duration: " << config.sim.duration << " s\n"
+       << "# network as resolved: " << config.sim.network << "\n"
        << in.rdbuf();
+  WriteTextFile(out / "scenario.yaml", copy.str());
 }
 
-std::ofstream OpenOutput(const std::filesystem::path& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path.string());
-  out.precision(10);
-  return out;
+namespace {
+constexpr std::size_t kFlushBytes = 1 << 20;
+
+std::string Reason() { return errno ? std::strerror(errno) : "unknown error"; }
+}  // namespace
+
+OutputFile::OutputFile(const std::filesystem::path& path) : path_(path) {
+  errno = 0;
+  if (path.extension() == ".gz") {
+    gz_ = gzopen(path.c_str(), "wb6");
+    if (!gz_) Fail("cannot create");
+  } else {
+    file_ = std::fopen(path.c_str(), "wb");
+    if (!file_) Fail("cannot create");
+  }
+  buffer_.reserve(kFlushBytes + (kFlushBytes >> 2));
 }
 
-GroundTruthWriter::GroundTruthWriter(const std::filesystem::path& path) : out_(OpenOutput(path)) {
-  out_ << "step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,"
-          "x_ego,y_ego,vx_ego,vy_ego\n";
+OutputFile::~OutputFile() {
+  if (file_) std::fclose(file_);
+  if (gz_) gzclose(static_cast<gzFile>(gz_));
+}
+
+void OutputFile::Fail(const std::string& what) {
+  throw std::runtime_error(what + " " + path_.string() + ": " + Reason());
+}
+
+void OutputFile::MaybeFlush() {
+  if (buffer_.size() >= kFlushBytes) Flush();
+}
+
+void OutputFile::Flush() {
+  if (buffer_.empty()) return;
+  errno = 0;
+  if (file_) {
+    if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+      Fail("cannot write");
+  } else if (gz_) {
+    if (gzwrite(static_cast<gzFile>(gz_), buffer_.data(), static_cast<unsigned>(buffer_.size())) !=
+        static_cast<int>(buffer_.size()))
+      Fail("cannot write");
+  }
+  buffer_.clear();
+}
+
+void OutputFile::Close() {
+  Flush();
+  errno = 0;
+  if (file_) {
+    const bool ok = std::fflush(file_) == 0 && std::ferror(file_) == 0;
+    const int rc = std::fclose(file_);
+    file_ = nullptr;
+    if (!ok || rc != 0) Fail("cannot write");
+  }
+  if (gz_) {
+    const int rc = gzclose(static_cast<gzFile>(gz_));
+    gz_ = nullptr;
+    if (rc != Z_OK) Fail("cannot write");
+  }
+}
+
+TempDir::TempDir(const std::string& purpose) : exceptions_(std::uncaught_exceptions()) {
+  std::string pattern =
+      (std::filesystem::temp_directory_path() / ("dualgrid_" + purpose + "_XXXXXX")).string();
+  if (!mkdtemp(pattern.data()))
+    throw std::runtime_error("cannot create a temporary folder " + pattern + ": " + Reason());
+  path_ = pattern;
+}
+
+TempDir::~TempDir() {
+  if (std::uncaught_exceptions() > exceptions_) return;
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+void WriteTextFile(const std::filesystem::path& path, const std::string& text) {
+  OutputFile out(path);
+  out.buffer() = text;
+  out.Close();
+}
+
+std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& dir,
+                                                   const std::string& format) {
+  if (format == "csv") return dir / "detections.csv";
+  if (format == "csv.gz") return dir / "detections.csv.gz";
+  if (format == "none") return std::nullopt;
+  throw std::invalid_argument("--detections: expected none, csv or csv.gz, got '" + format + "'");
+}
+
+GroundTruthWriter::GroundTruthWriter(const std::filesystem::path& path) : out_(path) {
+  out_.buffer() +=
+      "step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,"
+      "x_ego,y_ego,vx_ego,vy_ego\n";
 }
 
 void GroundTruthWriter::Write(const sim::Frame& f) {
   const Pose2 ego = f.EgoPose();
+  std::ostringstream os;
+  os.precision(10);
   auto row = [&](const sim::VehicleState& v, bool is_ego) {
     const Position p = ego.ToLocal(v.box.center);
     const Velocity vr = ego.RotateToLocal(v.velocity);
-    out_ << f.step << ',' << Fixed(f.time, 3) << ',' << v.id << ',' << v.type << ','
-         << (is_ego ? 1 : 0) << ',' << Fixed(v.box.center.x(), 4) << ','
-         << Fixed(v.box.center.y(), 4) << ',' << Fixed(v.box.yaw, 6) << ','
-         << Fixed(v.velocity.x(), 4) << ',' << Fixed(v.velocity.y(), 4) << ',' << Fixed(v.speed, 4)
-         << ',' << Fixed(v.lateral_speed, 4) << ',' << Fixed(v.yaw_rate, 6) << ','
-         << Fixed(v.box.length, 3) << ',' << Fixed(v.box.width, 3) << ',' << v.lane << ','
-         << Fixed(p.x(), 4) << ',' << Fixed(p.y(), 4) << ',' << Fixed(vr.x(), 4) << ','
-         << Fixed(vr.y(), 4) << '\n';
+    os << f.step << ',' << Fixed(f.time, 3) << ',' << v.id << ',' << v.type << ','
+       << (is_ego ? 1 : 0) << ',' << Fixed(v.box.center.x(), 4) << ',' << Fixed(v.box.center.y(), 4)
+       << ',' << Fixed(v.box.yaw, 6) << ',' << Fixed(v.velocity.x(), 4) << ','
+       << Fixed(v.velocity.y(), 4) << ',' << Fixed(v.speed, 4) << ',' << Fixed(v.lateral_speed, 4)
+       << ',' << Fixed(v.yaw_rate, 6) << ',' << Fixed(v.box.length, 3) << ','
+       << Fixed(v.box.width, 3) << ',' << v.lane << ',' << Fixed(p.x(), 4) << ',' << Fixed(p.y(), 4)
+       << ',' << Fixed(vr.x(), 4) << ',' << Fixed(vr.y(), 4) << '\n';
   };
   row(f.ego, true);
   for (const auto& v : f.vehicles) row(v, false);
+  out_.buffer() += os.str();
+  out_.MaybeFlush();
 }
 
-DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(OpenOutput(path)) {
-  out_ << "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
-          "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter\n";
+DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(path) {
+  out_.buffer() +=
+      "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
+      "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter\n";
 }
 
 void DetectionWriter::Write(const Pipeline& p) {
   const auto& f = p.frame();
+  std::ostringstream os;
+  os.precision(10);
   for (const auto& d : p.detections()) {
-    out_ << f.step << ',' << Fixed(f.time, 3) << ',' << d.sensor << ','
-         << p.radar().sensors()[d.sensor].name << ',' << Fixed(d.range, 4) << ','
-         << Fixed(d.azimuth, 6) << ',' << Fixed(d.range_rate, 4) << ',' << Fixed(d.snr_db, 2) << ','
-         << Fixed(d.position_ego.x(), 4) << ',' << Fixed(d.position_ego.y(), 4) << ','
-         << Fixed(d.position_world.x(), 4) << ',' << Fixed(d.position_world.y(), 4) << ','
-         << Fixed(d.radial_speed_compensated, 4) << ',' << Fixed(d.radial_velocity_world.x(), 4)
-         << ',' << Fixed(d.radial_velocity_world.y(), 4) << ','
-         << Fixed(d.sensor_position_world.x(), 4) << ',' << Fixed(d.sensor_position_world.y(), 4)
-         << ',' << p.ids().Name(d.source_id) << ',' << (d.is_clutter ? 1 : 0) << '\n';
+    os << f.step << ',' << Fixed(f.time, 3) << ',' << d.sensor << ','
+       << p.radar().sensors()[d.sensor].name << ',' << Fixed(d.range, 4) << ','
+       << Fixed(d.azimuth, 6) << ',' << Fixed(d.range_rate, 4) << ',' << Fixed(d.snr_db, 2) << ','
+       << Fixed(d.position_ego.x(), 4) << ',' << Fixed(d.position_ego.y(), 4) << ','
+       << Fixed(d.position_world.x(), 4) << ',' << Fixed(d.position_world.y(), 4) << ','
+       << Fixed(d.radial_speed_compensated, 4) << ',' << Fixed(d.radial_velocity_world.x(), 4)
+       << ',' << Fixed(d.radial_velocity_world.y(), 4) << ','
+       << Fixed(d.sensor_position_world.x(), 4) << ',' << Fixed(d.sensor_position_world.y(), 4)
+       << ',' << p.ids().Name(d.source_id) << ',' << (d.is_clutter ? 1 : 0) << '\n';
   }
+  out_.buffer() += os.str();
+  out_.MaybeFlush();
 }
 
 void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& path) {
-  std::ofstream out = OpenOutput(path);
+  std::ostringstream out;
   out << "id,kind,vertex,x,y,yaw,length,width\n";
   for (const auto& g : spec.guard_rails)
     for (std::size_t i = 0; i < g.points.size(); ++i)
@@ -92,6 +192,7 @@ void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& 
   for (const auto& p : spec.parked)
     out << p.id << ",parked,0," << p.box.center.x() << ',' << p.box.center.y() << ',' << p.box.yaw
         << ',' << p.box.length << ',' << p.box.width << '\n';
+  WriteTextFile(path, out.str());
 }
 
 }  // namespace dualgrid::tools

@@ -1,8 +1,9 @@
 // File output shared by the commands: CSV writers with documented columns (docs/output.md).
 #pragma once
 
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
@@ -18,34 +19,84 @@ std::string Fixed(double v, int decimals);
 /// Loads the scenario and applies command-line overrides (seed, duration).
 scenario::ScenarioConfig LoadConfig(const RunOptions& options);
 
-/// Copies the scenario file into the run folder, with the overrides noted, so a run can be
-/// repeated.
+/// Copies the scenario file into the run folder as scenario.yaml, with the overrides and the
+/// resolved network noted, so a run can be repeated.
 void CopyScenario(const scenario::ScenarioConfig& config, const std::filesystem::path& out);
+
+/// A text output written as it goes: plain, or gzip-compressed when the path ends in ".gz".
+/// Every write is checked when the file is closed: Close() throws std::runtime_error naming the
+/// file and the system's reason (a full disk, a file-size limit), so a failed write is never
+/// silent. Not copyable; the destructor closes without throwing (use Close() for the check).
+class OutputFile {
+ public:
+  explicit OutputFile(const std::filesystem::path& path);
+  ~OutputFile();
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+
+  /// Appends to an in-memory buffer, written out in large blocks.
+  std::string& buffer() { return buffer_; }
+  /// Writes the buffer out when it is large (call once per step).
+  void MaybeFlush();
+  void Close();
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  void Flush();
+  [[noreturn]] void Fail(const std::string& what);
+
+  std::filesystem::path path_;
+  std::string buffer_;
+  std::FILE* file_ = nullptr;
+  void* gz_ = nullptr;  // gzFile
+};
 
 /// ground_truth.csv: one row per vehicle (ego included) per step.
 class GroundTruthWriter {
  public:
   explicit GroundTruthWriter(const std::filesystem::path& path);
   void Write(const sim::Frame& frame);
+  void Close() { out_.Close(); }
 
  private:
-  std::ofstream out_;
+  OutputFile out_;
 };
 
-/// detections.csv: one row per radar detection per step.
+/// detections.csv (or detections.csv.gz): one row per radar detection per step.
 class DetectionWriter {
  public:
   explicit DetectionWriter(const std::filesystem::path& path);
   void Write(const Pipeline& pipeline);
+  void Close() { out_.Close(); }
 
  private:
-  std::ofstream out_;
+  OutputFile out_;
 };
+
+/// The detection file for a `--detections` format ("csv" or "csv.gz"); empty for "none".
+std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& dir,
+                                                   const std::string& format);
 
 /// obstacles.csv: guard-rail vertices and parked boxes.
 void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& path);
 
-/// Opens a file for writing or throws naming it.
-std::ofstream OpenOutput(const std::filesystem::path& path);
+/// A new, empty temporary folder (under $TMPDIR or /tmp), removed with everything in it when
+/// destroyed, unless destroyed while an exception is propagating: then it is kept for the
+/// working files an error message may name (e.g. SUMO's log).
+class TempDir {
+ public:
+  explicit TempDir(const std::string& purpose);
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  int exceptions_ = 0;
+};
+
+/// Writes a whole text file, checked: throws std::runtime_error naming the file and the reason.
+void WriteTextFile(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace dualgrid::tools

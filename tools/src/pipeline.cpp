@@ -10,6 +10,11 @@ int IdRegistry::Id(const std::string& name) {
   return it->second;
 }
 
+std::optional<int> IdRegistry::Find(const std::string& name) const {
+  const auto it = ids_.find(name);
+  return it == ids_.end() ? std::nullopt : std::optional<int>(it->second);
+}
+
 const std::string& IdRegistry::Name(int id) const {
   static const std::string kClutter = "clutter";
   if (id < 0 || id >= static_cast<int>(names_.size())) return kClutter;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@ namespace dualgrid::tools {
 class IdRegistry {
  public:
   int Id(const std::string& name);
+  /// The id of a name already registered.
+  std::optional<int> Find(const std::string& name) const;
   const std::string& Name(int id) const;  ///< "clutter" for -1
 
  private:

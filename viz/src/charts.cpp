@@ -92,6 +92,8 @@ struct LinearAxis {
 
 LinearAxis NiceAxis(double lo, double hi, bool fixed_lo, bool fixed_hi, int target) {
   if (!(hi > lo)) {
+    if (fixed_hi && !fixed_lo) lo = hi;
+    hi = lo;
     const double pad = std::max(1.0, std::abs(lo) * 0.1);
     lo -= pad;
     hi += pad;
@@ -103,6 +105,14 @@ LinearAxis NiceAxis(double lo, double hi, bool fixed_lo, bool fixed_hi, int targ
   return {lo, hi, detail::NiceTicks(lo, hi, target)};
 }
 
+// A chart with nothing to show still renders: its frame with a note, so a figure of an empty or
+// degenerate run is a picture that says so rather than an error.
+void DrawNoData(cairo_t* cr, const PlotArea& a, const std::string& what) {
+  DrawText(
+      cr, what, a.left + 0.5 * a.width, a.top + 0.5 * a.height,
+      {.size = kFont, .color = {0.4, 0.4, 0.4, 1.0}, .h = HAlign::kCenter, .v = VAlign::kMiddle});
+}
+
 }  // namespace
 
 PlotArea ChartPlotArea(int width, int height) {
@@ -111,8 +121,6 @@ PlotArea ChartPlotArea(int width, int height) {
 
 bool BarChart::IsValid(std::string* error) const {
   if (!ValidSize(width, height, error)) return false;
-  if (categories.empty()) return Fail(error, "categories is empty");
-  if (series.empty()) return Fail(error, "series is empty");
   for (std::size_t i = 0; i < series.size(); ++i) {
     if (series[i].values.size() != categories.size())
       return Fail(error, "series[" + std::to_string(i) + "].values has " +
@@ -128,8 +136,6 @@ bool BarChart::IsValid(std::string* error) const {
 
 bool LineChart::IsValid(std::string* error) const {
   if (!ValidSize(width, height, error)) return false;
-  if (series.empty()) return Fail(error, "series is empty");
-  bool any_point = false;
   for (std::size_t i = 0; i < series.size(); ++i) {
     const LineSeries& s = series[i];
     if (s.x.size() != s.y.size())
@@ -137,21 +143,13 @@ bool LineChart::IsValid(std::string* error) const {
                              " values, expected " + std::to_string(s.x.size()) + " (size of x)");
     if (!(s.line_width > 0.0 && s.line_width <= 20.0))
       return Fail(error, "series[" + std::to_string(i) + "].line_width must be in (0, 20]");
-    for (std::size_t k = 0; k < s.x.size(); ++k)
-      any_point |= std::isfinite(s.x[k]) && std::isfinite(s.y[k]) && (!log_y || s.y[k] > 0.0);
   }
-  if (!any_point)
-    return Fail(error, log_y ? "series has no finite positive point (log_y)"
-                             : "series has no finite point");
   if (log_y && !std::isnan(y_min) && !(y_min > 0.0))
     return Fail(error, "y_min must be positive with log_y");
   if (!std::isnan(x_min) && !std::isnan(x_max) && !(x_max > x_min))
     return Fail(error, "x_max must exceed x_min");
   if (!std::isnan(y_min) && !std::isnan(y_max) && !(y_max > y_min))
     return Fail(error, "y_max must exceed y_min");
-  for (std::size_t i = 0; i < spans.size(); ++i)
-    if (!(spans[i].x1 > spans[i].x0))
-      return Fail(error, "spans[" + std::to_string(i) + "].x1 must exceed x0");
   return true;
 }
 
@@ -184,6 +182,14 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
 
   const int nc = static_cast<int>(chart.categories.size());
   const int ns = static_cast<int>(chart.series.size());
+  if (nc == 0 || ns == 0) {
+    DrawFrame(cr, a);
+    DrawNoData(cr, a, "no data");
+    DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
+    DrawHeader(cr, chart.title, {}, a, chart.width);
+    canvas.WritePng(path);
+    return;
+  }
   const double slot = a.width / nc;
   const double bar_w = 0.8 * slot / ns;
   const double base = to_py(std::max(axis.lo, 0.0));
@@ -217,7 +223,12 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
     }
   }
   DrawFrame(cr, a);
-  for (int c = 0; c < nc; ++c)
+  // Every k-th category label when they would overlap (many objects in a narrow chart).
+  double widest = 0.0;
+  for (const std::string& c : chart.categories)
+    widest = std::max(widest, detail::TextWidth(cr, c, kFont * 0.9) + 6.0);
+  const int label_stride = std::max(1, static_cast<int>(std::ceil(widest / slot)));
+  for (int c = 0; c < nc; c += label_stride)
     DrawText(cr, chart.categories[c], a.left + slot * (c + 0.5), a.top + a.height + 8.0,
              {.size = kFont * 0.9, .h = HAlign::kCenter, .v = VAlign::kTop});
   DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
@@ -259,13 +270,22 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
         y_lo = std::min(y_lo, s.y[k]);
         y_hi = std::max(y_hi, s.y[k]);
       }
+  const bool no_data = !(x_hi >= x_lo);
+  if (no_data) x_lo = 0.0, x_hi = 1.0, y_lo = chart.log_y ? 0.1 : 0.0, y_hi = 1.0;
   if (!std::isnan(chart.x_min)) x_lo = chart.x_min;
   if (!std::isnan(chart.x_max)) x_hi = chart.x_max;
   if (!std::isnan(chart.y_min)) y_lo = chart.y_min;
   if (!std::isnan(chart.y_max)) y_hi = chart.y_max;
-  if (!(x_hi > x_lo)) {
-    x_lo -= 1.0;
-    x_hi += 1.0;
+  if (!(x_hi > x_lo)) {  // one point, one x, or a fixed end beyond the data: centre on x_lo
+    const double c = std::isnan(chart.x_min) && !std::isnan(chart.x_max) ? x_hi : x_lo;
+    x_lo = c - 1.0;
+    x_hi = c + 1.0;
+  }
+  if (chart.log_y && !(y_hi > y_lo)) {
+    if (std::isnan(chart.y_max))
+      y_hi = 10.0 * y_lo;
+    else
+      y_lo = 0.1 * y_hi;
   }
   // The x axis is not widened: time series should start and end at the frame.
   const std::vector<double> xt = detail::NiceTicks(x_lo, x_hi, std::max(2, int(a.width / 110)));
@@ -321,10 +341,14 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
     }
   }
 
-  // Shaded spans under the lines.
+  // Shaded spans under the lines; a span of zero width (one sample) is drawn 2 px wide, reversed
+  // ends are read in order, and a span with a non-finite end is skipped.
   for (const XSpan& span : chart.spans) {
-    const double x0 = std::max(a.left, to_px(span.x0));
-    const double x1 = std::min(a.left + a.width, to_px(span.x1));
+    if (!std::isfinite(span.x0) || !std::isfinite(span.x1)) continue;
+    double x0 = to_px(std::min(span.x0, span.x1)), x1 = to_px(std::max(span.x0, span.x1));
+    if (x1 - x0 < 2.0) x0 -= 1.0, x1 += 1.0;
+    x0 = std::max(a.left, x0);
+    x1 = std::min(a.left + a.width, x1);
     if (x1 <= x0) continue;
     cairo_rectangle(cr, x0, a.top, x1 - x0, a.height);
     SetColor(cr, {0.5, 0.5, 0.5, 0.15});
@@ -359,20 +383,23 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
     const Rgba color = SeriesColor(s.name, s.color, static_cast<int>(i));
     legend.push_back({s.name, color, s.dashed ? Marker::kDashedLine : Marker::kLine});
     cairo_new_path(cr);
-    bool pen_down = false;
-    for (std::size_t k = 0; k < s.x.size(); ++k) {
-      if (!usable(s.x[k], s.y[k])) {
-        pen_down = false;  // a gap breaks the line
-        continue;
-      }
-      const double px = to_px(s.x[k]), py = to_py(s.y[k]);
-      if (pen_down)
-        cairo_line_to(cr, px, py);
-      else
-        cairo_move_to(cr, px, py);
-      pen_down = true;
-    }
     SetColor(cr, color);
+    for (std::size_t k = 0; k < s.x.size(); ++k) {
+      if (!usable(s.x[k], s.y[k])) continue;
+      const double px = to_px(s.x[k]), py = to_py(s.y[k]);
+      const bool joined_before = k > 0 && usable(s.x[k - 1], s.y[k - 1]);
+      const bool joined_after = k + 1 < s.x.size() && usable(s.x[k + 1], s.y[k + 1]);
+      if (joined_before) {
+        cairo_line_to(cr, px, py);
+      } else if (joined_after) {
+        cairo_move_to(cr, px, py);
+      } else {  // an isolated point (one sample, or between gaps) would draw nothing: a dot
+        cairo_new_sub_path(cr);
+        cairo_arc(cr, px, py, s.line_width, 0.0, 2.0 * kPi);
+        cairo_fill(cr);
+        cairo_new_path(cr);
+      }
+    }
     cairo_set_line_width(cr, s.line_width);
     if (s.dashed) {
       const double dash[] = {3.0 * s.line_width, 2.0 * s.line_width};
@@ -383,6 +410,7 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
     cairo_stroke(cr);
   }
   cairo_restore(cr);
+  if (no_data) DrawNoData(cr, a, "no data");
   DrawFrame(cr, a);
   DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
   DrawHeader(cr, chart.title, legend, a, chart.width);

@@ -39,7 +39,9 @@ inline constexpr std::string_view kDetectionTime = "t_d";
 inline constexpr std::string_view kTrackedFraction = "D";
 inline constexpr std::string_view kFalseClusters = "false_clusters_per_scan";
 inline constexpr std::string_view kDuplicateClusters = "duplicate_clusters_per_scan";
+inline constexpr std::string_view kScored = "objects_scored";
 inline constexpr std::string_view kNeverTracked = "objects_never_tracked";
+inline constexpr std::string_view kNeverObservable = "objects_never_in_coverage";
 inline constexpr std::string_view kDynamicF1 = "dynamic_cell_f1";
 
 /// One number of the paper's Tables I and II, in our units (D as a fraction in [0, 1]).
@@ -76,6 +78,10 @@ class ComparisonTable {
   void SetPaper(std::string_view metric, std::string_view mode, double value);
   /// Sets every PaperReference(scenario()) value whose metric and mode are in the table.
   void AttachPaperReference();
+  /// A sentence printed under the Markdown table and listed in the JSON ("notes"), e.g. why a
+  /// cell is empty.
+  void AddNote(std::string note) { notes_.push_back(std::move(note)); }
+  const std::vector<std::string>& notes() const { return notes_; }
 
   std::optional<Summary> Ours(std::string_view metric, std::string_view mode) const;
   std::optional<double> Paper(std::string_view metric, std::string_view mode) const;
@@ -86,7 +92,8 @@ class ComparisonTable {
 
   /// A heading, a table with "mode" and "mode (paper)" columns (the latter only for modes with
   /// paper numbers), cells "mean ± half-width" ("—" when empty; "(n=k)" when fewer seeds than
-  /// the table's largest n contributed), and a note on the interval.
+  /// the table's largest n contributed), a note on the interval (none for a single seed), what
+  /// "—" means, and the notes.
   std::string ToMarkdown() const;
   /// Long format, one row per (metric, mode):
   /// scenario,metric,unit,mode,n,mean,ci95_half_width,ci95_low,ci95_high,paper (empty = none).
@@ -102,6 +109,7 @@ class ComparisonTable {
   std::vector<MetricSpec> metrics_;
   std::vector<std::vector<std::optional<Summary>>> ours_;  // [metric][mode]
   std::vector<std::vector<std::optional<double>>> paper_;
+  std::vector<std::string> notes_;
 };
 
 /// The runs (one ScenarioMetrics per seed) of one filter mode.
@@ -111,7 +119,8 @@ struct ModeRuns {
 };
 
 /// The standard table: Delta x [m], Delta v [m/s], t_d [s], D [%], false and duplicate clusters
-/// per scan, objects never tracked, and the dynamic-cell F1 when any run has cell metrics.
+/// per scan, objects scored, objects never tracked (scored, never consistently tracked) and of
+/// those never in any radar's coverage, and the dynamic-cell F1 when any run has cell metrics.
 /// Each cell summarises the seeds where the metric is defined (Summary::n says how many). Paper
 /// numbers are attached when the scenario is known. Columns follow the order of `runs`.
 ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const ModeRuns> runs);

@@ -14,7 +14,8 @@
 //   holds >= `required` tracked frames. Its track onset is the time t1 of the earliest tracked
 //   frame in that window (when the consistent track began, not when the rule confirmed it; the
 //   difference is at most window - 1 frames), and t_d = t1 - t0. Scenario t_d: mean over scored
-//   objects that were ever consistently tracked; the others are counted as never tracked.
+//   objects that were ever consistently tracked; the others are counted as never tracked (and,
+//   if they were never in any radar's coverage while in the grid, also as never observable).
 // - False / duplicate clusters per scan: mean over frames of the counts from Associate.
 #pragma once
 
@@ -70,8 +71,8 @@ struct ScenarioMetrics {
   std::optional<double> tracked_fraction;  ///< D in [0, 1]
   int objects_scored = 0;
   int objects_detected = 0;          ///< scored and ever consistently tracked
-  int objects_never_tracked = 0;     ///< scored, clock started, never consistently tracked
-  int objects_never_observable = 0;  ///< scored but never in_coverage while in_grid
+  int objects_never_tracked = 0;     ///< scored, never consistently tracked (for any reason)
+  int objects_never_observable = 0;  ///< of those: never in_coverage while in_grid
   double clusters_per_scan = 0.0;
   double false_clusters_per_scan = 0.0;
   double duplicate_clusters_per_scan = 0.0;

@@ -19,8 +19,10 @@ namespace dualgrid::sim {
 /// environment variable DUALGRID_NETWORK_DIR.
 std::filesystem::path DefaultNetworkDir();
 
-/// Resolves a scenario's network name to an existing .net.xml file or throws std::runtime_error
-/// naming the path it looked for.
+/// Resolves a scenario's network to an existing .net.xml file: a name ("highway") is looked up
+/// in `network_dir`; a path ending in .xml is taken as it is (the scenario loader has already
+/// made a relative path relative to the scenario file). Throws std::invalid_argument naming the
+/// path it looked for and, for a name, the networks that are built.
 std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir);
 
@@ -63,6 +65,7 @@ class SumoSimulation {
   void ApplyActions();
 
   ScenarioSpec spec_;
+  std::filesystem::path log_path_;  ///< SUMO's message log, named in errors
   Frame frame_;
   int step_ = 0;
   std::size_t next_action_ = 0;

@@ -1,0 +1,240 @@
+// A new user's first hour (issue 9): readable errors with documented exit codes, results that
+// survive a failing figure or seed, scenario-relative paths, and every output documented.
+#include <sys/wait.h>
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;  // stdout and stderr
+};
+
+Result Shell(const std::string& cmd) {
+  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string out;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
+}
+
+Result Run(const std::string& args) { return Shell(std::string(DUALGRID_EXE) + " " + args); }
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path TempDir(const std::string& name) {
+  const auto d = fs::temp_directory_path() / ("dualgrid_newcomer_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+int CountLines(const std::string& s) {
+  return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
+
+// One line on stderr, starting "dualgrid: error:", naming `what`, with no runaway number.
+void CheckOneLineError(const Result& r, int code, const std::string& what) {
+  INFO(r.output);
+  CHECK(r.code == code);
+  CHECK(CountLines(r.output) == 1);
+  CHECK(r.output.rfind("dualgrid: error: ", 0) == 0);
+  CHECK(r.output.find(what) != std::string::npos);
+  CHECK(r.output.size() < 400);
+}
+
+}  // namespace
+
+TEST_CASE("Bad command-line values: one readable line, exit code 2", "[cli][newcomer]") {
+  const std::string out = " --out " + (fs::temp_directory_path() / "dualgrid_never").string();
+  CheckOneLineError(Run("experiment scenarios/highway.yaml --seeds 0" + out), 2, "--seeds");
+  CheckOneLineError(Run("run scenarios/highway.yaml --threads -1" + out), 2, "--threads");
+  CheckOneLineError(Run("run scenarios/highway.yaml --threads 100000" + out), 2, "--threads");
+  CheckOneLineError(Run("run scenarios/highway.yaml --seed -1" + out), 2, "--seed");
+  CheckOneLineError(Run("run scenarios/highway.yaml --duration ''" + out), 2, "--duration");
+  CheckOneLineError(Run("experiment scenarios/highway.yaml -j 0" + out), 2, "--jobs");
+  CheckOneLineError(Run("experiment scenarios/highway.yaml -j -3" + out), 2, "--jobs");
+  CheckOneLineError(Run("experiment scenarios/highway.yaml --seed 3" + out), 2, "--seed");
+  CheckOneLineError(Run("snapshot scenarios/highway.yaml -t 3 --behind -5 --out /tmp/x.png"), 2,
+                    "--behind");
+  CheckOneLineError(Run("run scenarios/highway.yaml --modes dual,fancy" + out), 2, "--modes");
+  CheckOneLineError(Run("run" + out), 2, "scenario");
+  CheckOneLineError(Run("run scenarios/highway.yaml --out ''"), 2, "--out");
+  CheckOneLineError(Run("tangential --kind parallel --ego-speed 20 --speed 30 --out /tmp/t.yaml"),
+                    2, "--speed");
+  CHECK_FALSE(fs::exists(fs::temp_directory_path() / "dualgrid_never"));
+}
+
+TEST_CASE("Help shows defaults, documents exit codes, and lists only valid options",
+          "[cli][newcomer]") {
+  const Result tangential = Run("tangential --help");
+  CHECK(tangential.code == 0);
+  CHECK(tangential.output.find("--count INT:INT in [1, 12]=4") != std::string::npos);
+  CHECK(tangential.output.find("default: crossing 15") != std::string::npos);
+  const Result experiment = Run("experiment --help");
+  CHECK(experiment.output.find("--seed ") == std::string::npos);
+  CHECK(experiment.output.find("--seeds") != std::string::npos);
+  CHECK(experiment.output.find("{false}") == std::string::npos);
+  CHECK(experiment.output.find("--no-figures ") != std::string::npos);
+  const Result top = Run("--help");
+  CHECK(top.output.find("Exit codes: 0") != std::string::npos);
+  // Every code named in --help is explained in docs/cli.md.
+  const std::string doc = Slurp("docs/cli.md");
+  for (const char* code : {"| 0 |", "| 1 |", "| 2 |", "| 3 |"})
+    CHECK(doc.find(code) != std::string::npos);
+}
+
+TEST_CASE("tangential --speed is the speed over ground for both kinds", "[cli][newcomer]") {
+  const auto dir = TempDir("speed");
+  REQUIRE(Run("tangential --kind parallel --ego-speed 20 --speed 21 -q --out " +
+              (dir / "p.yaml").string())
+              .code == 0);
+  const std::string p = Slurp(dir / "p.yaml");
+  CHECK(p.find("speed: 21, desired_speed: 21") != std::string::npos);
+  REQUIRE(
+      Run("tangential --kind parallel --ego-speed 20 -q --out " + (dir / "d.yaml").string()).code ==
+      0);
+  CHECK(Slurp(dir / "d.yaml").find("speed: 20.3, desired_speed: 20.3") != std::string::npos);
+  REQUIRE(Run("tangential --kind crossing --speed 12 -q --out " + (dir / "c.yaml").string()).code ==
+          0);
+  CHECK(Slurp(dir / "c.yaml").find("speed: 12, desired_speed: 12") != std::string::npos);
+}
+
+TEST_CASE("snapshot writes only the PNG it is asked for", "[cli][newcomer]") {
+  const auto dir = TempDir("snapshot");
+  CheckOneLineError(
+      Run("snapshot scenarios/highway.yaml -t 2 -q --out " + (dir / "s.svg").string()), 2, ".png");
+  REQUIRE(Run("snapshot scenarios/highway.yaml -t 2 -q --out " + (dir / "s.png").string()).code ==
+          0);
+  std::set<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  CHECK(names == std::set<std::string>{"s.png"});
+}
+
+TEST_CASE("A network path is read relative to the scenario file", "[cli][newcomer]") {
+  const auto dir = TempDir("relative");
+  fs::create_directories(dir / "nets");
+  fs::copy_file(fs::path(DUALGRID_NETWORK_DIR) / "simple_road.net.xml",
+                dir / "nets" / "road.net.xml");
+  std::string text = Slurp("scenarios/simple_road.yaml");
+  text = std::regex_replace(text, std::regex("\nnetwork: simple_road\n"),
+                            "\nnetwork: nets/road.net.xml\n");
+  REQUIRE(text.find("nets/road.net.xml") != std::string::npos);
+  std::ofstream(dir / "s.yaml") << text;
+  // Run from the repository (the test's working folder), not from the scenario's folder.
+  const Result ok = Run("sim " + (dir / "s.yaml").string() + " --duration 1 -q --detections none " +
+                        "--out " + (dir / "o").string());
+  INFO(ok.output);
+  CHECK(ok.code == 0);
+  CHECK(Slurp(dir / "o" / "scenario.yaml").find((dir / "nets" / "road.net.xml").string()) !=
+        std::string::npos);
+  std::ofstream(dir / "bad.yaml") << std::regex_replace(text, std::regex("nets/road"), "nets/none");
+  CheckOneLineError(Run("sim " + (dir / "bad.yaml").string() + " --out " + (dir / "o2").string()),
+                    2, "relative to the scenario file");
+  CheckOneLineError(Run("sim " + (dir / "bad.yaml").string() + " --out " + (dir / "o2").string()),
+                    2, (dir / "nets" / "none.net.xml").string());
+}
+
+TEST_CASE("A figure that fails is a warning; the results are all there", "[cli][newcomer]") {
+  const auto dir = TempDir("figure_fails");
+  // A folder where the picture should go: cairo cannot write it.
+  fs::create_directories(dir / "figures" / "tracked_share.png");
+  const Result r = Run("run scenarios/simple_road.yaml --duration 2 --out " + dir.string());
+  INFO(r.output);
+  CHECK(r.code == 0);
+  CHECK(r.output.find("dualgrid: warning: figure " +
+                      (dir / "figures" / "tracked_share.png").string()) != std::string::npos);
+  CHECK(r.output.find("| D [%] |") != std::string::npos);  // the table is printed
+  for (const char* f : {"metrics.json", "objects.csv", "table.md", "table.csv", "table.json",
+                        "weights.csv", "summary.json"})
+    CHECK(fs::file_size(dir / f) > 0);
+  const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
+  CHECK(summary.at("complete") == true);
+  CHECK(summary.at("warnings").size() == 1);
+  // A single run claims no interval over one seed.
+  CHECK(r.output.find("over 1 seed") == std::string::npos);
+  CHECK(r.output.find("One seed") != std::string::npos);
+}
+
+TEST_CASE("experiment aggregates the seeds that finished and names the failed one",
+          "[cli][newcomer]") {
+  const auto dir = TempDir("seed_fails");
+  // Seed 2 cannot write its metrics (a folder stands in the way): that run fails late.
+  fs::create_directories(dir / "seeds" / "seed_2" / "metrics.json");
+  const Result r =
+      Run("experiment scenarios/simple_road.yaml --seeds 2 --duration 2 --no-figures "
+          "-q --out " +
+          dir.string());
+  INFO(r.output);
+  CHECK(r.code == 3);
+  CHECK(r.output.find("seed 2 failed: dualgrid: error: cannot create") != std::string::npos);
+  const std::string table = Slurp(dir / "table.csv");
+  CHECK(table.find("simple_road,D,%,dual,1,") != std::string::npos);  // seed 1 only
+  CHECK(Slurp(dir / "table.md").find("Seed 2 failed") != std::string::npos);
+  const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
+  CHECK(summary.at("complete") == false);
+  CHECK(summary.at("seeds_failed").at(0).at("seed") == 2);
+}
+
+TEST_CASE("A write past a file-size limit is an error naming the file", "[cli][newcomer]") {
+  const auto dir = TempDir("file_limit");
+  // 64 KiB per file: config.json fits, ground_truth.csv of 20 s does not.
+  const Result r =
+      Shell("ulimit -f 64; " + std::string(DUALGRID_EXE) +
+            " run scenarios/simple_road.yaml --duration 20 --no-figures -q --out " + dir.string());
+  INFO(r.output);
+  CHECK(r.code == 1);
+  CHECK(CountLines(r.output) == 1);
+  CHECK(r.output.find("cannot write " + (dir / "ground_truth.csv").string()) != std::string::npos);
+  CHECK(r.output.find("File too large") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "summary.json"));  // the run does not look finished
+}
+
+TEST_CASE("Every file a run and an experiment write is documented", "[cli][newcomer]") {
+  const auto dir = TempDir("outputs");
+  REQUIRE(Run("experiment scenarios/simple_road.yaml --seeds 1 --duration 2 --snapshots 1 "
+              "--detections csv.gz --write-particles -q --out " +
+              dir.string())
+              .code == 0);
+  const std::string doc = Slurp("docs/output.md");
+  // Concrete names are documented as patterns: times as <time>, modes as <mode>, seeds as <n>.
+  const std::regex time_re("_t[0-9]+\\.[0-9]+"), mode_re("_(position|velocity|dual)_"),
+      seed_re("seed_[0-9]+");
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    ++files;
+    std::string name = fs::relative(e.path(), dir).string();
+    name = std::regex_replace(name, seed_re, "seed_<n>");
+    name = std::regex_replace(name, std::regex("^seeds/seed_<n>/"), "");
+    name = std::regex_replace(name, time_re, "_t<time>");
+    name = std::regex_replace(name, mode_re, "_<mode>_");
+    INFO(e.path());
+    CHECK(doc.find("`" + name + "`") != std::string::npos);
+  }
+  CHECK(files > 20);
+}
+
+TEST_CASE("The paper is cited so that a reader can find it", "[docs][newcomer]") {
+  const std::string doc = Slurp("docs/algorithm.md");
+  CHECK(doc.find("/work/") == std::string::npos);
+  CHECK(doc.find("arXiv:2303.11390") != std::string::npos);
+}

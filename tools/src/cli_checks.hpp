@@ -1,0 +1,33 @@
+// Command-line value checks with readable messages ("--seeds: expected a whole number in
+// [1, 10000], got '0'") in place of CLI11's generic range text, and the bounds they enforce.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace dualgrid::tools {
+
+/// Largest seed accepted anywhere: 2^53 - 1, so that a seed written to JSON is read back exactly
+/// by readers that hold numbers as doubles (Python's json, JavaScript).
+inline constexpr std::uint64_t kMaxSeed = (std::uint64_t{1} << 53) - 1;
+/// At most this many seeds per experiment (each is one process and one folder).
+inline constexpr int kMaxSeeds = 10000;
+/// OpenMP threads (and parallel runs) per core at most: more only adds switching, and very large
+/// counts exhaust the stack space of the thread pool.
+inline constexpr int kMaxThreadsPerCore = 4;
+/// Longest simulated duration [s] accepted on the command line (one day).
+inline constexpr double kMaxDuration = 86400.0;
+
+/// The machine's cores (at least 1).
+int Cores();
+
+/// A whole number in [lo, hi] (no sign for lo >= 0, no fraction, no trailing text).
+CLI::Validator WholeNumber(long long lo, long long hi);
+/// A non-empty path (an empty --out would write into the working folder).
+CLI::Validator NonEmptyPath();
+/// A finite number in (lo, hi] when lo_open, else [lo, hi].
+CLI::Validator Number(double lo, double hi, bool lo_open);
+
+}  // namespace dualgrid::tools

@@ -1,0 +1,153 @@
+#include "run_outputs.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace dualgrid::tools {
+
+ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
+  out_.buffer() += "step,time,mode,x,y,vx,vy,weight,particles,role,object,x_ego,y_ego\n";
+}
+
+void ClusterWriter::Write(const sim::Frame& f, const std::string& mode, const ModeScorer& scorer,
+                          const std::vector<eval::TruthObject>& objects, const IdRegistry& ids) {
+  static const char* kRole[] = {"matched", "duplicate", "false"};
+  const auto& a = scorer.association();
+  std::ostringstream os;
+  os.precision(10);
+  for (std::size_t c = 0; c < scorer.clusters().size(); ++c) {
+    const eval::Cluster& cl = scorer.clusters()[c];
+    const Position local = f.EgoPose().ToLocal(cl.position);
+    os << f.step << ',' << Fixed(f.time, 3) << ',' << mode << ',' << Fixed(cl.position.x(), 3)
+       << ',' << Fixed(cl.position.y(), 3) << ',' << Fixed(cl.velocity.x(), 3) << ','
+       << Fixed(cl.velocity.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
+       << kRole[static_cast<int>(a.role[c])] << ','
+       << (a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id)
+                                       : std::string())
+       << ',' << Fixed(local.x(), 2) << ',' << Fixed(local.y(), 2) << '\n';
+  }
+  out_.buffer() += os.str();
+  out_.MaybeFlush();
+}
+
+void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
+  const sim::Frame& f = pipeline.frame();
+  const auto& grid = pipeline.grid(mode);
+  const auto& p = grid.particles();
+  for (const auto& v : f.vehicles) {
+    if (!grid.CellOf(v.box.center)) continue;
+    ++frames_in_grid[v.id];
+    double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
+    const OrientedBox grown{v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
+      wp += p.w_position[i];
+      wv += p.w_velocity[i];
+      w += p.weight[i];
+      if ((Velocity(p.vx[i], p.vy[i]) - v.velocity).norm() < WeightTrace::kGoodVelocity) {
+        wp_good += p.w_position[i];
+        wv_good += p.w_velocity[i];
+      }
+    }
+    int n = 0, tangential = 0;
+    const int vehicle_id = pipeline.ids().Find(v.id).value_or(-2);  // scanned: registered
+    for (const auto& d : pipeline.detections())
+      if (d.source_id == vehicle_id) {
+        tangential += std::abs(d.radial_speed_compensated) < 0.5 * v.velocity.norm();
+        ++n;
+      }
+    auto& t = by_vehicle[v.id];
+    t.time.push_back(f.time);
+    t.w_position.push_back(wp);
+    t.w_velocity.push_back(wv);
+    t.weight.push_back(w);
+    t.position_share.push_back(wp > 0 ? wp_good / wp : std::nan(""));
+    t.velocity_share.push_back(wv > 0 ? wv_good / wv : std::nan(""));
+    t.tangential_share.push_back(n > 0 ? static_cast<double>(tangential) / n : std::nan(""));
+  }
+}
+
+std::string WeightTraces::Focus(const std::string& requested) const {
+  if (by_vehicle.count(requested)) return requested;
+  std::string focus;
+  int best = -1;
+  for (const auto& [id, n] : frames_in_grid)
+    if (n > best) best = n, focus = id;
+  return focus;
+}
+
+void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot& snapshot,
+                    const std::filesystem::path& path) {
+  OutputFile pc(path);
+  pc.buffer() += "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
+  const auto& grid = pipeline.grid(m);
+  const auto& ps = grid.particles();
+  std::ostringstream os;
+  os.precision(10);
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    const auto cell = grid.CellOf(Position(ps.x[i], ps.y[i]));
+    const double pd =
+        cell ? snapshot.dynamic[static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x]
+             : 0.0;
+    os << Fixed(ps.x[i], 3) << ',' << Fixed(ps.y[i], 3) << ',' << Fixed(ps.vx[i], 3) << ','
+       << Fixed(ps.vy[i], 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
+       << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
+  }
+  pc.buffer() += os.str();
+  pc.Close();
+}
+
+void WriteObjects(const std::vector<std::string>& modes,
+                  const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
+                  const std::filesystem::path& path) {
+  std::ostringstream os;
+  os << "mode,id,name,frames_in_grid,frames_tracked,scored,D,t_d,delta_x,delta_v\n";
+  auto opt = [](const std::optional<double>& v) { return v ? Fixed(*v, 4) : std::string(); };
+  for (std::size_t m = 0; m < modes.size(); ++m)
+    for (const auto& o : metrics[m].objects)
+      os << modes[m] << ',' << o.id << ',' << ids.Name(o.id) << ',' << o.frames_in_grid << ','
+         << o.frames_tracked << ',' << (o.scored ? 1 : 0) << ',' << opt(o.tracked_fraction) << ','
+         << opt(o.detection_time) << ',' << opt(o.position_error) << ',' << opt(o.velocity_error)
+         << '\n';
+  WriteTextFile(path, os.str());
+}
+
+void WriteWeights(const WeightTrace& t, const std::string& object,
+                  const std::filesystem::path& path) {
+  std::ostringstream os;
+  os.precision(10);
+  os << "time,object,w_position,w_velocity,w_resample,position_share,velocity_share,"
+        "tangential_share\n";
+  for (std::size_t i = 0; i < t.time.size(); ++i)
+    os << Fixed(t.time[i], 3) << ',' << object << ',' << t.w_position[i] << ',' << t.w_velocity[i]
+       << ',' << t.weight[i] << ',' << t.position_share[i] << ',' << t.velocity_share[i] << ','
+       << t.tangential_share[i] << '\n';
+  WriteTextFile(path, os.str());
+}
+
+void WriteTables(const eval::ComparisonTable& table, const std::filesystem::path& dir) {
+  WriteTextFile(dir / "table.md", table.ToMarkdown());
+  WriteTextFile(dir / "table.csv", table.ToCsv());
+  WriteTextFile(dir / "table.json", table.ToJson().dump(2) + "\n");
+}
+
+std::vector<std::string> UnscoredNotes(const std::vector<eval::ScenarioMetrics>& metrics,
+                                       const IdRegistry& ids, int min_frames_in_grid) {
+  // Every mode sees the same vehicles in the same grid: the first mode's objects suffice.
+  if (metrics.empty()) return {};
+  std::string list;
+  int count = 0;
+  for (const auto& o : metrics.front().objects) {
+    if (o.scored) continue;
+    if (++count <= 12)
+      list += (list.empty() ? "" : ", ") + ids.Name(o.id) + " (" +
+              std::to_string(o.frames_in_grid) + ")";
+  }
+  if (count == 0) return {};
+  if (count > 12) list += ", and " + std::to_string(count - 12) + " more";
+  return {"Not scored, fewer than " + std::to_string(min_frames_in_grid) +
+          " frames in the grid (`evaluation.min_frames_in_grid`): " + list +
+          ". Their frames are in objects.csv."};
+}
+
+}  // namespace dualgrid::tools

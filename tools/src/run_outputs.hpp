@@ -1,0 +1,64 @@
+// The files a `dualgrid run` writes besides the ground truth and detections (docs/output.md):
+// per-cycle clusters, per-vehicle weight traces, the particles behind a picture, and the results.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dualgrid/eval/aggregate.hpp"
+#include "figures.hpp"
+#include "output.hpp"
+#include "pipeline.hpp"
+#include "scoring.hpp"
+
+namespace dualgrid::tools {
+
+/// clusters.csv: every cluster of every cycle with its role in the association.
+class ClusterWriter {
+ public:
+  explicit ClusterWriter(const std::filesystem::path& path);
+  /// The clusters of `scorer`'s last frame, for mode `mode`; `objects` as given to the scorer.
+  void Write(const sim::Frame& frame, const std::string& mode, const ModeScorer& scorer,
+             const std::vector<eval::TruthObject>& objects, const IdRegistry& ids);
+  void Close() { out_.Close(); }
+
+ private:
+  OutputFile out_;
+};
+
+/// Weight traces of every vehicle in the grid (paper Fig. 4), from one filter's particles.
+struct WeightTraces {
+  std::map<std::string, WeightTrace> by_vehicle;
+  std::map<std::string, int> frames_in_grid;
+  /// Adds the current step of `pipeline` for filter `mode`.
+  void Add(const Pipeline& pipeline, std::size_t mode);
+  /// The scenario's focus object if it was in the grid, else the vehicle longest in the grid;
+  /// empty when no vehicle was.
+  std::string Focus(const std::string& requested) const;
+};
+
+/// figures/particles_<mode>_t<time>.csv: every particle of filter `m` with its cell's P(dynamic).
+void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot& snapshot,
+                    const std::filesystem::path& path);
+
+/// objects.csv: one row per (mode, object ever in the grid).
+void WriteObjects(const std::vector<std::string>& modes,
+                  const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
+                  const std::filesystem::path& path);
+
+/// weights.csv of one vehicle's trace.
+void WriteWeights(const WeightTrace& trace, const std::string& object,
+                  const std::filesystem::path& path);
+
+/// table.md, table.csv and table.json.
+void WriteTables(const eval::ComparisonTable& table, const std::filesystem::path& dir);
+
+/// Notes for the table: the objects that were in the grid but too briefly to be scored.
+std::vector<std::string> UnscoredNotes(const std::vector<eval::ScenarioMetrics>& metrics,
+                                       const IdRegistry& ids, int min_frames_in_grid);
+
+}  // namespace dualgrid::tools
