@@ -164,7 +164,9 @@ std::string ComparisonTable::ToMarkdown() const {
     }
   }
   std::ostringstream os;
-  os << "### " << scenario_ << "\n\n| metric |";
+  os << "### " << scenario_ << "\n\n";
+  if (!status_.empty()) os << "**" << status_ << "**\n\n";
+  os << "| metric |";
   std::string rule = "|---|";
   for (std::size_t c = 0; c < modes_.size(); ++c) {
     os << ' ' << modes_[c] << " |";
@@ -255,7 +257,11 @@ nlohmann::json ComparisonTable::ToJson() const {
     }
     metrics.push_back({{"key", m.key}, {"label", m.label}, {"unit", m.unit}, {"values", values}});
   }
-  return {{"scenario", scenario_}, {"modes", modes_}, {"metrics", metrics}, {"notes", notes_}};
+  return {{"scenario", scenario_},
+          {"modes", modes_},
+          {"metrics", metrics},
+          {"notes", notes_},
+          {"status", status_}};
 }
 
 ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const ModeRuns> runs) {

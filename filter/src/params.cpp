@@ -40,6 +40,11 @@ bool Fail(std::string* error, const std::string& msg) {
 
 }  // namespace
 
+double FilterParams::MemoryBytes() const {
+  const double cells = static_cast<double>(CellsX()) * CellsY();
+  return 93.0 * cells + 88.0 * num_particles + 44.0 * num_birth;
+}
+
 bool FilterParams::IsValid(std::string* error) const {
   const auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   const auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };

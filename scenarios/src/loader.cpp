@@ -414,6 +414,7 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
 void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out) {
   ScenarioConfig& config = *out;
   MapReader root(doc, name, "");
+  config.sim.file = name;
   ReadSim(root, &config.sim);
   if (config.sim.name.empty()) config.sim.name = std::filesystem::path(name).stem().string();
   std::string error;
@@ -422,6 +423,26 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
   ReadFilter(root, &config.filter);
   ReadEvaluation(root, &config.evaluation);
   root.Finish();
+  // Names the evaluation uses must exist: a typo would silently pick another vehicle.
+  const auto& focus = config.evaluation.focus_object;
+  if (!focus.empty()) {
+    bool found = focus == config.sim.ego.id;
+    for (const auto& v : config.sim.vehicles) found = found || v.id == focus;
+    // A flow's vehicles are named by SUMO "<flow id>.<k>".
+    for (const auto& f : config.sim.flows)
+      found =
+          found || (focus.rfind(f.id + ".", 0) == 0 && focus.size() > f.id.size() + 1 &&
+                    focus.find_first_not_of("0123456789", f.id.size() + 1) == std::string::npos);
+    if (!found || focus == config.sim.ego.id)
+      throw ConfigError(name + ": key 'evaluation.focus_object' names '" + focus +
+                        "', which is no vehicle of the scenario (expected an id of "
+                        "traffic.vehicles, or <flow id>.<k> for the k-th vehicle of a flow)");
+  }
+  for (double t : config.evaluation.snapshot_times)
+    if (!(t > 0.0 && t <= config.sim.duration))
+      throw ConfigError(
+          name + ": key 'evaluation.snapshot_times' holds " + std::to_string(t) +
+          " s, outside the run (0, duration = " + std::to_string(config.sim.duration) + "] s");
 }
 
 }  // namespace dualgrid::scenario

@@ -12,6 +12,29 @@ std::string Show(const YAML::Node& n) {
   return "nothing";
 }
 
+// Text goes into JSON and SUMO's XML, both UTF-8 only.
+bool ValidUtf8(const std::string& s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t extra = 0;  // continuation bytes after the lead byte
+    if (c >= 0x80) {
+      if ((c >> 5) == 0x6)
+        extra = 1;
+      else if ((c >> 4) == 0xE)
+        extra = 2;
+      else if ((c >> 3) == 0x1E)
+        extra = 3;
+      else
+        return false;
+    }
+    if (i + extra >= s.size() && extra > 0) return false;
+    for (std::size_t k = 1; k <= extra; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) >> 6) != 0x2) return false;
+    i += 1 + extra;
+  }
+  return true;
+}
+
 }  // namespace
 
 MapReader::MapReader(YAML::Node node, std::string file, std::string path)
@@ -19,6 +42,18 @@ MapReader::MapReader(YAML::Node node, std::string file, std::string path)
   if (!node_.IsMap()) {
     throw ConfigError(file_ + ": key '" + (path_.empty() ? "<document>" : path_) +
                       "': expected a map of settings, got " + Show(node_));
+  }
+  // yaml-cpp keeps one of two equal keys without a word; a repeated key is almost always an
+  // edit that left the old value behind, so it is an error naming the line of the second.
+  std::set<std::string> seen;
+  for (const auto& kv : node_) {
+    if (!kv.first.IsScalar()) continue;  // reported where the key is read
+    if (!ValidUtf8(kv.first.Scalar()))
+      throw ConfigError(file_ + ":" + std::to_string(kv.first.Mark().line + 1) + ": a key of '" +
+                        (path_.empty() ? "<document>" : path_) + "' is not valid UTF-8 text");
+    if (!seen.insert(kv.first.Scalar()).second)
+      throw ConfigError(file_ + ":" + std::to_string(kv.first.Mark().line + 1) + ": key '" +
+                        KeyPath(kv.first.Scalar()) + "' appears twice in the same map");
   }
 }
 
@@ -94,6 +129,7 @@ void MapReader::Read(const std::string& key, bool* out) {
 void MapReader::Read(const std::string& key, std::string* out) {
   if (auto n = Get(key)) {
     if (!n.IsScalar()) Fail(key, "expected a text value, got " + Show(n));
+    if (!ValidUtf8(n.Scalar())) Fail(key, "is not valid UTF-8 text");
     *out = n.Scalar();
   }
 }
@@ -131,6 +167,8 @@ void MapReader::Read(const std::string& key, std::vector<std::string>* out) {
     for (std::size_t i = 0; i < n.size(); ++i) {
       if (!n[i].IsScalar())
         Fail(key + "[" + std::to_string(i) + "]", "expected a name, got " + Show(n[i]));
+      if (!ValidUtf8(n[i].Scalar()))
+        Fail(key + "[" + std::to_string(i) + "]", "is not valid UTF-8 text");
       out->push_back(n[i].Scalar());
     }
   }

@@ -13,9 +13,15 @@ bool Fail(std::string* error, const std::string& field, const std::string& messa
   return false;
 }
 
+// SUMO refuses ids with these characters (whitespace and XML or list separators).
+bool ValidSumoId(const std::string& id) {
+  return !id.empty() && id.find_first_of(" \t\n\r|\\'\";,<>&") == std::string::npos;
+}
+constexpr const char* kIdRule = "must be non-empty without spaces or any of | \\ ' \" ; , < > &";
+
 bool CheckVehicle(const VehicleSpec& v, const std::string& field, const ScenarioSpec& s,
                   std::string* error) {
-  if (v.id.empty()) return Fail(error, field + ".id", "must not be empty");
+  if (!ValidSumoId(v.id)) return Fail(error, field + ".id", kIdRule);
   if (!s.vehicle_types.count(v.type))
     return Fail(error, field + ".type", "unknown vehicle type '" + v.type + "'");
   if (!s.routes.count(v.route))
@@ -40,13 +46,14 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   if (network.empty()) return Fail(error, "network", "must name a network");
   if (!(duration > 0.0 && duration <= 3600.0))
     return Fail(error, "duration", "must be in (0, 3600] s");
-  if (!(step_length > 0.0 && step_length <= 1.0))
-    return Fail(error, "step_length", "must be in (0, 1] s");
+  if (!(step_length >= 0.001 && step_length <= 1.0))
+    return Fail(error, "step_length", "must be in [0.001, 1] s");
   if (std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) > 1e-6)
     return Fail(error, "step_length", "must be a whole number of milliseconds (SUMO's resolution)");
   if (!(lane_change_duration >= 0.0)) return Fail(error, "lane_change_duration", "must be >= 0 s");
   for (const auto& [name, t] : vehicle_types) {
     const std::string f = "vehicle_types." + name;
+    if (!ValidSumoId(name)) return Fail(error, f, std::string("(the type's name) ") + kIdRule);
     if (!(t.length > 0.0 && t.length <= 30.0))
       return Fail(error, f + ".length", "must be in (0, 30] m");
     if (!(t.width > 0.0 && t.width <= 4.0)) return Fail(error, f + ".width", "must be in (0, 4] m");
@@ -56,8 +63,11 @@ bool ScenarioSpec::IsValid(std::string* error) const {
     if (!(t.decel > 0.0)) return Fail(error, f + ".decel", "must be > 0 m/s^2");
     if (!std::isfinite(t.rcs_dbsm)) return Fail(error, f + ".rcs_dbsm", "must be finite");
   }
-  for (const auto& [name, edges] : routes)
+  for (const auto& [name, edges] : routes) {
+    if (!ValidSumoId(name))
+      return Fail(error, "routes." + name, std::string("(the route's name) ") + kIdRule);
     if (edges.empty()) return Fail(error, "routes." + name, "must list at least one edge");
+  }
   if (!(duration >= step_length))
     return Fail(error, "duration", "must be at least one step_length");
   if (!CheckVehicle(ego, "ego", *this, error)) return false;
@@ -75,7 +85,7 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   for (std::size_t i = 0; i < flows.size(); ++i) {
     const FlowSpec& fl = flows[i];
     const std::string f = "traffic.flows[" + std::to_string(i) + "]";
-    if (fl.id.empty()) return Fail(error, f + ".id", "must not be empty");
+    if (!ValidSumoId(fl.id)) return Fail(error, f + ".id", kIdRule);
     if (!ids.insert(fl.id).second) return Fail(error, f + ".id", "duplicate id '" + fl.id + "'");
     if (!vehicle_types.count(fl.type))
       return Fail(error, f + ".type", "unknown vehicle type '" + fl.type + "'");
@@ -108,8 +118,13 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   }
   for (std::size_t i = 0; i < guard_rails.size(); ++i) {
     const std::string f = "obstacles.guard_rails[" + std::to_string(i) + "]";
-    if (guard_rails[i].points.size() < 2)
-      return Fail(error, f + ".points", "needs at least 2 points");
+    const auto& pts = guard_rails[i].points;
+    if (pts.size() < 2) return Fail(error, f + ".points", "needs at least 2 points");
+    for (std::size_t k = 1; k < pts.size(); ++k)
+      if (!((pts[k] - pts[k - 1]).norm() > 1e-3))
+        return Fail(error, f + ".points",
+                    "has a segment of zero length (points " + std::to_string(k - 1) + " and " +
+                        std::to_string(k) + " coincide)");
   }
   for (std::size_t i = 0; i < parked.size(); ++i) {
     const OrientedBox& b = parked[i].box;

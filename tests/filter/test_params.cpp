@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <malloc.h>
+
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -51,4 +53,25 @@ TEST_CASE("weight mode names round-trip", "[filter][params]") {
   CHECK(ParseWeightMode(ToString(m)) == m);
   CHECK_FALSE(ParseWeightMode("Dual").has_value());
   CHECK_FALSE(ParseWeightMode("").has_value());
+}
+
+TEST_CASE("MemoryBytes matches what a DynamicGrid allocates", "[filter][params]") {
+  struct Size {
+    double length, width;
+    int particles, births;
+  };
+  const Size size = GENERATE(Size{100.0, 25.0, 10000, 1000}, Size{200.0, 50.0, 200000, 20000},
+                             Size{60.0, 60.0, 1000000, 0});
+  FilterParams p;
+  p.length_x = size.length;
+  p.width_y = size.width;
+  p.num_particles = size.particles;
+  p.num_birth = size.births;
+  const std::size_t before = mallinfo2().uordblks + mallinfo2().hblkhd;
+  const DynamicGrid grid(p, 1);
+  const std::size_t after = mallinfo2().uordblks + mallinfo2().hblkhd;
+  const double used = static_cast<double>(after - before);
+  INFO("estimate " << p.MemoryBytes() << " B, allocated " << used << " B");
+  CHECK(p.MemoryBytes() >= 0.95 * used);
+  CHECK(p.MemoryBytes() <= 1.05 * used);
 }

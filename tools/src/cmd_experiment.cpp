@@ -1,11 +1,13 @@
 // `dualgrid experiment`: `dualgrid run` over several seeds (separate processes: libsumo holds one
 // simulation per process), then the paper-style tables with 95 % confidence intervals.
 #include <fcntl.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -21,8 +23,7 @@
 #include "output.hpp"
 #include "progress.hpp"
 #include "run_outputs.hpp"
-
-extern char** environ;
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 namespace {
@@ -64,16 +65,36 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
   const std::string log = (dir / "log.txt").string();
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, o.executable.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw std::runtime_error("cannot start " + o.executable + ": " + std::strerror(rc));
+  const pid_t parent = getpid();
+  // fork + exec rather than posix_spawn: the child must die with the experiment
+  // (PR_SET_PDEATHSIG), or a killed experiment leaves its runs running on their own. Between
+  // fork and exec only async-signal-safe calls.
+  const pid_t pid = fork();
+  if (pid < 0)
+    throw std::runtime_error("cannot start " + o.executable + ": " + std::strerror(errno));
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(143);  // the parent died before prctl took effect
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) _exit(126);
+    dup2(fd, 1);
+    dup2(fd, 2);
+    close(fd);
+    execv(o.executable.c_str(), argv.data());
+    _exit(127);
+  }
   return pid;
+}
+
+// A run folder is finished only when its summary.json, written last, says so.
+bool RunComplete(const std::filesystem::path& dir) {
+  try {
+    std::ifstream in(dir / "summary.json");
+    return in && nlohmann::json::parse(in).value("complete", false);
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 // The last non-empty line of a run's log: its error message.
@@ -97,8 +118,10 @@ int RunExperiment(const ExperimentOptions& o) {
                                 std::to_string(kMaxSeed));
   ParseModes(o.run.modes);  // fail early on a bad mode
   scenario::ScenarioConfig config = LoadConfig(o.run.run);
+  CheckFilterMemory(config, o.run.modes.size());
   DetectionPath(o.run.run.out, o.run.detections);  // fail early on a bad format
   const auto& out = o.run.run.out;
+  BeginOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
   const int jobs = o.jobs > 0 ? o.jobs : Cores();
   auto seed_dir = [&](std::uint64_t seed) {
@@ -111,23 +134,37 @@ int RunExperiment(const ExperimentOptions& o) {
   std::vector<std::uint64_t> finished;
   std::vector<std::pair<std::uint64_t, std::string>> failed;  // seed, its error
   int next = 0, done = 0;
+  std::vector<std::uint64_t> cut_short;  // stopped by a signal: partial, not aggregated
+  bool forwarded = false;
   while (done < o.seeds) {
-    while (next < o.seeds && static_cast<int>(running.size()) < jobs) {
+    while (!StopSignal() && next < o.seeds && static_cast<int>(running.size()) < jobs) {
       const std::uint64_t seed = o.first_seed + next++;
       running[StartRun(o, seed, seed_dir(seed), o.run.figures && seed == o.first_seed)] = seed;
     }
+    if (StopSignal() && !forwarded) {
+      // Each run stops at the end of its step and writes its part, marked incomplete.
+      for (const auto& [pid, seed] : running) kill(pid, StopSignal());
+      forwarded = true;
+    }
+    if (running.empty()) break;  // stopped before every seed was started
     int status = 0;
     const pid_t pid = wait(&status);
-    if (pid < 0) throw std::runtime_error("lost track of the seed runs");
+    if (pid < 0) {
+      if (errno == EINTR) continue;  // a signal: forward it above
+      throw std::runtime_error("lost track of the seed runs: " + std::string(std::strerror(errno)));
+    }
     const std::uint64_t seed = running.at(pid);
     running.erase(pid);
     ++done;
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (code == 0 && RunComplete(seed_dir(seed))) {
       finished.push_back(seed);
+    } else if (StopSignal() && (code == 130 || code == 143)) {
+      cut_short.push_back(seed);
     } else {
       std::string why = LastLine(seed_dir(seed) / "log.txt");
       if (WIFSIGNALED(status)) why = "killed by signal " + std::to_string(WTERMSIG(status));
-      if (why.empty()) why = "exit code " + std::to_string(WEXITSTATUS(status));
+      if (why.empty()) why = "exit code " + std::to_string(code);
       failed.emplace_back(seed, why);
       std::cerr << "dualgrid: seed " << seed << " failed: " << why << "\n";
     }
@@ -135,6 +172,19 @@ int RunExperiment(const ExperimentOptions& o) {
   }
   progress.Finish();
   std::sort(finished.begin(), finished.end());
+  std::string stop_status;
+  if (StopSignal()) {
+    std::string list;
+    for (auto seed : cut_short) list += (list.empty() ? "" : ", ") + std::to_string(seed);
+    stop_status =
+        "Incomplete experiment: stopped by signal " + std::to_string(StopSignal()) + "; " +
+        std::to_string(finished.size()) + " of " + std::to_string(o.seeds) + " seeds finished" +
+        (list.empty() ? "" : "; cut short: " + list) + "; never started: " +
+        std::to_string(o.seeds -
+                       static_cast<int>(finished.size() + cut_short.size() + failed.size()));
+    std::cerr << "dualgrid: " << stop_status << "\n";
+    if (finished.empty()) return StopExitCode();
+  }
   if (finished.empty())
     throw std::runtime_error("all " + std::to_string(o.seeds) +
                              " seed runs failed; the first: " + failed.front().second +
@@ -149,7 +199,7 @@ int RunExperiment(const ExperimentOptions& o) {
   for (const std::uint64_t seed : finished) {
     const auto dir = seed_dir(seed);
     nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "metrics.json"));
-    wall += j.value("wall_s", 0.0);
+    wall += nlohmann::json::parse(std::ifstream(dir / "summary.json")).value("wall_s", 0.0);
     for (auto& r : runs) {
       eval::ScenarioMetrics m = j.at("modes").at(r.mode).get<eval::ScenarioMetrics>();
       for (auto& obj : m.objects)
@@ -159,6 +209,7 @@ int RunExperiment(const ExperimentOptions& o) {
     }
   }
   eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
+  table.SetStatus(stop_status);
   for (const auto& [seed, why] : failed)
     table.AddNote("Seed " + std::to_string(seed) + " failed and is not in the table: " + why);
   WriteTables(table, out);
@@ -176,7 +227,7 @@ int RunExperiment(const ExperimentOptions& o) {
   if (!o.run.run.quiet) std::cout << table.ToMarkdown() << "\n";
 
   std::vector<std::string> warnings;
-  if (o.run.figures) {
+  if (o.run.figures && !StopSignal()) {
     TrackedShares shares;
     for (const auto& [id, r] : rows) shares.emplace_back(names.Name(id), r);
     const auto png = out / "figures" / "tracked_share.png";
@@ -197,7 +248,9 @@ int RunExperiment(const ExperimentOptions& o) {
         std::filesystem::copy_file(e.path(), out / "figures" / e.path().filename(),
                                    std::filesystem::copy_options::overwrite_existing);
   }
-  nlohmann::json summary = {{"complete", failed.empty()},
+  nlohmann::json summary = {{"complete", failed.empty() && !StopSignal()},
+                            {"status", stop_status},
+                            {"seeds_cut_short", cut_short},
                             {"scenario", config.sim.name},
                             {"seeds_finished", finished},
                             {"wall_s_of_runs", wall},
@@ -208,6 +261,7 @@ int RunExperiment(const ExperimentOptions& o) {
   if (!o.run.run.quiet)
     std::cout << finished.size() << " of " << o.seeds << " seeds (" << Fixed(wall, 0)
               << " s of runs); results in " << out.string() << "\n";
+  if (StopSignal()) return StopExitCode();
   if (!failed.empty()) {
     std::string list;
     for (const auto& [seed, why] : failed)

@@ -14,6 +14,7 @@
 #include "progress.hpp"
 #include "run_outputs.hpp"
 #include "scoring.hpp"
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 
@@ -68,9 +69,11 @@ int RunFilters(const FilterRunOptions& options) {
   std::vector<std::string> mode_names;
   for (auto m : modes) mode_names.emplace_back(filter::ToString(m));
   scenario::ScenarioConfig config = LoadConfig(options.run);
+  CheckFilterMemory(config, modes.size());
   const std::vector<double> snapshot_times = SnapshotTimes(options, config);
   const auto detections_path = DetectionPath(options.run.out, options.detections);
   const auto& out = options.run.out;
+  BeginOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
   CopyScenario(config, out);
   WriteTextFile(out / "config.json", ConfigJson(config, options).dump(2) + "\n");
@@ -94,7 +97,7 @@ int RunFilters(const FilterRunOptions& options) {
                     config.sim.StepCount(), !options.run.quiet);
   int steps = 0;
   std::size_t total_detections = 0;
-  while (pipeline.Step()) {
+  while (!StopSignal() && pipeline.Step()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
@@ -136,6 +139,16 @@ int RunFilters(const FilterRunOptions& options) {
     progress.Update(steps, "t=" + Fixed(f.time, 1) + " s");
   }
   progress.Finish();
+  const int stop = StopSignal();
+  const double simulated = steps * config.sim.step_length;
+  const bool complete = !stop && steps == config.sim.StepCount();
+  std::string status;
+  if (stop)
+    status = "Incomplete run: stopped by signal " + std::to_string(stop) +
+             " at t = " + Fixed(simulated, 2) + " s of " + Fixed(config.sim.duration, 2) + " s";
+  else if (!complete)
+    status = "Shorter run than asked: SUMO ended at t = " + Fixed(simulated, 2) + " s of " +
+             Fixed(config.sim.duration, 2) + " s (the ego left the network; see sumo.log)";
   truth.Close();
   if (detections) detections->Close();
   clusters.Close();
@@ -154,13 +167,13 @@ int RunFilters(const FilterRunOptions& options) {
   mj["scenario"] = config.sim.name;
   mj["seed"] = config.sim.seed;
   mj["steps"] = steps;
-  mj["wall_s"] = wall;
   mj["detections_per_step"] = steps ? static_cast<double>(total_detections) / steps : 0.0;
   for (const auto& o : metrics.front().objects)
     mj["object_names"][std::to_string(o.id)] = pipeline.ids().Name(o.id);
   WriteTextFile(out / "metrics.json", mj.dump(2) + "\n");
   WriteObjects(mode_names, metrics, pipeline.ids(), out / "objects.csv");
   eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
+  table.SetStatus(status);
   for (std::string& note :
        UnscoredNotes(metrics, pipeline.ids(), config.evaluation.tracking.min_frames_in_grid))
     table.AddNote(std::move(note));
@@ -169,7 +182,7 @@ int RunFilters(const FilterRunOptions& options) {
   if (!focus.empty()) WriteWeights(traces.by_vehicle.at(focus), focus, out / "weights.csv");
   if (!options.run.quiet) std::cout << table.ToMarkdown() << "\n";
 
-  if (options.figures) {
+  if (options.figures && !stop) {
     if (!focus.empty()) {
       const auto png = out / "figures" / "weights.png";
       TryFigure(
@@ -192,15 +205,20 @@ int RunFilters(const FilterRunOptions& options) {
   }
 
   // Written last: a run folder without summary.json did not finish.
-  nlohmann::json summary = {{"complete", true},
+  nlohmann::json summary = {{"complete", complete},
+                            {"status", status},
                             {"scenario", config.sim.name},
                             {"seed", config.sim.seed},
                             {"steps", steps},
-                            {"simulated_s", steps * config.sim.step_length},
+                            {"simulated_s", simulated},
                             {"requested_s", config.sim.duration},
                             {"wall_s", wall},
                             {"warnings", warnings}};
+  summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
+  if (!status.empty())
+    std::cerr << "dualgrid: " << status << "; results in " << out.string() << "\n";
+  if (stop) return StopExitCode();
   if (!options.run.quiet)
     std::cout << config.sim.name << ": " << steps << " steps in " << Fixed(wall, 1)
               << " s; results in " << out.string()

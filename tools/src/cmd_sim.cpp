@@ -12,6 +12,7 @@
 #include "output.hpp"
 #include "pipeline.hpp"
 #include "progress.hpp"
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 
@@ -20,7 +21,7 @@ int RunSim(const SimOptions& sim_options) {
   scenario::ScenarioConfig config = LoadConfig(options);
   const auto detections_path = DetectionPath(options.out, sim_options.detections);
   const sim::ScenarioSpec& spec = config.sim;
-  std::filesystem::create_directories(options.out);
+  BeginOutputFolder(options.out);
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -38,7 +39,7 @@ int RunSim(const SimOptions& sim_options) {
   Progress progress("sim " + spec.name, spec.StepCount(), !options.quiet);
   int steps = 0;
   std::size_t detection_count = 0, clutter_count = 0;
-  while (pipeline.Step()) {
+  while (!StopSignal() && pipeline.Step()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
@@ -61,7 +62,7 @@ int RunSim(const SimOptions& sim_options) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
   nlohmann::json summary;
-  summary["complete"] = true;
+  summary["complete"] = !StopSignal() && steps == spec.StepCount();
   summary["scenario"] = spec.name;
   summary["seed"] = spec.seed;
   summary["steps"] = steps;
@@ -77,8 +78,19 @@ int RunSim(const SimOptions& sim_options) {
                                {"min_distance_to_ego_m", s.min_distance}};
   }
   summary["requested_s"] = spec.duration;
+  summary["digests"] = OutputDigests(options.out);
   // Written last: a folder without summary.json did not finish.
   WriteTextFile(options.out / "summary.json", summary.dump(2) + "\n");
+  if (StopSignal()) {
+    std::cerr << "dualgrid: stopped by signal " << StopSignal()
+              << " at t = " << Fixed(steps * spec.step_length, 2) << " s; the simulated part is in "
+              << options.out.string() << "\n";
+    return StopExitCode();
+  }
+  if (steps != spec.StepCount())
+    std::cerr << "dualgrid: shorter run than asked: SUMO ended at t = "
+              << Fixed(steps * spec.step_length, 2) << " s of " << Fixed(spec.duration, 2)
+              << " s (the ego left the network; see sumo.log)\n";
   if (!options.quiet) {
     std::cout << spec.name << ": " << steps << " steps (" << Fixed(steps * spec.step_length, 1)
               << " s simulated in " << Fixed(wall, 1) << " s), " << seen.size()

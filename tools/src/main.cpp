@@ -12,6 +12,7 @@
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 #include "exit_codes.hpp"
+#include "signals.hpp"
 
 namespace {
 
@@ -20,7 +21,8 @@ using namespace dualgrid::tools;
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (SUMO error, an output not written); 2 bad input "
     "(command line, scenario or network file; nothing simulated); 3 experiment: some seed runs "
-    "failed (the others are aggregated). Details: docs/cli.md.";
+    "failed (the others are aggregated); 130/143 stopped by SIGINT/SIGTERM (results of the "
+    "simulated part written, marked incomplete). Details: docs/cli.md.";
 
 // An option whose default is shown in --help.
 template <typename T>
@@ -98,6 +100,7 @@ int main(int argc, char** argv) {
   // Past a file-size limit (ulimit -f) a write should fail and be reported naming the file, not
   // kill the process with SIGXFSZ and leave a half-written run behind silently.
   std::signal(SIGXFSZ, SIG_IGN);
+  InstallStopHandlers();
   CLI::App app{
       "dualgrid: radar-only dynamic occupancy grid with dual particle weights, "
       "co-simulated with SUMO.\nScenarios are YAML files (see scenarios/ and "

@@ -3,7 +3,10 @@
 #include <stdlib.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
+#include <vector>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -114,6 +117,37 @@ TempDir::~TempDir() {
   if (std::uncaught_exceptions() > exceptions_) return;
   std::error_code ec;
   std::filesystem::remove_all(path_, ec);
+}
+
+nlohmann::json OutputDigests(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  nlohmann::json digests = nlohmann::json::object();
+  std::vector<char> buf(1 << 16);
+  for (const auto& f : files) {
+    const std::string name = f.filename().string();
+    if (name == "summary.json" || name == "sumo.log" || name == "log.txt") continue;
+    std::uint64_t h = 14695981039346656037ull;
+    std::ifstream in(f, std::ios::binary);
+    while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
+      for (std::streamsize i = 0; i < in.gcount(); ++i)
+        h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ull;
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    digests[std::filesystem::relative(f, dir).string()] = hex;
+  }
+  return digests;
+}
+
+void BeginOutputFolder(const std::filesystem::path& out) {
+  std::filesystem::create_directories(out);
+  std::error_code ec;
+  std::filesystem::remove(out / "summary.json", ec);
+  if (ec)
+    throw std::runtime_error("cannot remove the earlier " + (out / "summary.json").string() + ": " +
+                             ec.message());
 }
 
 void WriteTextFile(const std::filesystem::path& path, const std::string& text) {

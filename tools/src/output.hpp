@@ -6,6 +6,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
@@ -95,6 +97,18 @@ class TempDir {
   std::filesystem::path path_;
   int exceptions_ = 0;
 };
+
+/// Creates the output folder and removes an earlier run's completion record (summary.json) from
+/// it before anything else is written: a folder is a finished run only if its summary.json says
+/// `complete: true`, so a run killed midway in a reused folder never looks finished.
+void BeginOutputFolder(const std::filesystem::path& out);
+
+/// Digests of every file under `dir` (relative path -> 16 hex digits, FNV-1a 64 over the bytes:
+/// a change detector, not a cryptographic hash), except summary.json, which holds them, and
+/// SUMO's own sumo.log and the runs' log.txt. Everything else a run writes is a function of the
+/// scenario and the seed alone (wall-clock times live only in summary.json), so equal digests
+/// mean equal outputs, whatever the thread count.
+nlohmann::json OutputDigests(const std::filesystem::path& dir);
 
 /// Writes a whole text file, checked: throws std::runtime_error naming the file and the reason.
 void WriteTextFile(const std::filesystem::path& path, const std::string& text);

@@ -1,5 +1,8 @@
 #include "pipeline.hpp"
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <stdexcept>
 
 namespace dualgrid::tools {
@@ -21,9 +24,28 @@ const std::string& IdRegistry::Name(int id) const {
   return names_[id];
 }
 
+const scenario::ScenarioConfig& CheckFilterMemory(const scenario::ScenarioConfig& config,
+                                                  std::size_t modes) {
+  const double need = static_cast<double>(modes) * config.filter.MemoryBytes();
+  const double have =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+  if (have > 0 && need > 0.8 * have) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "%s: key 'filter.num_particles' (%d) with num_birth %d and %d x %d cells: %zu "
+                  "filter(s) would need %.1f GB, more than 80 %% of this machine's %.1f GB; lower "
+                  "them or run fewer --modes",
+                  config.file.string().c_str(), config.filter.num_particles,
+                  config.filter.num_birth, config.filter.CellsX(), config.filter.CellsY(), modes,
+                  need / 1e9, have / 1e9);
+    throw std::invalid_argument(buf);
+  }
+  return config;
+}
+
 Pipeline::Pipeline(const scenario::ScenarioConfig& config, const std::filesystem::path& network_dir,
                    const std::filesystem::path& work_dir, std::vector<filter::WeightMode> modes)
-    : config_(config),
+    : config_(CheckFilterMemory(config, modes.size())),
       simulation_(config.sim, sim::ResolveNetwork(config.sim.network, network_dir), work_dir),
       radar_(config.radar.sensors, config.radar.options, config.sim.seed),
       modes_(std::move(modes)) {

@@ -31,6 +31,12 @@ class IdRegistry {
   std::vector<std::string> names_;
 };
 
+/// Throws std::invalid_argument, naming the scenario file and its filter keys, when `modes`
+/// filters of `config` would need more than 80 % of this machine's physical memory
+/// (FilterParams::MemoryBytes); returns `config`. Call before writing anything.
+const scenario::ScenarioConfig& CheckFilterMemory(const scenario::ScenarioConfig& config,
+                                                  std::size_t modes);
+
 class Pipeline {
  public:
   Pipeline(const scenario::ScenarioConfig& config, const std::filesystem::path& network_dir,

@@ -81,6 +81,9 @@ class ComparisonTable {
   /// A sentence printed under the Markdown table and listed in the JSON ("notes"), e.g. why a
   /// cell is empty.
   void AddNote(std::string note) { notes_.push_back(std::move(note)); }
+  /// A status line printed in bold right under the heading (e.g. an incomplete run) and stored
+  /// in the JSON as "status"; empty: none.
+  void SetStatus(std::string status) { status_ = std::move(status); }
   const std::vector<std::string>& notes() const { return notes_; }
 
   std::optional<Summary> Ours(std::string_view metric, std::string_view mode) const;
@@ -110,6 +113,7 @@ class ComparisonTable {
   std::vector<std::vector<std::optional<Summary>>> ours_;  // [metric][mode]
   std::vector<std::vector<std::optional<double>>> paper_;
   std::vector<std::string> notes_;
+  std::string status_;
 };
 
 /// The runs (one ScenarioMetrics per seed) of one filter mode.

@@ -66,6 +66,14 @@ struct FilterParams {
   /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
   int CellsX() const;
   int CellsY() const;
+  /// Heap memory of one DynamicGrid with these parameters [bytes], from its layout: per cell 93
+  /// bytes (four double masses, free-space bits, nearest detection and distance, cell ranges,
+  /// birth list, 8 sort histograms), per persistent particle 88 (the particle and its sorted
+  /// copy, 36 each, cell index, resampling sum), per new-born particle 44. Within a few percent
+  /// of the measured allocation (tests/filter/test_params.cpp); detection buffers (which grow
+  /// with the detections per cycle) are not included. Lets a caller refuse a configuration
+  /// before allocating it.
+  double MemoryBytes() const;
 
   /// True when every field is usable; otherwise names the offending field in *error.
   bool IsValid(std::string* error) const;

@@ -83,9 +83,11 @@ struct ParkedBox {
 };
 
 struct ScenarioSpec {
+  std::string file;  ///< the scenario file it came from, named in error messages ("" if none)
   std::string name;
   std::string description;
-  std::string network;        ///< network name, resolved to <network dir>/<name>.net.xml
+  /// A built network's name (<network dir>/<name>.net.xml) or a path to a .net.xml file.
+  std::string network;
   double duration = 60.0;     ///< [s]
   double step_length = 0.05;  ///< [s] SUMO step = radar cycle
   std::uint64_t seed = 1;

@@ -63,6 +63,10 @@ class SumoSimulation {
   VehicleState ReadVehicle(const std::string& id);
   void ApplyDepartures();
   void ApplyActions();
+  // Checks the scenario against the loaded network: every route edge exists and consecutive
+  // edges connect, departure lanes exist and positions lie on the first edge. Throws
+  // std::invalid_argument naming the key.
+  void CheckAgainstNetwork() const;
 
   ScenarioSpec spec_;
   std::filesystem::path log_path_;  ///< SUMO's message log, named in errors

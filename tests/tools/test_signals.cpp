@@ -1,0 +1,167 @@
+// Real signals sent to real runs (docs/reliability.md): SIGINT and SIGTERM stop at the end of a
+// step and leave the simulated part's results marked incomplete; experiment forwards them; a
+// killed experiment takes its runs with it; a killed run never looks finished.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+fs::path TempDir(const std::string& name) {
+  const auto d = fs::temp_directory_path() / ("dualgrid_signals_" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Starts dualgrid with `args`, output to `log`; returns its pid.
+pid_t Start(const std::vector<std::string>& args, const fs::path& log) {
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    std::freopen(log.c_str(), "w", stdout);
+    dup2(fileno(stdout), 2);
+    std::vector<char*> argv{const_cast<char*>(DUALGRID_EXE)};
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(DUALGRID_EXE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+// Waits until `path` exists (the run has got going), at most `limit`.
+bool WaitFor(const fs::path& path, std::chrono::seconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (std::chrono::steady_clock::now() < end) {
+    if (fs::exists(path)) return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return false;
+}
+
+int ExitCode(pid_t pid) {
+  int status = 0;
+  REQUIRE(waitpid(pid, &status, 0) == pid);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Processes whose command line mentions `text` (the runs of one test's output folder).
+int ProcessesMentioning(const std::string& text) {
+  int n = 0;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string pid = e.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(e.path() / "cmdline");
+    std::string cmd((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ifstream st(e.path() / "stat");
+    std::string stat((std::istreambuf_iterator<char>(st)), std::istreambuf_iterator<char>());
+    const bool zombie = stat.find(") Z ") != std::string::npos;
+    if (!zombie && cmd.find(text) != std::string::npos) ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("SIGINT and SIGTERM stop a run with its partial results marked incomplete",
+          "[cli][signals]") {
+  const int sig = GENERATE(SIGINT, SIGTERM);
+  const auto dir = TempDir("run_" + std::to_string(sig));
+  const pid_t pid =
+      Start({"run", "scenarios/highway.yaml", "--no-figures", "-q", "--out", dir.string()},
+            dir.parent_path() / ("run_" + std::to_string(sig) + ".log"));
+  // clusters.csv is created when the first step starts; give it a few steps more.
+  REQUIRE(WaitFor(dir / "clusters.csv", 60s));
+  std::this_thread::sleep_for(1s);
+  kill(pid, sig);
+  CHECK(ExitCode(pid) == 128 + sig);
+  const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
+  CHECK(summary.at("complete") == false);
+  CHECK(summary.at("simulated_s").get<double>() < summary.at("requested_s").get<double>());
+  CHECK(
+      Slurp(dir / "table.md").find("**Incomplete run: stopped by signal " + std::to_string(sig)) !=
+      std::string::npos);
+  const auto metrics = nlohmann::json::parse(Slurp(dir / "metrics.json"));
+  CHECK(metrics.at("steps").get<int>() > 0);
+}
+
+TEST_CASE("experiment forwards SIGTERM to its runs and keeps the finished seeds",
+          "[cli][signals]") {
+  const auto dir = TempDir("experiment");
+  // Seed 1 is short and finishes; seed 2 is still running when the signal comes.
+  const pid_t pid = Start({"experiment", "scenarios/highway.yaml", "--seeds", "2", "-j", "1",
+                           "--no-figures", "-q", "--out", dir.string()},
+                          dir.parent_path() / "experiment.log");
+  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 120s));
+  std::this_thread::sleep_for(1s);
+  kill(pid, SIGTERM);  // the parent only: it must forward the signal
+  CHECK(ExitCode(pid) == 143);
+  CHECK(ProcessesMentioning(dir.string()) == 0);
+  const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
+  CHECK(summary.at("complete") == false);
+  CHECK(summary.at("seeds_finished") == nlohmann::json::array({1}));
+  CHECK(summary.at("seeds_cut_short") == nlohmann::json::array({2}));
+  const auto seed2 = nlohmann::json::parse(Slurp(dir / "seeds" / "seed_2" / "summary.json"));
+  CHECK(seed2.at("complete") == false);
+  CHECK(Slurp(dir / "table.csv").find("highway,D,%,dual,1,") != std::string::npos);
+}
+
+TEST_CASE("A killed experiment takes its runs with it", "[cli][signals]") {
+  const auto dir = TempDir("orphans");
+  const pid_t pid = Start({"experiment", "scenarios/highway.yaml", "--seeds", "2", "-j", "2",
+                           "--no-figures", "-q", "--out", dir.string()},
+                          dir.parent_path() / "orphans.log");
+  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 120s));
+  kill(pid, SIGKILL);
+  CHECK(ExitCode(pid) == 128 + SIGKILL);
+  // The runs get SIGTERM from the kernel (PR_SET_PDEATHSIG) and stop at the end of their step.
+  const auto end = std::chrono::steady_clock::now() + 20s;
+  while (ProcessesMentioning(dir.string()) > 0 && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(100ms);
+  CHECK(ProcessesMentioning(dir.string()) == 0);
+}
+
+TEST_CASE("A run killed in a folder of an earlier finished run does not look finished",
+          "[cli][signals]") {
+  const auto dir = TempDir("reuse");
+  const std::string exe = DUALGRID_EXE;
+  REQUIRE(std::system((exe +
+                       " run scenarios/simple_road.yaml --duration 1 --no-figures -q "
+                       "--out " +
+                       dir.string())
+                          .c_str()) == 0);
+  REQUIRE(fs::exists(dir / "summary.json"));
+  const pid_t pid =
+      Start({"run", "scenarios/simple_road.yaml", "--no-figures", "-q", "--out", dir.string()},
+            dir.parent_path() / "reuse.log");
+  // The earlier run's completion record goes before the new run writes anything.
+  const auto end = std::chrono::steady_clock::now() + 60s;
+  while (fs::exists(dir / "summary.json") && std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(20ms);
+  REQUIRE_FALSE(fs::exists(dir / "summary.json"));
+  std::this_thread::sleep_for(1s);
+  kill(pid, SIGKILL);
+  CHECK(ExitCode(pid) == 128 + SIGKILL);
+  CHECK_FALSE(fs::exists(dir / "summary.json"));
+}
