@@ -820,14 +820,26 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
       // such returns are clutter; their occupied mass stays unassigned (unknown).
       const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
-      const double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
+      double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
       if (a_static + a_dyn + a_birth <= 0.0) {
         // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
         // the measurement cannot arbitrate, so the predicted split is kept.
         a_static = s_pred + slow_mass;
         a_dyn = fast_mass;
       }
-      const double q_norm = a_static + a_dyn + a_birth;
+      double q_norm = a_static + a_dyn + a_birth;
+      // Subnormal likelihoods (e.g. a static mass decayed to 5e-324 and nothing else) lose their
+      // precision in o_up * a / q_norm: the product rounds up to the smallest subnormal and the
+      // share comes out as o_up * 1, breaking F + S <= 1 (found by the soak test,
+      // docs/reliability.md). Scaling all three by 2^600 is exact and restores full precision;
+      // normal values are untouched, so results elsewhere stay bit-identical.
+      if (q_norm > 0.0 && q_norm < std::numeric_limits<double>::min()) {
+        constexpr double kScale = 0x1p600;
+        a_static *= kScale;
+        a_dyn *= kScale;
+        a_birth *= kScale;
+        q_norm = a_static + a_dyn + a_birth;
+      }
       double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
       if (q_norm > 0.0) {
         s_up = o_up * a_static / q_norm;
@@ -1089,6 +1101,40 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   Birth(measurements);                           // 7. birth
   Resample();                                    // 8. resampling
   ++step_;
+}
+
+std::optional<std::string> DynamicGrid::CheckInvariants() const {
+  constexpr double kEps = 1e-9;
+  double dynamic_total = 0.0;
+  for (std::int64_t i = 0; i < num_cells_; ++i) {
+    const double f = free_[i], st = static_[i], d = dynamic_[i];
+    if (!(std::isfinite(f) && std::isfinite(st) && std::isfinite(d)) || f < -kEps || st < -kEps ||
+        d < -kEps || f + st + d > 1.0 + 1e-6)
+      return "cell " + std::to_string(i) + ": masses free " + std::to_string(f) + ", static " +
+             std::to_string(st) + ", dynamic " + std::to_string(d) + " break 0 <= m, sum <= 1";
+    dynamic_total += d + born_[i];
+  }
+  if (static_cast<int>(particles_.size()) != params_.num_particles)
+    return "particle count " + std::to_string(particles_.size()) + " != num_particles " +
+           std::to_string(params_.num_particles);
+  double weight_total = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const double values[] = {
+        particles_.x[i],          particles_.y[i],          particles_.vx[i],    particles_.vy[i],
+        particles_.w_position[i], particles_.w_velocity[i], particles_.weight[i]};
+    for (double v : values)
+      if (!std::isfinite(v)) return "particle " + std::to_string(i) + " has a non-finite state";
+    if (particles_.weight[i] < 0.0 || particles_.w_position[i] < 0.0 ||
+        particles_.w_velocity[i] < 0.0)
+      return "particle " + std::to_string(i) + " has a negative weight";
+    weight_total += particles_.weight[i];
+  }
+  // Resampling carries the persistent and the new-born mass; new-born mass of cells that got no
+  // birth particle (systematic allocation) is dropped, so the particles never hold more.
+  if (weight_total > dynamic_total * (1.0 + 1e-5) + 1e-6)
+    return "particle weights sum to " + std::to_string(weight_total) +
+           ", more than the cells' dynamic and new-born mass " + std::to_string(dynamic_total);
+  return std::nullopt;
 }
 
 }  // namespace dualgrid::filter

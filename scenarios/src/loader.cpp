@@ -1,6 +1,7 @@
 #include "dualgrid/scenario/loader.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <type_traits>
 
 #include "yaml_reader.hpp"
@@ -267,8 +268,9 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
     return all;
   };
   for (auto& [name, r] : section->NamedMaps("overrides")) {
+    const std::string& sensor = name;  // structured bindings cannot be captured before C++20
     auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
-                           [&](const radar::SensorParams& s) { return s.name == name; });
+                           [&](const radar::SensorParams& s) { return s.name == sensor; });
     if (it == radar->sensors.end())
       throw ConfigError(r.file() + ": key '" + r.path() + "' names unknown sensor '" + name +
                         "' (expected one of: " + names() + ")");
@@ -356,13 +358,14 @@ bool EvaluationConfig::IsValid(std::string* error) const {
   return true;
 }
 
-ScenarioConfig LoadScenario(const std::filesystem::path& file) {
+namespace {
+
+ScenarioConfig LoadDocument(const std::function<YAML::Node()>& parse,
+                            const std::filesystem::path& file) {
   const std::string name = file.string();
-  if (!std::filesystem::is_regular_file(file))
-    throw ConfigError(name + ": scenario file not found");
   YAML::Node doc;
   try {
-    doc = YAML::LoadFile(name);
+    doc = parse();
   } catch (const YAML::Exception& e) {
     throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
                       std::to_string(e.mark.column + 1) + ": not valid YAML: " + e.msg);
@@ -377,6 +380,18 @@ ScenarioConfig LoadScenario(const std::filesystem::path& file) {
                       std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
   return config;
+}
+
+}  // namespace
+
+ScenarioConfig LoadScenario(const std::filesystem::path& file) {
+  if (!std::filesystem::is_regular_file(file))
+    throw ConfigError(file.string() + ": scenario file not found");
+  return LoadDocument([&] { return YAML::LoadFile(file.string()); }, file);
+}
+
+ScenarioConfig LoadScenarioText(const std::string& text, const std::filesystem::path& file) {
+  return LoadDocument([&] { return YAML::Load(text); }, file);
 }
 
 nlohmann::json ConfigToJson(const ScenarioConfig& c) {

@@ -1,6 +1,7 @@
 // Synthetic single targets with exact detections: the three weight modes on the paper's cases.
 #include <catch2/catch.hpp>
 
+#include <string>
 #include <vector>
 
 #include "dualgrid/filter/dynamic_grid.hpp"
@@ -15,7 +16,8 @@ namespace {
 enum class Case { kRadial, kTangential, kStatic };
 
 struct Trace {
-  std::vector<TargetView> views;  // one per cycle
+  std::vector<TargetView> views;    // one per cycle
+  std::vector<std::string> broken;  // invariant violations, "cycle k: ..."
 };
 
 // dt = 0.05 s (the radar cycle of the project), 3 s. Car 4.5 m x 1.8 m at 25 m/s (90 km/h).
@@ -63,6 +65,8 @@ Trace Run(Case c, WeightMode mode, std::uint64_t seed, int cycles = 60) {
       z.push_back(Detect(p, v, cov.origin));
     }
     g.Update({ego, ego_v}, z, std::span<const SensorCoverage>(&cov, 1), dt);
+    if (const auto b = g.CheckInvariants())
+      tr.broken.push_back("cycle " + std::to_string(k) + ": " + *b);
     TargetView view = LookAt(g, box, 0.5);
     view.mean_velocity -= v;  // store the error vector
     tr.views.push_back(view);
@@ -78,6 +82,17 @@ double MeanVelocityError(const Trace& t, int from, int to) {
 }
 
 }  // namespace
+
+TEST_CASE("the grid's invariants hold after every cycle, in every case and mode",
+          "[filter][targets][invariants]") {
+  const Case c = GENERATE(Case::kRadial, Case::kTangential, Case::kStatic);
+  const WeightMode mode = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
+  const std::uint64_t seed = GENERATE(1, 2);
+  const Trace t = Run(c, mode, seed);
+  INFO("case " << static_cast<int>(c) << " mode " << ToString(mode) << " seed " << seed);
+  CHECK(t.broken.empty());
+  if (!t.broken.empty()) FAIL_CHECK(t.broken.front());
+}
 
 TEST_CASE("a target on the radar's line of sight becomes dynamic with the right velocity",
           "[filter][targets]") {

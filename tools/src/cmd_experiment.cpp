@@ -61,6 +61,7 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   }
   args.insert(args.end(), {"--detections", o.run.detections});
   if (o.run.write_particles) args.push_back("--write-particles");
+  if (o.run.check_invariants) args.push_back("--check-invariants");
   if (o.run.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.run.threads)});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());

@@ -1,5 +1,9 @@
 // `dualgrid run`: one SUMO run, one radar stream, three filters side by side, scored per step.
 #include <omp.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
 
 #include <chrono>
 #include <iostream>
@@ -39,6 +43,14 @@ nlohmann::json ConfigJson(const scenario::ScenarioConfig& c, const FilterRunOpti
   nlohmann::json j = scenario::ConfigToJson(c);
   j["modes"] = o.modes;
   return j;
+}
+
+// Resident memory of this process [MB] (/proc/self/statm), 0 if unreadable.
+double ResidentMegabytes() {
+  std::ifstream in("/proc/self/statm");
+  long pages_total = 0, pages_resident = 0;
+  if (!(in >> pages_total >> pages_resident)) return 0.0;
+  return static_cast<double>(pages_resident) * static_cast<double>(sysconf(_SC_PAGE_SIZE)) / 1e6;
 }
 
 // The grid picture times: the command line's, else the scenario's within the run, else 1/4, 1/2
@@ -92,6 +104,7 @@ int RunFilters(const FilterRunOptions& options) {
   const auto dual = std::find(modes.begin(), modes.end(), filter::WeightMode::kDual);
   const std::size_t trace_mode = dual != modes.end() ? dual - modes.begin() : modes.size() - 1;
   WeightTraces traces;
+  nlohmann::json rss_mb = nlohmann::json::array();  // [time s, resident MB] with --check-invariants
 
   Progress progress("run " + config.sim.name + " seed " + std::to_string(config.sim.seed),
                     config.sim.StepCount(), !options.run.quiet);
@@ -115,6 +128,14 @@ int RunFilters(const FilterRunOptions& options) {
       clusters.Write(f, mode_names[m], scorers[m], objects, pipeline.ids());
     }
     traces.Add(pipeline, trace_mode);
+    if (options.check_invariants) {
+      for (std::size_t m = 0; m < modes.size(); ++m)
+        if (const auto broken = pipeline.grid(m).CheckInvariants())
+          throw std::logic_error("filter invariant broken at t = " + Fixed(f.time, 2) + " s (" +
+                                 mode_names[m] + "): " + *broken);
+      if (steps % std::max(1, static_cast<int>(std::lround(60.0 / config.sim.step_length))) == 0)
+        rss_mb.push_back({f.time, ResidentMegabytes()});
+    }
     // Several requested times may fall into one step: one picture for all of them.
     bool picture = false;
     while (next_snapshot < snapshot_times.size() &&
@@ -214,6 +235,11 @@ int RunFilters(const FilterRunOptions& options) {
                             {"requested_s", config.sim.duration},
                             {"wall_s", wall},
                             {"warnings", warnings}};
+  if (options.check_invariants) {
+    rss_mb.push_back({steps * config.sim.step_length, ResidentMegabytes()});
+    summary["invariants_checked_steps"] = steps;
+    summary["rss_mb"] = rss_mb;
+  }
   summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!status.empty())

@@ -39,6 +39,10 @@ struct FilterRunOptions {
   /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).
   bool write_particles = false;
   int threads = 0;  ///< OpenMP threads; 0: the OpenMP default
+  /// Checks every filter's invariants after every step (DynamicGrid::CheckInvariants; a
+  /// violation ends the run with exit code 1) and samples the resident memory every 60 s
+  /// simulated into summary.json (`rss_mb`): the soak test's mode.
+  bool check_invariants = false;
 };
 
 /// `dualgrid experiment`: `run` over seeds 1..N in separate processes, then aggregated.

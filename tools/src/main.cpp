@@ -68,6 +68,9 @@ void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
   cmd->add_flag("--write-particles", o->write_particles,
                 "Write every particle beside each grid picture (figures/particles_*.csv, several "
                 "MB each)");
+  cmd->add_flag("--check-invariants", o->check_invariants,
+                "Check the filters' invariants every step and sample the resident memory (soak "
+                "tests; docs/reliability.md)");
   cmd->add_option("--threads", o->threads,
                   "OpenMP threads per run (default 0: all cores; at most " +
                       std::to_string(kMaxThreadsPerCore) + " per core)")

@@ -6,13 +6,13 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
-#include <vector>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace dualgrid::tools {
 

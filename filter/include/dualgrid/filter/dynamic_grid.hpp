@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -92,6 +93,15 @@ class DynamicGrid {
     return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
   }
   const FilterParams& params() const { return params_; }
+
+  /// Checks the invariants that hold after every Update (the soak test runs it each cycle):
+  /// every cell's masses are finite, in [0, 1] and free + static + dynamic <= 1 (unknown >= 0);
+  /// the particle count is num_particles; every particle's position, velocity and weights are
+  /// finite, weights >= 0, and the weights sum to no more than the cells' persistent dynamic plus
+  /// new-born mass (resampling creates no mass; new-born mass of a cell that got no birth
+  /// particle is dropped, so the sum may be lower). Returns a description of the first
+  /// violation, std::nullopt if none. O(cells + particles); not called by Update.
+  std::optional<std::string> CheckInvariants() const;
 
  private:
   // Storage index of global cell (gx, gy): circular in both axes so that shifting moves no data.

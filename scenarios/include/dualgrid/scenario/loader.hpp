@@ -58,4 +58,8 @@ nlohmann::json ConfigToJson(const ScenarioConfig& config);
 /// Loads and validates a scenario file. Throws ConfigError.
 ScenarioConfig LoadScenario(const std::filesystem::path& file);
 
+/// The same for a scenario's text; `file` names it in errors and anchors relative network paths.
+/// Throws ConfigError and nothing else for any text (the fuzz target tests/fuzz/ checks this).
+ScenarioConfig LoadScenarioText(const std::string& text, const std::filesystem::path& file);
+
 }  // namespace dualgrid::scenario

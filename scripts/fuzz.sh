@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Fuzzes the scenario loader with libFuzzer for a bounded time (default 600 s):
+#   scripts/fuzz.sh [SECONDS]
+# Installs clang and its libFuzzer runtime if missing (Debian packages), builds build-fuzz/ with
+# clang, coverage instrumentation and ASan + UBSan, and runs the ctest label `fuzz`. A crash
+# leaves its input in build-fuzz/tests/fuzz/crash-*; make it a case of tests/hostile/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-600}
+missing=()
+for p in clang libclang-rt-14-dev libomp-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO=sudo
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+build=${DUALGRID_FUZZ_BUILD_DIR:-build-fuzz}
+CXX=clang++ CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDUALGRID_FUZZ=ON \
+  -DDUALGRID_SANITIZE=fuzzer-no-link,address,undefined -DDUALGRID_BUILD_TESTS=OFF \
+  -DDUALGRID_BUILD_BENCHMARKS=OFF -DDUALGRID_FUZZ_SECONDS="$seconds" >/dev/null
+cmake --build "$build" -j "$(nproc)" --target fuzz_scenario_loader
+ctest --test-dir "$build" -L fuzz --output-on-failure
