@@ -1,6 +1,7 @@
-// Real signals sent to real runs (docs/reliability.md): SIGINT and SIGTERM stop at the end of a
-// step and leave the simulated part's results marked incomplete; experiment forwards them; a
-// killed experiment takes its runs with it; a killed run never looks finished.
+// Runs that end early (docs/reliability.md): real signals sent to real runs (SIGINT and SIGTERM
+// stop at the end of a step and leave the simulated part's results marked incomplete; experiment
+// forwards them; a killed experiment takes its runs with it; a killed run never looks finished),
+// and a run whose ego leaves the network before the requested duration.
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -164,4 +165,23 @@ TEST_CASE("A run killed in a folder of an earlier finished run does not look fin
   kill(pid, SIGKILL);
   CHECK(ExitCode(pid) == 128 + SIGKILL);
   CHECK_FALSE(fs::exists(dir / "summary.json"));
+}
+
+TEST_CASE("A run shorter than asked says so and is not complete", "[cli][signals]") {
+  const auto dir = TempDir("short");
+  // The route ends about 450 m ahead of the ego, which drives 27.78 m/s: SUMO ends near 16 s.
+  std::ofstream(dir / "short.yaml")
+      << "network: highway\nduration: 20.0\nroutes: {short: [east_1, east_2]}\n"
+         "ego: {type: car, route: short, lane: 1, position: 1350, speed: 27.78,\n"
+         "      speed_policy: {mode: fixed, speed: 27.78}}\n";
+  const pid_t pid = Start({"run", (dir / "short.yaml").string(), "--modes", "dual", "--no-figures",
+                           "-q", "--out", (dir / "out").string()},
+                          dir / "log.txt");
+  CHECK(ExitCode(pid) == 0);
+  const std::string log = Slurp(dir / "log.txt");
+  CHECK(log.find("dualgrid: Shorter run than asked: SUMO ended at t = ") != std::string::npos);
+  const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
+  CHECK(summary.at("complete") == false);
+  CHECK(summary.at("simulated_s").get<double>() < 18.0);
+  CHECK(Slurp(dir / "out" / "table.md").find("**Shorter run than asked") != std::string::npos);
 }
