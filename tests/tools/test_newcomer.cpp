@@ -155,17 +155,19 @@ TEST_CASE("A network path is read relative to the scenario file", "[cli][newcome
 
 TEST_CASE("A figure that fails is a warning; the results are all there", "[cli][newcomer]") {
   const auto dir = TempDir("figure_fails");
-  // A folder where the picture should go: cairo cannot write it.
-  fs::create_directories(dir / "figures" / "tracked_share.png");
-  const Result r = Run("run scenarios/simple_road.yaml --duration 2 --out " + dir.string());
+  // The test hook makes drawing this figure throw (docs/reliability.md).
+  const Result r = Shell("DUALGRID_FAULT=figure:tracked_share.png " + std::string(DUALGRID_EXE) +
+                         " run scenarios/simple_road.yaml --duration 2 --out " + dir.string());
   INFO(r.output);
   CHECK(r.code == 0);
   CHECK(r.output.find("dualgrid: warning: figure " +
-                      (dir / "figures" / "tracked_share.png").string()) != std::string::npos);
+                      (dir / "figures" / "tracked_share.png").string() + " not drawn") !=
+        std::string::npos);
   CHECK(r.output.find("| D [%] |") != std::string::npos);  // the table is printed
   for (const char* f : {"metrics.json", "objects.csv", "table.md", "table.csv", "table.json",
-                        "weights.csv", "summary.json"})
+                        "weights.csv", "summary.json", "figures/weights.png"})
     CHECK(fs::file_size(dir / f) > 0);
+  CHECK_FALSE(fs::exists(dir / "figures" / "tracked_share.png"));
   const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
   CHECK(summary.at("complete") == true);
   CHECK(summary.at("warnings").size() == 1);
@@ -177,21 +179,35 @@ TEST_CASE("A figure that fails is a warning; the results are all there", "[cli][
 TEST_CASE("experiment aggregates the seeds that finished and names the failed one",
           "[cli][newcomer]") {
   const auto dir = TempDir("seed_fails");
-  // Seed 2 cannot write its metrics (a folder stands in the way): that run fails late.
-  fs::create_directories(dir / "seeds" / "seed_2" / "metrics.json");
-  const Result r =
-      Run("experiment scenarios/simple_road.yaml --seeds 2 --duration 2 --no-figures "
-          "-q --out " +
-          dir.string());
+  // The test hook makes seed 2's run fail after its simulation.
+  const Result r = Shell("DUALGRID_FAULT=run-seed:2 " + std::string(DUALGRID_EXE) +
+                         " experiment scenarios/simple_road.yaml --seeds 2 --duration 2 "
+                         "--no-figures -q --out " +
+                         dir.string());
   INFO(r.output);
   CHECK(r.code == 3);
-  CHECK(r.output.find("seed 2 failed: dualgrid: error: cannot create") != std::string::npos);
+  CHECK(r.output.find("seed 2 failed: dualgrid: error: injected fault") != std::string::npos);
   const std::string table = Slurp(dir / "table.csv");
   CHECK(table.find("simple_road,D,%,dual,1,") != std::string::npos);  // seed 1 only
   CHECK(Slurp(dir / "table.md").find("Seed 2 failed") != std::string::npos);
   const auto summary = nlohmann::json::parse(Slurp(dir / "summary.json"));
   CHECK(summary.at("complete") == false);
   CHECK(summary.at("seeds_failed").at(0).at("seed") == 2);
+}
+
+TEST_CASE("An output folder never mixes two runs", "[cli][newcomer]") {
+  const auto dir = TempDir("reuse_folder");
+  const std::string run = "run scenarios/simple_road.yaml --duration 1 --no-figures -q --out ";
+  REQUIRE(Run(run + dir.string() + " --detections csv").code == 0);
+  REQUIRE(fs::exists(dir / "detections.csv"));
+  REQUIRE(Run(run + dir.string()).code == 0);  // an earlier run's folder is emptied first
+  CHECK_FALSE(fs::exists(dir / "detections.csv"));
+  CHECK(fs::exists(dir / "summary.json"));
+  // A folder of other files is never cleared.
+  const auto other = TempDir("other_folder");
+  std::ofstream(other / "thesis.tex") << "precious";
+  CheckOneLineError(Run(run + other.string()), 2, "not a dualgrid run");
+  CHECK(Slurp(other / "thesis.tex") == "precious");
 }
 
 TEST_CASE("A write past a file-size limit is an error naming the file", "[cli][newcomer]") {

@@ -29,6 +29,11 @@ namespace dualgrid::tools {
 namespace {
 
 // Starts `dualgrid run` for one seed with its output and log in `dir`.
+// A seed run's output log: seeds/seed_N.log beside its folder seeds/seed_N/.
+std::filesystem::path LogPath(const std::filesystem::path& seed_dir) {
+  return seed_dir.parent_path() / (seed_dir.filename().string() + ".log");
+}
+
 // Exact decimal text of a double (std::to_string rounds to 6 decimals).
 std::string Exact(double v) {
   char buf[64];
@@ -38,7 +43,7 @@ std::string Exact(double v) {
 
 pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesystem::path& dir,
                bool figures) {
-  std::filesystem::create_directories(dir);
+  std::filesystem::create_directories(dir.parent_path());
   std::vector<std::string> args = {o.executable,
                                    "run",
                                    o.run.run.scenario.string(),
@@ -66,7 +71,8 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  const std::string log = (dir / "log.txt").string();
+  // Beside the run folder, which the run itself prepares (docs/output.md).
+  const std::string log = LogPath(dir).string();
   const pid_t parent = getpid();
   // fork + exec rather than posix_spawn: the child must die with the experiment
   // (PR_SET_PDEATHSIG), or a killed experiment leaves its runs running on their own. Between
@@ -122,7 +128,7 @@ int RunExperiment(const ExperimentOptions& o) {
   CheckFilterMemory(config, o.run.modes.size());
   DetectionPath(o.run.run.out, o.run.detections);  // fail early on a bad format
   const auto& out = o.run.run.out;
-  BeginOutputFolder(out);
+  PrepareOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
   const int jobs = o.jobs > 0 ? o.jobs : Cores();
   auto seed_dir = [&](std::uint64_t seed) {
@@ -163,7 +169,7 @@ int RunExperiment(const ExperimentOptions& o) {
     } else if (StopSignal() && (code == 130 || code == 143)) {
       cut_short.push_back(seed);
     } else {
-      std::string why = LastLine(seed_dir(seed) / "log.txt");
+      std::string why = LastLine(LogPath(seed_dir(seed)));
       if (WIFSIGNALED(status)) why = "killed by signal " + std::to_string(WTERMSIG(status));
       if (why.empty()) why = "exit code " + std::to_string(code);
       failed.emplace_back(seed, why);
@@ -189,7 +195,7 @@ int RunExperiment(const ExperimentOptions& o) {
   if (finished.empty())
     throw std::runtime_error("all " + std::to_string(o.seeds) +
                              " seed runs failed; the first: " + failed.front().second +
-                             " (logs: " + (out / "seeds").string() + "/seed_*/log.txt)");
+                             " (logs: " + (out / "seeds").string() + "/seed_*.log)");
 
   // Aggregate: per mode, the metrics of every seed; object ids mapped by vehicle name so that
   // per-object results line up across seeds.
@@ -269,7 +275,7 @@ int RunExperiment(const ExperimentOptions& o) {
       list += (list.empty() ? "" : ", ") + std::to_string(seed);
     std::cerr << "dualgrid: error: " << failed.size() << " of " << o.seeds
               << " seed runs failed (seeds " << list << "; logs in " << (out / "seeds").string()
-              << "/seed_*/log.txt); the table aggregates the other " << finished.size() << "\n";
+              << "/seed_*.log); the table aggregates the other " << finished.size() << "\n";
     return kExitSomeSeedsFailed;
   }
   return kExitOk;

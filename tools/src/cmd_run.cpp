@@ -85,7 +85,7 @@ int RunFilters(const FilterRunOptions& options) {
   const std::vector<double> snapshot_times = SnapshotTimes(options, config);
   const auto detections_path = DetectionPath(options.run.out, options.detections);
   const auto& out = options.run.out;
-  BeginOutputFolder(out);
+  PrepareOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
   CopyScenario(config, out);
   WriteTextFile(out / "config.json", ConfigJson(config, options).dump(2) + "\n");
@@ -175,6 +175,9 @@ int RunFilters(const FilterRunOptions& options) {
   clusters.Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+
+  if (FaultInjected("run-seed:" + std::to_string(config.sim.seed)))
+    throw std::runtime_error("injected fault (DUALGRID_FAULT) after the simulation");
 
   // Results first: nothing below may be lost to a figure that fails.
   std::vector<eval::ScenarioMetrics> metrics;

@@ -21,7 +21,7 @@ int RunSim(const SimOptions& sim_options) {
   scenario::ScenarioConfig config = LoadConfig(options);
   const auto detections_path = DetectionPath(options.out, sim_options.detections);
   const sim::ScenarioSpec& spec = config.sim;
-  BeginOutputFolder(options.out);
+  PrepareOutputFolder(options.out);
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();

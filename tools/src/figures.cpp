@@ -14,6 +14,8 @@ namespace dualgrid::tools {
 bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
                std::vector<std::string>* warnings) {
   try {
+    if (FaultInjected("figure:" + path.filename().string()))
+      throw std::runtime_error("injected fault (DUALGRID_FAULT)");
     draw();
     return true;
   } catch (const std::exception& e) {

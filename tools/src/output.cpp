@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <fstream>
@@ -128,7 +129,7 @@ nlohmann::json OutputDigests(const std::filesystem::path& dir) {
   std::vector<char> buf(1 << 16);
   for (const auto& f : files) {
     const std::string name = f.filename().string();
-    if (name == "summary.json" || name == "sumo.log" || name == "log.txt") continue;
+    if (name == "summary.json" || name == kRunMarker || f.extension() == ".log") continue;
     std::uint64_t h = 14695981039346656037ull;
     std::ifstream in(f, std::ios::binary);
     while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
@@ -141,13 +142,40 @@ nlohmann::json OutputDigests(const std::filesystem::path& dir) {
   return digests;
 }
 
-void BeginOutputFolder(const std::filesystem::path& out) {
-  std::filesystem::create_directories(out);
+void PrepareOutputFolder(const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  std::filesystem::remove(out / "summary.json", ec);
-  if (ec)
-    throw std::runtime_error("cannot remove the earlier " + (out / "summary.json").string() + ": " +
-                             ec.message());
+  if (fs::exists(out, ec) && !fs::is_directory(out))
+    throw std::invalid_argument("--out: " + out.string() + " exists and is not a folder");
+  if (fs::exists(out, ec) && !fs::is_empty(out)) {
+    if (!fs::exists(out / kRunMarker) && !fs::exists(out / "summary.json") &&
+        !fs::exists(out / "config.json")) {
+      const std::string first = fs::directory_iterator(out)->path().filename().string();
+      throw std::invalid_argument("--out: " + out.string() +
+                                  " holds files that are not a dualgrid run (e.g. '" + first +
+                                  "'); give a new or empty folder");
+    }
+    fs::remove(out / "summary.json", ec);  // first: from here on the folder is not a finished run
+    if (ec)
+      throw std::runtime_error("cannot remove the earlier " + (out / "summary.json").string() +
+                               ": " + ec.message());
+    for (const auto& e : fs::directory_iterator(out)) {
+      fs::remove_all(e.path(), ec);
+      if (ec)
+        throw std::runtime_error("cannot clear the earlier run's " + e.path().string() + ": " +
+                                 ec.message());
+    }
+  }
+  fs::create_directories(out);
+  WriteTextFile(out / kRunMarker,
+                "This folder is written by dualgrid; a new run with this --out empties it.\n");
+}
+
+bool FaultInjected(const std::string& what) {
+  const char* env = std::getenv("DUALGRID_FAULT");
+  if (!env) return false;
+  const std::string list = std::string(",") + env + ",";
+  return list.find("," + what + ",") != std::string::npos;
 }
 
 void WriteTextFile(const std::filesystem::path& path, const std::string& text) {

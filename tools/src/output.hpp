@@ -98,14 +98,25 @@ class TempDir {
   int exceptions_ = 0;
 };
 
-/// Creates the output folder and removes an earlier run's completion record (summary.json) from
-/// it before anything else is written: a folder is a finished run only if its summary.json says
-/// `complete: true`, so a run killed midway in a reused folder never looks finished.
-void BeginOutputFolder(const std::filesystem::path& out);
+/// Marks a folder as dualgrid's own, written first into every output folder.
+inline constexpr const char* kRunMarker = ".dualgrid-run";
+
+/// Makes `out` an empty folder for a new run, so that no folder ever mixes two runs' files:
+/// creates it if missing; keeps it if empty; empties it if it holds an earlier dualgrid output
+/// (it has the marker kRunMarker, a summary.json or a config.json); otherwise throws
+/// std::invalid_argument (a folder of other files is never cleared). The earlier completion
+/// record goes first, so a run killed while clearing never looks finished. Then writes the
+/// marker.
+void PrepareOutputFolder(const std::filesystem::path& out);
+
+/// Test hook (docs/reliability.md): true when the environment variable DUALGRID_FAULT lists
+/// `what` (comma-separated), e.g. DUALGRID_FAULT=figure:tracked_share.png,run-seed:2. Lets the
+/// tests make one figure or one seed run fail on purpose; unset in normal use.
+bool FaultInjected(const std::string& what);
 
 /// Digests of every file under `dir` (relative path -> 16 hex digits, FNV-1a 64 over the bytes:
-/// a change detector, not a cryptographic hash), except summary.json, which holds them, and
-/// SUMO's own sumo.log and the runs' log.txt. Everything else a run writes is a function of the
+/// a change detector, not a cryptographic hash), except summary.json, which holds them, SUMO's
+/// own sumo.log and the seed runs' logs (*.log). Everything else a run writes is a function of the
 /// scenario and the seed alone (wall-clock times live only in summary.json), so equal digests
 /// mean equal outputs, whatever the thread count.
 nlohmann::json OutputDigests(const std::filesystem::path& dir);
