@@ -10,17 +10,8 @@ PACKAGES=(build-essential cmake pkg-config sumo sumo-tools libeigen3-dev libyaml
   nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev zlib1g-dev)
 BUILD_DIR=${DUALGRID_BUILD_DIR:-build}
 
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "bootstrap: installing missing Debian packages: ${missing[*]}"
-  SUDO=""
-  [ "$(id -u)" -ne 0 ] && SUDO=sudo
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+source scripts/lib/install_missing.sh
+install_missing "${PACKAGES[@]}"
 
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j "$(nproc)"

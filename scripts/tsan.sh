@@ -8,16 +8,8 @@
 #   scripts/tsan.sh [TEST_FILTER ARGS...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-missing=()
-for p in clang libclang-rt-14-dev libomp-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  SUDO=""
-  [ "$(id -u)" -ne 0 ] && SUDO=sudo
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+source scripts/lib/install_missing.sh
+install_missing clang libclang-rt-14-dev libomp-dev
 archer=$(ls /usr/lib/llvm-*/lib/libarcher.so 2>/dev/null | sort -V | tail -n 1)
 [ -n "$archer" ] || { echo "tsan.sh: libarcher.so not found (package libomp5-14)" >&2; exit 1; }
 build=${DUALGRID_TSAN_BUILD_DIR:-build-tsan}

@@ -12,44 +12,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_harness.hpp"
+
 namespace fs = std::filesystem;
+using namespace dualgrid::testing;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;  // stdout and stderr
-};
-
-Result Shell(const std::string& cmd) {
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string out;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
-}
-
-Result Run(const std::string& args) { return Shell(std::string(DUALGRID_EXE) + " " + args); }
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-fs::path TempDir(const std::string& name) {
-  const auto d = fs::temp_directory_path() / ("dualgrid_newcomer_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-int CountLines(const std::string& s) {
-  return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
-}
+fs::path TempDir(const std::string& name) { return dualgrid::testing::TempDir("newcomer", name); }
 
 // One line on stderr, starting "dualgrid: error:", naming `what`, with no runaway number.
 void CheckOneLineError(const Result& r, int code, const std::string& what) {

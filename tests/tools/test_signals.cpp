@@ -16,24 +16,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_harness.hpp"
+
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
+using namespace dualgrid::testing;
 
 namespace {
 
-fs::path TempDir(const std::string& name) {
-  const auto d = fs::temp_directory_path() / ("dualgrid_signals_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+fs::path TempDir(const std::string& name) { return dualgrid::testing::TempDir("signals", name); }
 
 // Starts dualgrid with `args`, output to `log`; returns its pid.
 pid_t Start(const std::vector<std::string>& args, const fs::path& log) {
