@@ -282,6 +282,8 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
        [](const ScenarioMetrics& m) { return m.detection_time; }},
       {{std::string(kTrackedFraction), "D", "%", 100.0, 1},
        [](const ScenarioMetrics& m) { return m.tracked_fraction; }},
+      {{std::string(kTrackedFractionV), "D_v (velocity right)", "%", 100.0, 1},
+       [](const ScenarioMetrics& m) { return m.tracked_fraction_v; }},
       {{std::string(kBoxDistance), "Δx to box surface", "m", 1.0, 2},
        [](const ScenarioMetrics& m) { return m.box_distance; }},
       {{std::string(kFalseClusters), "false clusters / scan", "", 1.0, 2},
@@ -327,11 +329,13 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
   return table;
 }
 
-std::map<int, Summary> PerObjectTrackedFraction(std::span<const ScenarioMetrics> seeds) {
+std::map<int, Summary> PerObjectTrackedFraction(std::span<const ScenarioMetrics> seeds,
+                                                bool velocity_aware) {
   std::map<int, std::vector<double>> samples;
   for (const ScenarioMetrics& m : seeds) {
     for (const ObjectMetrics& o : m.objects) {
-      if (o.scored && o.tracked_fraction) samples[o.id].push_back(*o.tracked_fraction);
+      const std::optional<double>& d = velocity_aware ? o.tracked_fraction_v : o.tracked_fraction;
+      if (o.scored && d) samples[o.id].push_back(*d);
     }
   }
   std::map<int, Summary> out;

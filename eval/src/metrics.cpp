@@ -21,6 +21,10 @@ bool TrackingMetricsParams::IsValid(std::string* error) const {
   if (window < 1) return fail("window must be >= 1");
   if (required < 1 || required > window) return fail("required must be in [1, window]");
   if (min_frames_in_grid < 1) return fail("min_frames_in_grid must be >= 1");
+  if (!(velocity_tolerance > 0.0 && std::isfinite(velocity_tolerance)))
+    return fail("velocity_tolerance must be finite and > 0");
+  if (!(velocity_tolerance_fraction >= 0.0 && velocity_tolerance_fraction <= 1.0))
+    return fail("velocity_tolerance_fraction must be in [0, 1]");
   return true;
 }
 
@@ -72,6 +76,9 @@ AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
       ++s.frames_tracked;
       const double dx = (clusters[c].position - o.box.center).norm();
       const double dv = (clusters[c].velocity - o.velocity).norm();
+      if (dv < std::max(params_.velocity_tolerance,
+                        params_.velocity_tolerance_fraction * o.velocity.norm()))
+        ++s.frames_tracked_v;
       s.position_error_sum += dx;
       s.velocity_error_sum += dv;
       position_error_sum_ += dx;
@@ -118,18 +125,21 @@ ScenarioMetrics TrackingMetricsAccumulator::Result() const {
     m.false_clusters_per_scan = static_cast<double>(false_clusters_) / frames_;
     m.duplicate_clusters_per_scan = static_cast<double>(duplicate_clusters_) / frames_;
   }
-  double d_sum = 0.0, td_sum = 0.0;
+  double d_sum = 0.0, dv_sum = 0.0, td_sum = 0.0;
   for (const auto& [id, s] : objects_) {
     ObjectMetrics o;
     o.id = id;
     o.frames_in_grid = s.frames_in_grid;
     o.frames_tracked = s.frames_tracked;
+    o.frames_tracked_v = s.frames_tracked_v;
     o.scored = s.frames_in_grid >= params_.min_frames_in_grid;
     o.first_in_grid_time = s.first_in_grid_time;
     o.clock_start_time = s.clock_start_time;
     o.track_onset_time = s.track_onset_time;
-    if (s.frames_in_grid > 0)
+    if (s.frames_in_grid > 0) {
       o.tracked_fraction = static_cast<double>(s.frames_tracked) / s.frames_in_grid;
+      o.tracked_fraction_v = static_cast<double>(s.frames_tracked_v) / s.frames_in_grid;
+    }
     if (s.track_onset_time) o.detection_time = *s.track_onset_time - *s.clock_start_time;
     if (s.frames_tracked > 0) {
       o.position_error = s.position_error_sum / s.frames_tracked;
@@ -138,6 +148,7 @@ ScenarioMetrics TrackingMetricsAccumulator::Result() const {
     if (o.scored) {
       ++m.objects_scored;
       d_sum += *o.tracked_fraction;
+      dv_sum += *o.tracked_fraction_v;
       if (o.detection_time) {
         ++m.objects_detected;
         td_sum += *o.detection_time;
@@ -148,7 +159,10 @@ ScenarioMetrics TrackingMetricsAccumulator::Result() const {
     }
     m.objects.push_back(o);
   }
-  if (m.objects_scored > 0) m.tracked_fraction = d_sum / m.objects_scored;
+  if (m.objects_scored > 0) {
+    m.tracked_fraction = d_sum / m.objects_scored;
+    m.tracked_fraction_v = dv_sum / m.objects_scored;
+  }
   if (m.objects_detected > 0) m.detection_time = td_sum / m.objects_detected;
   return m;
 }
@@ -157,18 +171,22 @@ void to_json(nlohmann::json& j, const TrackingMetricsParams& p) {
   j = {{"association", p.association},
        {"required", p.required},
        {"window", p.window},
-       {"min_frames_in_grid", p.min_frames_in_grid}};
+       {"min_frames_in_grid", p.min_frames_in_grid},
+       {"velocity_tolerance", p.velocity_tolerance},
+       {"velocity_tolerance_fraction", p.velocity_tolerance_fraction}};
 }
 
 void to_json(nlohmann::json& j, const ObjectMetrics& m) {
   j = nlohmann::json{{"id", m.id},
                      {"frames_in_grid", m.frames_in_grid},
                      {"frames_tracked", m.frames_tracked},
+                     {"frames_tracked_v", m.frames_tracked_v},
                      {"scored", m.scored},
                      {"first_in_grid_time", OptToJson(m.first_in_grid_time)},
                      {"clock_start_time", OptToJson(m.clock_start_time)},
                      {"track_onset_time", OptToJson(m.track_onset_time)},
                      {"tracked_fraction", OptToJson(m.tracked_fraction)},
+                     {"tracked_fraction_v", OptToJson(m.tracked_fraction_v)},
                      {"detection_time", OptToJson(m.detection_time)},
                      {"position_error", OptToJson(m.position_error)},
                      {"velocity_error", OptToJson(m.velocity_error)}};
@@ -178,11 +196,13 @@ void from_json(const nlohmann::json& j, ObjectMetrics& m) {
   j.at("id").get_to(m.id);
   j.at("frames_in_grid").get_to(m.frames_in_grid);
   j.at("frames_tracked").get_to(m.frames_tracked);
+  m.frames_tracked_v = j.value("frames_tracked_v", 0);
   j.at("scored").get_to(m.scored);
   m.first_in_grid_time = OptFromJson(j, "first_in_grid_time");
   m.clock_start_time = OptFromJson(j, "clock_start_time");
   m.track_onset_time = OptFromJson(j, "track_onset_time");
   m.tracked_fraction = OptFromJson(j, "tracked_fraction");
+  m.tracked_fraction_v = OptFromJson(j, "tracked_fraction_v");
   m.detection_time = OptFromJson(j, "detection_time");
   m.position_error = OptFromJson(j, "position_error");
   m.velocity_error = OptFromJson(j, "velocity_error");
@@ -196,6 +216,7 @@ void to_json(nlohmann::json& j, const ScenarioMetrics& m) {
                      {"velocity_error", OptToJson(m.velocity_error)},
                      {"detection_time", OptToJson(m.detection_time)},
                      {"tracked_fraction", OptToJson(m.tracked_fraction)},
+                     {"tracked_fraction_v", OptToJson(m.tracked_fraction_v)},
                      {"objects_scored", m.objects_scored},
                      {"objects_detected", m.objects_detected},
                      {"objects_never_tracked", m.objects_never_tracked},
@@ -215,6 +236,7 @@ void from_json(const nlohmann::json& j, ScenarioMetrics& m) {
   m.velocity_error = OptFromJson(j, "velocity_error");
   m.detection_time = OptFromJson(j, "detection_time");
   m.tracked_fraction = OptFromJson(j, "tracked_fraction");
+  m.tracked_fraction_v = OptFromJson(j, "tracked_fraction_v");
   j.at("objects_scored").get_to(m.objects_scored);
   j.at("objects_detected").get_to(m.objects_detected);
   j.at("objects_never_tracked").get_to(m.objects_never_tracked);

@@ -326,6 +326,8 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
   r->Read("consistent_required", &e->tracking.required);
   r->Read("consistent_window", &e->tracking.window);
   r->Read("min_frames_in_grid", &e->tracking.min_frames_in_grid);
+  r->Read("velocity_tolerance", &e->tracking.velocity_tolerance);
+  r->Read("velocity_tolerance_fraction", &e->tracking.velocity_tolerance_fraction);
   r->Read("focus_object", &e->focus_object);
   r->Read("snapshot_times", &e->snapshot_times);
   r->Finish();

@@ -123,6 +123,7 @@ TEST_CASE("Comparison table renders ours beside the paper's", "[aggregate]") {
 TEST_CASE("A single run claims no confidence interval; notes are printed", "[aggregate]") {
   ScenarioMetrics m;
   m.tracked_fraction = 0.5;
+  m.tracked_fraction_v = 0.25;
   m.position_error = 1.0;
   m.velocity_error = 1.0;
   m.box_distance = 0.0;

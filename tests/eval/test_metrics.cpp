@@ -286,3 +286,52 @@ TEST_CASE("Box distance: zero inside the box, the overshoot beyond a face outsid
   CHECK(*m.box_distance == Approx((0.0 + 1.0 + std::sqrt(0.5)) / 3.0));
   CHECK(*m.position_error == Approx((1.5 + 3.0 + std::hypot(2.5, 1.5)) / 3.0));
 }
+
+// D_v counts a tracked frame only when the cluster's velocity is right: within
+// max(velocity_tolerance, velocity_tolerance_fraction x speed) of the object's.
+TEST_CASE("D_v: right place with the wrong velocity is tracked for D, not for D_v",
+          "[metrics][d_v]") {
+  TrackingMetricsParams params;  // tolerance max(2 m/s, 20 % of 25 m/s = 5 m/s) = 5 m/s
+  TrackingMetricsAccumulator acc(params);
+  for (int f = 0; f < kFrames; ++f) {
+    const TruthObject a = Object(1, f), b = Object(2, f);
+    // Object 1: velocity 8 m/s off in the first half (wrong), 3 m/s off in the second (right).
+    // Object 2: tracked at the right velocity only every fourth frame, else 6 m/s off.
+    const std::vector<Cluster> clusters = {
+        ClusterOn(a, Position(0.5, 0.0), Velocity(f < kFrames / 2 ? 8.0 : 3.0, 0.0)),
+        ClusterOn(b, Position(0.0, 0.0), Velocity(0.0, f % 4 == 0 ? 1.0 : 6.0))};
+    acc.AddFrame(f * kDt, clusters, std::vector<TruthObject>{a, b});
+  }
+  const ScenarioMetrics m = acc.Result();
+  const ObjectMetrics& o1 = Find(m, 1);
+  const ObjectMetrics& o2 = Find(m, 2);
+  CHECK(*o1.tracked_fraction == Approx(1.0));
+  CHECK(*o1.tracked_fraction_v == Approx(0.5));
+  CHECK(o1.frames_tracked_v == kFrames / 2);
+  CHECK(*o2.tracked_fraction == Approx(1.0));
+  CHECK(*o2.tracked_fraction_v == Approx(0.25));
+  CHECK(*m.tracked_fraction == Approx(1.0));
+  CHECK(*m.tracked_fraction_v == Approx((0.5 + 0.25) / 2.0));
+
+  // A slower object (5 m/s): the absolute bound (2 m/s) applies, so 3 m/s off is wrong too.
+  TrackingMetricsAccumulator slow(params);
+  for (int f = 0; f < kFrames; ++f) {
+    TruthObject o = Object(1, f);
+    o.velocity = Velocity(5.0, 0.0);
+    slow.AddFrame(f * kDt, std::vector<Cluster>{ClusterOn(o, Position(0, 0), Velocity(3.0, 0))},
+                  std::vector<TruthObject>{o});
+  }
+  CHECK(*slow.Result().tracked_fraction_v == Approx(0.0));
+}
+
+TEST_CASE("D_v tolerances are validated", "[metrics][d_v]") {
+  TrackingMetricsParams p;
+  p.velocity_tolerance = 0.0;
+  std::string error;
+  CHECK_FALSE(p.IsValid(&error));
+  CHECK(error.find("velocity_tolerance") != std::string::npos);
+  p = TrackingMetricsParams{};
+  p.velocity_tolerance_fraction = 1.5;
+  CHECK_FALSE(p.IsValid(&error));
+  CHECK(error.find("velocity_tolerance_fraction") != std::string::npos);
+}

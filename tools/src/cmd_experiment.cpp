@@ -221,37 +221,41 @@ int RunExperiment(const ExperimentOptions& o) {
     table.AddNote("Seed " + std::to_string(seed) + " failed and is not in the table: " + why);
   WriteTables(table, out);
 
-  // Per-object tracked share over seeds (paper Fig. 6).
-  std::map<int, std::vector<double>> rows;
+  // Per-object tracked share over seeds (paper Fig. 6), D and D_v.
+  std::map<int, std::vector<double>> rows[2];  // [velocity_aware][object] -> per mode
   nlohmann::json per_object;
-  for (std::size_t m = 0; m < runs.size(); ++m) {
-    for (const auto& [id, s] : eval::PerObjectTrackedFraction(runs[m].seeds)) {
-      rows.try_emplace(id, runs.size(), std::nan("")).first->second[m] = s.mean;
-      per_object[names.Name(id)][runs[m].mode] = s;
-    }
-  }
+  for (const bool v : {false, true})
+    for (std::size_t m = 0; m < runs.size(); ++m)
+      for (const auto& [id, s] : eval::PerObjectTrackedFraction(runs[m].seeds, v)) {
+        rows[v].try_emplace(id, runs.size(), std::nan("")).first->second[m] = s.mean;
+        per_object[names.Name(id)][runs[m].mode][v ? "D_v" : "D"] = s;
+      }
   WriteTextFile(out / "per_object.json", per_object.dump(2) + "\n");
   if (!o.run.run.quiet) std::cout << table.ToMarkdown() << "\n";
 
   std::vector<std::string> warnings;
   if (o.run.figures && !StopSignal()) {
-    TrackedShares shares;
-    for (const auto& [id, r] : rows) shares.emplace_back(names.Name(id), r);
-    const auto png = out / "figures" / "tracked_share.png";
-    TryFigure(
-        png,
-        [&] {
-          RenderTrackedShares(o.run.modes, shares,
-                              config.sim.name + ": tracked share D per object, mean over " +
-                                  std::to_string(finished.size()) + " seeds",
-                              png);
-        },
-        &warnings);
+    for (const bool v : {false, true}) {
+      TrackedShares shares;
+      for (const auto& [id, r] : rows[v]) shares.emplace_back(names.Name(id), r);
+      const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
+      const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
+      TryFigure(
+          png,
+          [&] {
+            RenderTrackedShares(o.run.modes, shares,
+                                config.sim.name + ": tracked share " + what +
+                                    " per object, mean over " + std::to_string(finished.size()) +
+                                    " seeds",
+                                "tracked share " + what, png);
+          },
+          &warnings);
+    }
     // The first seed's pictures (grids, scene, weights) are the experiment's examples.
     const auto first = seed_dir(o.first_seed) / "figures";
     std::error_code ec;
     for (const auto& e : std::filesystem::directory_iterator(first, ec))
-      if (e.path().filename() != "tracked_share.png")
+      if (e.path().filename().string().rfind("tracked_share", 0) != 0)
         std::filesystem::copy_file(e.path(), out / "figures" / e.path().filename(),
                                    std::filesystem::copy_options::overwrite_existing);
   }

@@ -216,16 +216,19 @@ int RunFilters(const FilterRunOptions& options) {
           },
           &warnings);
     }
-    const auto png = out / "figures" / "tracked_share.png";
-    TryFigure(
-        png,
-        [&] {
-          RenderTrackedShares(mode_names, RunTrackedShares(metrics, pipeline.ids()),
-                              config.sim.name + ": tracked share D per object (seed " +
-                                  std::to_string(config.sim.seed) + ")",
-                              png);
-        },
-        &warnings);
+    for (const bool v : {false, true}) {
+      const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
+      const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
+      TryFigure(
+          png,
+          [&] {
+            RenderTrackedShares(mode_names, RunTrackedShares(metrics, pipeline.ids(), v),
+                                config.sim.name + ": tracked share " + what + " per object (seed " +
+                                    std::to_string(config.sim.seed) + ")",
+                                "tracked share " + what, png);
+          },
+          &warnings);
+    }
   }
 
   // Written last: a run folder without summary.json did not finish.

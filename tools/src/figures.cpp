@@ -100,13 +100,13 @@ void RenderGridFigure(const std::vector<std::string>& modes,
 }
 
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
-                               const IdRegistry& ids) {
+                               const IdRegistry& ids, bool velocity_aware) {
   std::map<int, std::vector<double>> per_object;  // by id: order of first appearance
   for (std::size_t m = 0; m < metrics.size(); ++m) {
     for (const auto& o : metrics[m].objects) {
       if (!o.scored) continue;
       auto& row = per_object.try_emplace(o.id, metrics.size(), std::nan("")).first->second;
-      row[m] = o.tracked_fraction.value_or(0.0);
+      row[m] = (velocity_aware ? o.tracked_fraction_v : o.tracked_fraction).value_or(0.0);
     }
   }
   TrackedShares out;
@@ -115,11 +115,12 @@ TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics
 }
 
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
-                         const std::string& title, const std::filesystem::path& path) {
+                         const std::string& title, const std::string& y_label,
+                         const std::filesystem::path& path) {
   viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
   chart.x_label = "object";
-  chart.y_label = "tracked share D";
+  chart.y_label = y_label;
   chart.percent = true;
   chart.value_labels = shares.size() <= 12;
   // 60 px per bar up to a 4000 px wide image; beyond that the bars narrow (to 1 px) and the

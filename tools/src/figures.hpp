@@ -33,13 +33,16 @@ void RenderGridFigure(const std::vector<std::string>& modes,
 /// D per object (name) and mode; NaN where a mode did not score the object.
 using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
 
-/// The paper's Fig. 6: tracked share D per object and mode. Draws nothing without objects.
+/// The paper's Fig. 6: tracked share (D or D_v, named by `y_label`) per object and mode; says
+/// "no data" without objects.
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
-                         const std::string& title, const std::filesystem::path& path);
+                         const std::string& title, const std::string& y_label,
+                         const std::filesystem::path& path);
 
-/// The scored objects' D of one run, per mode (object ids named through `ids`).
+/// The scored objects' D (or D_v, `velocity_aware`) of one run, per mode (object ids named
+/// through `ids`).
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
-                               const IdRegistry& ids);
+                               const IdRegistry& ids, bool velocity_aware);
 
 /// Particle weights on one object over time (paper Fig. 4). The filter normalises both weights
 /// per cell, so their sums over an object are equal; what differs is *which* particles carry

@@ -101,12 +101,14 @@ void WriteObjects(const std::vector<std::string>& modes,
                   const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
                   const std::filesystem::path& path) {
   std::ostringstream os;
-  os << "mode,id,name,frames_in_grid,frames_tracked,scored,D,t_d,delta_x,delta_v\n";
+  os << "mode,id,name,frames_in_grid,frames_tracked,frames_tracked_v,scored,D,D_v,t_d,delta_x,"
+        "delta_v\n";
   auto opt = [](const std::optional<double>& v) { return v ? Fixed(*v, 4) : std::string(); };
   for (std::size_t m = 0; m < modes.size(); ++m)
     for (const auto& o : metrics[m].objects)
       os << modes[m] << ',' << o.id << ',' << ids.Name(o.id) << ',' << o.frames_in_grid << ','
-         << o.frames_tracked << ',' << (o.scored ? 1 : 0) << ',' << opt(o.tracked_fraction) << ','
+         << o.frames_tracked << ',' << o.frames_tracked_v << ',' << (o.scored ? 1 : 0) << ','
+         << opt(o.tracked_fraction) << ',' << opt(o.tracked_fraction_v) << ','
          << opt(o.detection_time) << ',' << opt(o.position_error) << ',' << opt(o.velocity_error)
          << '\n';
   WriteTextFile(path, os.str());

@@ -37,6 +37,7 @@ inline constexpr std::string_view kDeltaV = "delta_v";
 inline constexpr std::string_view kBoxDistance = "box_distance";
 inline constexpr std::string_view kDetectionTime = "t_d";
 inline constexpr std::string_view kTrackedFraction = "D";
+inline constexpr std::string_view kTrackedFractionV = "D_v";
 inline constexpr std::string_view kFalseClusters = "false_clusters_per_scan";
 inline constexpr std::string_view kDuplicateClusters = "duplicate_clusters_per_scan";
 inline constexpr std::string_view kScored = "objects_scored";
@@ -122,16 +123,18 @@ struct ModeRuns {
   std::vector<ScenarioMetrics> seeds;
 };
 
-/// The standard table: Delta x [m], Delta v [m/s], t_d [s], D [%], false and duplicate clusters
-/// per scan, objects scored, objects never tracked (scored, never consistently tracked) and of
-/// those never in any radar's coverage, and the dynamic-cell F1 when any run has cell metrics.
-/// Each cell summarises the seeds where the metric is defined (Summary::n says how many). Paper
-/// numbers are attached when the scenario is known. Columns follow the order of `runs`.
+/// The standard table: Delta x [m], Delta v [m/s], t_d [s], D [%], D_v [%], false and duplicate
+/// clusters per scan, objects scored, objects never tracked (scored, never consistently tracked)
+/// and of those never in any radar's coverage, and the dynamic-cell F1 when any run has cell
+/// metrics. Each cell summarises the seeds where the metric is defined (Summary::n says how many).
+/// Paper numbers are attached when the scenario is known. Columns follow the order of `runs`.
 ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const ModeRuns> runs);
 
 /// Per object id: D summarised over the seeds in which that object was scored (for the paper's
-/// Fig. 6). Meaningful when object ids denote the same vehicle in every seed.
-std::map<int, Summary> PerObjectTrackedFraction(std::span<const ScenarioMetrics> seeds);
+/// Fig. 6). Meaningful when object ids denote the same vehicle in every seed. `velocity_aware`:
+/// D_v instead of D.
+std::map<int, Summary> PerObjectTrackedFraction(std::span<const ScenarioMetrics> seeds,
+                                                bool velocity_aware = false);
 
 void to_json(nlohmann::json& j, const Summary& s);
 

@@ -5,6 +5,11 @@
 // when it is in_grid and a cluster is matched to it by Associate):
 // - Delta x / Delta v: mean over all (frame, tracked object) pairs of
 //   ||cluster.position - box.center|| / ||cluster.velocity - object.velocity||.
+// - D_v of an object (not in the paper): frames tracked by a cluster whose velocity error is below
+//   max(velocity_tolerance, velocity_tolerance_fraction x the object's speed) / frames in_grid.
+//   D counts a cluster in the gate whatever its velocity; in the paper a wrong velocity turns the
+//   cells static, so its D implicitly needs roughly right dynamics: D_v is that, made explicit.
+//   Scenario D_v: mean over scored objects, like D.
 // - D of an object: frames tracked / frames in_grid. Objects with fewer than min_frames_in_grid
 //   in_grid frames are not scored (too short to say anything). Scenario D: mean over scored
 //   objects (each object counts once, as in the paper's "average duration").
@@ -40,6 +45,12 @@ struct TrackingMetricsParams {
   int window = 5;
   /// Objects with fewer in_grid frames are not scored (20 frames = 1 s at 20 Hz).
   int min_frames_in_grid = 20;
+  /// D_v: a tracked frame counts when |cluster velocity - object velocity| is below
+  /// max(velocity_tolerance [m/s], velocity_tolerance_fraction x |object velocity|): 2 m/s is
+  /// about the paper's Delta v (Tables I, II: 0.2-3.3 m/s); 20 % keeps the bound meaningful for
+  /// fast traffic.
+  double velocity_tolerance = 2.0;
+  double velocity_tolerance_fraction = 0.2;
 
   bool IsValid(std::string* error) const;
 };
@@ -48,11 +59,13 @@ struct ObjectMetrics {
   int id = 0;
   int frames_in_grid = 0;
   int frames_tracked = 0;                    ///< in_grid frames with a matched cluster
+  int frames_tracked_v = 0;                  ///< ... whose velocity is within the tolerance
   bool scored = false;                       ///< frames_in_grid >= min_frames_in_grid
   std::optional<double> first_in_grid_time;  ///< [s]
   std::optional<double> clock_start_time;    ///< first in_grid && in_coverage frame [s]
   std::optional<double> track_onset_time;    ///< t1 of the t_d definition [s]
   std::optional<double> tracked_fraction;    ///< D in [0, 1]; empty if never in_grid
+  std::optional<double> tracked_fraction_v;  ///< D_v in [0, 1]; empty if never in_grid
   std::optional<double> detection_time;      ///< t_d [s]; empty if never consistently tracked
   std::optional<double> position_error;      ///< mean over its tracked frames [m]
   std::optional<double> velocity_error;      ///< [m/s]
@@ -66,9 +79,10 @@ struct ScenarioMetrics {
   /// Radar sees only the faces turned to it, so clusters sit on a face; this separates that
   /// offset (up to half a length) from errors of the filter itself.
   std::optional<double> box_distance;
-  std::optional<double> velocity_error;    ///< Delta v [m/s]
-  std::optional<double> detection_time;    ///< t_d [s]
-  std::optional<double> tracked_fraction;  ///< D in [0, 1]
+  std::optional<double> velocity_error;      ///< Delta v [m/s]
+  std::optional<double> detection_time;      ///< t_d [s]
+  std::optional<double> tracked_fraction;    ///< D in [0, 1]
+  std::optional<double> tracked_fraction_v;  ///< D_v in [0, 1]
   int objects_scored = 0;
   int objects_detected = 0;          ///< scored and ever consistently tracked
   int objects_never_tracked = 0;     ///< scored, never consistently tracked (for any reason)
@@ -98,6 +112,7 @@ class TrackingMetricsAccumulator {
   struct ObjectState {
     int frames_in_grid = 0;
     int frames_tracked = 0;
+    int frames_tracked_v = 0;
     std::optional<double> first_in_grid_time, clock_start_time, track_onset_time;
     std::vector<std::pair<double, bool>> window;  // (time, tracked), oldest first, <= window
     double position_error_sum = 0.0, velocity_error_sum = 0.0;
