@@ -300,7 +300,7 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_never_tracked));
        }},
-      {{std::string(kNeverObservable), "… of which never in radar coverage", "", 1.0, 1},
+      {{std::string(kNeverObservable), "… of which never seen in the grid", "", 1.0, 1},
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_never_observable));
        }},

@@ -61,10 +61,11 @@ AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
     const TruthObject& o = objects[k];
     const int c = a.cluster_of_object[k];
     const bool tracked = o.in_grid && c >= 0;
-    // Objects enter the table when first in the grid; earlier frames carry no information.
+    // Objects enter the table when first in the grid or first detected in it; earlier frames
+    // carry no information about the grid.
     auto it = objects_.find(o.id);
     if (it == objects_.end()) {
-      if (!o.in_grid) continue;
+      if (!o.in_grid && !o.detected_in_grid) continue;
       it = objects_.emplace(o.id, ObjectState{}).first;
     }
     ObjectState& s = it->second;
@@ -72,13 +73,16 @@ AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
       ++s.frames_in_grid;
       if (!s.first_in_grid_time) s.first_in_grid_time = time;
     }
+    // Matched with the right velocity (D_v, and the t_d window whether or not in the grid).
+    const bool matched_v =
+        c >= 0 && (clusters[c].velocity - o.velocity).norm() <
+                      std::max(params_.velocity_tolerance,
+                               params_.velocity_tolerance_fraction * o.velocity.norm());
     if (tracked) {
       ++s.frames_tracked;
       const double dx = (clusters[c].position - o.box.center).norm();
       const double dv = (clusters[c].velocity - o.velocity).norm();
-      if (dv < std::max(params_.velocity_tolerance,
-                        params_.velocity_tolerance_fraction * o.velocity.norm()))
-        ++s.frames_tracked_v;
+      if (matched_v) ++s.frames_tracked_v;
       s.position_error_sum += dx;
       s.velocity_error_sum += dv;
       position_error_sum_ += dx;
@@ -90,10 +94,10 @@ AssociationResult TrackingMetricsAccumulator::AddFrame(double time,
       box_distance_sum_ += outside.norm();
       ++matches_;
     }
-    if (!s.clock_start_time && o.in_grid && o.in_coverage) s.clock_start_time = time;
+    if (!s.clock_start_time && o.in_coverage && o.detected_in_grid) s.clock_start_time = time;
     if (s.clock_start_time && !s.track_onset_time) {
       if (static_cast<int>(s.window.size()) == params_.window) s.window.erase(s.window.begin());
-      s.window.emplace_back(time, tracked);
+      s.window.emplace_back(time, matched_v);
       int count = 0;
       std::optional<double> earliest;
       for (const auto& [t, tr] : s.window) {

@@ -140,7 +140,7 @@ TEST_CASE("A single run claims no confidence interval; notes are printed", "[agg
   CHECK(md.find("— : not defined") == std::string::npos);  // nothing is blank
   CHECK(md.find("Not scored: cross_1 (17 frames).") != std::string::npos);
   CHECK(md.find("| objects never tracked | 1.0 |") != std::string::npos);
-  CHECK(md.find("| … of which never in radar coverage | 1.0 |") != std::string::npos);
+  CHECK(md.find("| … of which never seen in the grid | 1.0 |") != std::string::npos);
   CHECK(t.ToJson().at("notes").size() == 1);
 }
 

@@ -32,7 +32,7 @@ TruthObject Object(int id, int f, double length = 4.5) {
   // Objects 50 m apart laterally so that no gate overlaps another object's.
   o.box = OrientedBox{Position(v.x() * f * kDt, 50.0 * id), 0.0, length, 1.8};
   o.velocity = v;
-  o.in_grid = o.in_coverage = true;
+  o.in_grid = o.in_coverage = o.detected_in_grid = true;
   return o;
 }
 
@@ -85,7 +85,7 @@ ScenarioMetrics RunSyntheticScenario() {
     }
     // 6: listed but never in the grid, with a cluster on it: neither scored nor false.
     objects.push_back(Object(6, f));
-    objects.back().in_grid = false;
+    objects.back().in_grid = objects.back().detected_in_grid = false;
     clusters.push_back(ClusterOn(objects.back(), {1.0, 0.0}, {5.0, 0.0}));
     // 7: in the grid but never seen by a radar.
     objects.push_back(Object(7, f));
@@ -334,4 +334,39 @@ TEST_CASE("D_v tolerances are validated", "[metrics][d_v]") {
   p.velocity_tolerance_fraction = 1.5;
   CHECK_FALSE(p.IsValid(&error));
   CHECK(error.find("velocity_tolerance_fraction") != std::string::npos);
+}
+
+// The t_d clock starts at the first detection in the grid (in coverage), and the consistent track
+// needs the right velocity: a cluster on the object's front before its centre enters the grid
+// counts from the first detection, and a wrong-velocity cluster does not end the clock.
+TEST_CASE(
+    "t_d: the clock starts at the first detection in the grid; onset needs the right "
+    "velocity",
+    "[metrics][t_d]") {
+  TrackingMetricsAccumulator acc;
+  for (int f = 0; f < kFrames; ++f) {
+    // Object 1 (oncoming, say): detected in the grid from frame 4, its centre in the grid only
+    // from frame 10; a cluster with the right velocity on it from frame 8.
+    TruthObject a = Object(1, f);
+    a.detected_in_grid = f >= 4;
+    a.in_grid = f >= 10;
+    // Object 2: detected and in the grid throughout; clusters from frame 0, but with a 9 m/s
+    // velocity error until frame 12 (beyond max(2, 0.2 x 25 = 5) m/s), right from frame 12.
+    const TruthObject b = Object(2, f);
+    std::vector<Cluster> clusters;
+    if (f >= 8) clusters.push_back(ClusterOn(a, {0.0, 0.0}, {0.5, 0.0}));
+    clusters.push_back(ClusterOn(b, {0.0, 0.0}, {f < 12 ? 9.0 : 0.5, 0.0}));
+    acc.AddFrame(f * kDt, clusters, std::vector<TruthObject>{a, b});
+  }
+  const ScenarioMetrics m = acc.Result();
+  const ObjectMetrics& o1 = Find(m, 1);
+  const ObjectMetrics& o2 = Find(m, 2);
+  REQUIRE(o1.clock_start_time);
+  CHECK(*o1.clock_start_time == Approx(4 * kDt));
+  REQUIRE(o1.detection_time);
+  CHECK(*o1.detection_time == Approx((8 - 4) * kDt));  // not 0: the front was shown at frame 4
+  CHECK(o1.frames_in_grid == kFrames - 10);
+  REQUIRE(o2.detection_time);
+  CHECK(*o2.detection_time == Approx(12 * kDt));  // D counted it from frame 0, t_d does not
+  CHECK(*o2.tracked_fraction == Approx(1.0));
 }

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -104,9 +105,15 @@ bool Pipeline::Step() {
 std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) {
   std::vector<eval::TruthObject> out;
   const auto poses = radar_.SensorPoses(ego_.pose);
+  // Sources of this step's detections inside the grid: the t_d clock starts at a vehicle's first.
+  std::vector<int> detected;
+  for (const radar::Detection& d : detections_)
+    if (grid.CellOf(d.position_world)) detected.push_back(d.source_id);
+  std::sort(detected.begin(), detected.end());
   for (const sim::VehicleState& v : frame().vehicles) {
     eval::TruthObject o;
     o.id = ids_.Id(v.id);
+    o.detected_in_grid = std::binary_search(detected.begin(), detected.end(), o.id);
     o.box = v.box;
     o.velocity = v.velocity;
     o.in_grid = grid.CellOf(v.box.center).has_value();

@@ -35,6 +35,9 @@ struct TruthObject {
   Velocity velocity = Velocity::Zero();  ///< velocity of the box centre [m/s]
   bool in_grid = false;                  ///< its centre lies inside the grid
   bool in_coverage = false;              ///< at least one radar field of view sees it
+  /// At least one of this cycle's radar detections from it lies inside the grid: the t_d clock
+  /// starts no earlier (the grid cannot track what it has not been shown).
+  bool detected_in_grid = false;
 };
 
 struct AssociationParams {

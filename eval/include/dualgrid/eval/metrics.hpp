@@ -2,7 +2,8 @@
 // clusters per scan, accumulated frame by frame.
 //
 // Definitions (frame = one AddFrame call = one filter cycle; an object "is tracked" in a frame
-// when it is in_grid and a cluster is matched to it by Associate):
+// when it is in_grid and a cluster is matched to it by Associate; objects are listed from the
+// first frame in which they are in_grid or detected_in_grid):
 // - Delta x / Delta v: mean over all (frame, tracked object) pairs of
 //   ||cluster.position - box.center|| / ||cluster.velocity - object.velocity||.
 // - D_v of an object (not in the paper): frames tracked by a cluster whose velocity error is below
@@ -13,14 +14,18 @@
 // - D of an object: frames tracked / frames in_grid. Objects with fewer than min_frames_in_grid
 //   in_grid frames are not scored (too short to say anything). Scenario D: mean over scored
 //   objects (each object counts once, as in the paper's "average duration").
-// - t_d of an object: the clock starts at the first frame where it is in_grid && in_coverage
-//   (time t0). From then on each frame in which the object is listed enters a window of the last
-//   `window` frames; the object is first "consistently tracked" in the first frame whose window
-//   holds >= `required` tracked frames. Its track onset is the time t1 of the earliest tracked
-//   frame in that window (when the consistent track began, not when the rule confirmed it; the
-//   difference is at most window - 1 frames), and t_d = t1 - t0. Scenario t_d: mean over scored
-//   objects that were ever consistently tracked; the others are counted as never tracked (and,
-//   if they were never in any radar's coverage while in the grid, also as never observable).
+// - t_d of an object: the clock starts at the first frame where it is in_coverage and
+//   detected_in_grid (time t0): the grid has been shown the object. (Before, the clock started
+//   when the box centre entered the grid: an oncoming car, whose front the grid tracks before its
+//   centre enters, scored t_d = 0.) From then on each frame in which the object is listed enters
+//   a window of the last `window` frames; the object is first "consistently tracked" in the first
+//   frame whose window holds >= `required` frames in which a cluster is matched to it with the
+//   right velocity (as for D_v; the centre need not be in the grid yet). Its track onset is the
+//   time t1 of the earliest tracked frame in that window (when the consistent track began, not when
+//   the rule confirmed it; the difference is at most window - 1 frames), and t_d = t1 - t0.
+//   Scenario t_d: mean over scored objects that were ever consistently tracked; the others are
+//   counted as never tracked (and, if they were never in any radar's coverage while in the grid,
+//   also as never observable).
 // - False / duplicate clusters per scan: mean over frames of the counts from Associate.
 #pragma once
 
@@ -86,7 +91,8 @@ struct ScenarioMetrics {
   int objects_scored = 0;
   int objects_detected = 0;          ///< scored and ever consistently tracked
   int objects_never_tracked = 0;     ///< scored, never consistently tracked (for any reason)
-  int objects_never_observable = 0;  ///< of those: never in_coverage while in_grid
+  int objects_never_observable = 0;  ///< of those: clock never started (never detected in the
+                                     ///< grid while in coverage)
   double clusters_per_scan = 0.0;
   double false_clusters_per_scan = 0.0;
   double duplicate_clusters_per_scan = 0.0;
