@@ -84,7 +84,7 @@ TEST_CASE("SIGINT and SIGTERM stop a run with its partial results marked incompl
       Start({"run", "scenarios/highway.yaml", "--no-figures", "-q", "--out", dir.string()},
             dir.parent_path() / ("run_" + std::to_string(sig) + ".log"));
   // clusters.csv is created when the first step starts; give it a few steps more.
-  REQUIRE(WaitFor(dir / "clusters.csv", 60s));
+  REQUIRE(WaitFor(dir / "clusters.csv", 600s));
   std::this_thread::sleep_for(1s);
   kill(pid, sig);
   CHECK(ExitCode(pid) == 128 + sig);
@@ -101,11 +101,12 @@ TEST_CASE("SIGINT and SIGTERM stop a run with its partial results marked incompl
 TEST_CASE("experiment forwards SIGTERM to its runs and keeps the finished seeds",
           "[cli][signals]") {
   const auto dir = TempDir("experiment");
-  // Seed 1 is short and finishes; seed 2 is still running when the signal comes.
+  // One seed at a time: seed 1 finishes; seed 2 is still running when the signal comes (it needs
+  // a few seconds, or minutes under a sanitizer).
   const pid_t pid = Start({"experiment", "scenarios/highway.yaml", "--seeds", "2", "-j", "1",
-                           "--no-figures", "-q", "--out", dir.string()},
+                           "--duration", "20", "--no-figures", "-q", "--out", dir.string()},
                           dir.parent_path() / "experiment.log");
-  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 120s));
+  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 900s));
   std::this_thread::sleep_for(1s);
   kill(pid, SIGTERM);  // the parent only: it must forward the signal
   CHECK(ExitCode(pid) == 143);
@@ -124,7 +125,7 @@ TEST_CASE("A killed experiment takes its runs with it", "[cli][signals]") {
   const pid_t pid = Start({"experiment", "scenarios/highway.yaml", "--seeds", "2", "-j", "2",
                            "--no-figures", "-q", "--out", dir.string()},
                           dir.parent_path() / "orphans.log");
-  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 120s));
+  REQUIRE(WaitFor(dir / "seeds" / "seed_2" / "clusters.csv", 900s));
   kill(pid, SIGKILL);
   CHECK(ExitCode(pid) == 128 + SIGKILL);
   // The runs get SIGTERM from the kernel (PR_SET_PDEATHSIG) and stop at the end of their step.
