@@ -81,6 +81,9 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   if (pid < 0)
     throw std::runtime_error("cannot start " + o.executable + ": " + std::strerror(errno));
   if (pid == 0) {
+    // Its own process group: Ctrl-C on the terminal reaches the experiment only, which forwards
+    // it once (a run that got SIGINT twice would stop at once, without its partial results).
+    setpgid(0, 0);
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent) _exit(143);  // the parent died before prctl took effect
     const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);

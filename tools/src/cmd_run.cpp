@@ -2,10 +2,9 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
-
-#include <chrono>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
