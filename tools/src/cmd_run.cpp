@@ -102,7 +102,7 @@ int RunFilters(const FilterRunOptions& options) {
   // Weight traces (paper Fig. 4) of the dual filter, or of the last mode if dual is not run.
   const auto dual = std::find(modes.begin(), modes.end(), filter::WeightMode::kDual);
   const std::size_t trace_mode = dual != modes.end() ? dual - modes.begin() : modes.size() - 1;
-  WeightTraces traces;
+  WeightTraces traces(config.evaluation.focus_object);
   nlohmann::json rss_mb = nlohmann::json::array();  // [time s, resident MB] with --check-invariants
 
   Progress progress("run " + config.sim.name + " seed " + std::to_string(config.sim.seed),
@@ -201,7 +201,7 @@ int RunFilters(const FilterRunOptions& options) {
        UnscoredNotes(metrics, pipeline.ids(), config.evaluation.tracking.min_frames_in_grid))
     table.AddNote(std::move(note));
   WriteTables(table, out);
-  const std::string focus = traces.Focus(config.evaluation.focus_object);
+  const std::string focus = traces.Focus();
   if (!focus.empty()) WriteWeights(traces.by_vehicle.at(focus), focus, out / "weights.csv");
   if (!options.run.quiet) std::cout << table.ToMarkdown() << "\n";
 

@@ -34,9 +34,12 @@ void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
   const sim::Frame& f = pipeline.frame();
   const auto& grid = pipeline.grid(mode);
   const auto& p = grid.particles();
+  std::set<std::string> in_grid;
   for (const auto& v : f.vehicles) {
     if (!grid.CellOf(v.box.center)) continue;
     ++frames_in_grid[v.id];
+    in_grid.insert(v.id);
+    if (dropped.count(v.id)) continue;
     double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
     const OrientedBox grown{v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0};
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -65,14 +68,23 @@ void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
     t.velocity_share.push_back(wv > 0 ? wv_good / wv : std::nan(""));
     t.tangential_share.push_back(n > 0 ? static_cast<double>(tangential) / n : std::nan(""));
   }
+  const std::string leader = Focus();
+  for (auto it = by_vehicle.begin(); it != by_vehicle.end();) {
+    if (it->first != requested && it->first != leader && !in_grid.count(it->first)) {
+      dropped.insert(it->first);
+      it = by_vehicle.erase(it);
+    } else {
+      ++it;
+    }
+  }
 }
 
-std::string WeightTraces::Focus(const std::string& requested) const {
+std::string WeightTraces::Focus() const {
   if (by_vehicle.count(requested)) return requested;
   std::string focus;
   int best = -1;
   for (const auto& [id, n] : frames_in_grid)
-    if (n > best) best = n, focus = id;
+    if (n > best && by_vehicle.count(id)) best = n, focus = id;
   return focus;
 }
 
