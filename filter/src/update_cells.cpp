@@ -1,0 +1,260 @@
+// Steps 5-6 of the cycle (docs/algorithm.md): particle weights (paper eqs. 7, 8, 14) and the joint
+// occupancy update (eqs. 9-12), cell by cell.
+#include "dualgrid/filter/dynamic_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include "grid_internal.hpp"
+
+namespace dualgrid::filter {
+
+using namespace detail;
+
+void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
+  const FilterParams& p = params_;
+  const double inv_2sf2 = 0.5 / (p.sigma_f * p.sigma_f);
+  const double inv_sd2 = 1.0 / (p.sigma_static_distance * p.sigma_static_distance);
+  const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);
+  const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
+  const double keep = 1.0 - p.decay_eps;
+  const double slow2 = p.static_speed * p.static_speed;
+  const double max_speed2 = p.max_speed * p.max_speed;
+  const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
+  ParticleSet& q = sorted_;
+  // f_v of the static hypothesis (v = 0) per detection: once per detection, not per cell.
+  const int nz = static_cast<int>(z.size());
+  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grows only
+  for (int j = 0; j < nz; ++j) {
+    det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
+  }
+  const double* const fv0_of = det_fv0_.data();
+  const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
+  const double static_persistence = p.static_persistence, free_decay = p.free_decay;
+  const std::int64_t* const start = cell_start_.data();
+  const int* const near = near_det_.data();
+  const std::uint8_t* const view_bits = view_.data();
+  double* const free_l = free_.data();
+  double* const static_l = static_.data();
+  double* const dynamic_l = dynamic_.data();
+  // Blocks of cells in parallel; dynamic scheduling only balances load, every value is computed by
+  // one thread from the same inputs, so results do not depend on the thread count.
+  const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t ch = 0; ch < chunks; ++ch) {
+    const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
+    // Fast path (most cells): no particle, no detection. The general equations below reduce to a
+    // free/static Dempster update with the whole occupied mass static and no dynamic mass (same
+    // operations with d_pred = 0, occ_k = 0). Branch-free over the block so that it vectorises;
+    // the other cells keep their values here and are updated in the loop below.
+    for (std::int64_t s = c_lo; s < c_hi; ++s) {
+      const bool fast = (start[s] == start[s + 1]) & (near[s] < 0);
+      const std::uint8_t view = view_bits[s];
+      // z_free of the general path, as 0/1 selectors (fm * 1 + fm_nr * 0 = fm exactly).
+      const int obs = view & kObserved, ray = (view >> 1) & 1, none = (view >> 2) & 1;
+      const double z_free =
+          static_cast<double>(obs & ray) * fm + static_cast<double>(obs & (ray ^ 1) & none) * fm_nr;
+      const double st = static_l[s], fr = free_l[s];
+      const double s_pred = std::min(static_persistence * st, 1.0 - 0.0);
+      const double f_pred = std::max(0.0, std::min(free_decay * fr, 1.0 - 0.0 - s_pred));
+      const double o_pred = 0.0 + s_pred;
+      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
+      const double norm0 = 1.0 / (1.0 - s_pred * z_free);
+      const double nf = (f_pred + u_pred * z_free) * norm0;
+      const double ns = s_pred * (1.0 - z_free) * norm0;
+      free_l[s] = fast ? nf : fr;
+      static_l[s] = fast ? ns : st;
+      dynamic_l[s] = fast ? 0.0 : dynamic_l[s];
+    }
+    // Cells with birth mass, in cell order (Birth reads only these).
+    std::int64_t* const born_list = born_cells_.data() + c_lo;
+    std::int32_t n_born = 0;
+    for (std::int64_t s = c_lo; s < c_hi; ++s) {
+      const std::int64_t lo = start[s], hi = start[s + 1];
+      if (lo == hi && near[s] < 0) continue;  // done above
+      const std::uint8_t view = view_[s];
+      const bool observed = (view & kObserved) != 0;
+
+      // --- Prediction: predicted masses (dynamic = sum of persistent particle weights). ---
+      double d_pred = 0.0;
+      for (std::int64_t i = lo; i < hi; ++i) d_pred += q.weight[i];
+      const double cap = d_pred > 1.0 ? 1.0 / d_pred : 1.0;  // dynamic mass is a probability
+      d_pred *= cap;
+      const double s_pred = std::min(p.static_persistence * static_[s], 1.0 - d_pred);
+      const double f_pred = std::max(0.0, std::min(p.free_decay * free_[s], 1.0 - d_pred - s_pred));
+      const double o_pred = d_pred + s_pred;
+      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
+
+      // --- Measurement grid: occupied (f_d, eq. 2), static (eq. 4), free (eq. 3 on rays). ---
+      double occ_k = 0.0, static_k = 0.0;
+      const int j = near_det_[s];
+      if (j >= 0) {
+        const double d2 = near_d2_[s];
+        occ_k = std::exp(-d2 * inv_2sf2);
+        static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
+      }
+      const double z_occ = p.occupied_mass * occ_k;
+      double z_free = 0.0;
+      if (observed) {
+        if (view & kFreeRay) {
+          z_free = p.free_mass * (1.0 - occ_k);
+        } else if (view & kNoReturn) {
+          z_free = p.free_mass_no_return * (1.0 - occ_k);
+        }
+      }
+      const double z_unk = 1.0 - z_occ - z_free;
+
+      // --- Temporal fusion (Dempster's rule on {free, occupied}). ---
+      const double conflict = o_pred * z_free + f_pred * z_occ;
+      const double norm = 1.0 / (1.0 - conflict);
+      double o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
+      double f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
+      if (o_up + f_up > 1.0) {  // rounding only
+        const double k = 1.0 / (o_up + f_up);
+        o_up *= k;
+        f_up *= k;
+      }
+
+      // --- Particle weights, eqs. (7) and (8), unnormalised. The per-cycle factors double as the
+      // likelihood of each hypothesis in the joint normalisation below. ---
+      const auto mode_factor = [&](double lp, double lv) {
+        return p.mode == WeightMode::kPosition   ? lp
+               : p.mode == WeightMode::kVelocity ? lv
+                                                 : std::max(lp, lv);  // eq. (14)
+      };
+      double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
+      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
+      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
+      std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+      bool any_candidate = false;
+      if (hi > lo) {
+        const auto [bx, by] = BucketOf(q.x[lo], q.y[lo]);
+        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx_ - 1, bx + 1);
+        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++r) {
+          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx_;
+          cand[r][0] = bucket_start_[row + x_lo];
+          cand[r][1] = bucket_start_[row + x_hi + 1];
+          any_candidate = any_candidate || cand[r][1] > cand[r][0];
+        }
+      }
+      for (std::int64_t i = lo; i < hi; ++i) {
+        const double m = q.weight[i] * cap;
+        q.weight[i] = m;
+        if (q.vx[i] * q.vx[i] + q.vy[i] * q.vy[i] < slow2) {
+          // A particle at (almost) zero speed is the static hypothesis (occ and v = 0): its mass
+          // votes static and the particle dies at resampling.
+          slow_mass += m;
+          q.w_position[i] = q.w_velocity[i] = q.weight[i] = 0.0;
+          continue;
+        }
+        // Nearest detection within the cutoff (ties to the lower detection index).
+        int jn = -1;
+        double d2 = cutoff2;
+        if (any_candidate) {
+          const double px = q.x[i], py = q.y[i];
+          for (const auto& range : cand) {
+            for (std::int64_t k = range[0]; k < range[1]; ++k) {
+              const double ex = det_x_[k] - px, ey = det_y_[k] - py;
+              const double e2 = ex * ex + ey * ey;
+              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items_[k] < jn)) {
+                d2 = e2;
+                jn = bucket_items_[k];
+              }
+            }
+          }
+        }
+        double lp = keep, lv = keep;  // unobserved: decayed prior
+        if (jn >= 0 || observed) {
+          // Float exp: kernel values need no double precision and this runs per particle.
+          const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
+          double fv = 0.0;
+          if (jn >= 0) {
+            const double ex = q.vx[i] - z[jn].radial_velocity.x();
+            const double ey = q.vy[i] - z[jn].radial_velocity.y();
+            fv = ExpUnder(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
+          }
+          lp = fd * keep;                    // eq. (7)
+          lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
+        }
+        const double wp = lp * q.w_position[i], wv = lv * q.w_velocity[i];
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        fast_mass += m;
+        sum_pos += wp;
+        sum_vel += wv;
+        a_dyn += m * mode_factor(lp, lv);
+      }
+      // The static hypothesis is scored like a particle with v = 0 at the cell centre.
+      double ls_pos = keep, ls_vel = keep;
+      if (j >= 0 || observed) {
+        const double fv0 = j >= 0 ? fv0_of[j] : 0.0;
+        ls_pos = occ_k * keep;
+        ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
+      }
+      const double l_static = mode_factor(ls_pos, ls_vel);
+
+      // --- Joint normalisation of the occupied mass (eqs. 9-12 on o_up). ---
+      double a_static =
+          (s_pred + slow_mass) * l_static + p.static_gain * p.occupied_mass * static_k;
+      // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
+      // such returns are clutter; their occupied mass stays unassigned (unknown).
+      const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
+      double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
+      if (a_static + a_dyn + a_birth <= 0.0) {
+        // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
+        // the measurement cannot arbitrate, so the predicted split is kept.
+        a_static = s_pred + slow_mass;
+        a_dyn = fast_mass;
+      }
+      double q_norm = a_static + a_dyn + a_birth;
+      // Subnormal likelihoods (e.g. a static mass decayed to 5e-324 and nothing else) lose their
+      // precision in o_up * a / q_norm: the product rounds up to the smallest subnormal and the
+      // share comes out as o_up * 1, breaking F + S <= 1 (found by the soak test,
+      // docs/reliability.md). Scaling all three by 2^600 is exact and restores full precision;
+      // normal values are untouched, so results elsewhere stay bit-identical.
+      if (q_norm > 0.0 && q_norm < std::numeric_limits<double>::min()) {
+        constexpr double kScale = 0x1p600;
+        a_static *= kScale;
+        a_dyn *= kScale;
+        a_birth *= kScale;
+        q_norm = a_static + a_dyn + a_birth;
+      }
+      double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
+      if (q_norm > 0.0) {
+        s_up = o_up * a_static / q_norm;
+        rho_p = o_up * a_dyn / q_norm;
+        rho_b = o_up * a_birth / q_norm;
+      }
+
+      // --- Normalise weights so that they sum to rho_p in the cell; w_resample by mode. ---
+      double sum_res = 0.0;
+      for (std::int64_t i = lo; i < hi; ++i) {
+        if (q.weight[i] == 0.0) continue;
+        const double m = q.weight[i];
+        const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
+        const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        const double wr = mode_factor(wp, wv);  // w_resample
+        q.weight[i] = wr;
+        sum_res += wr;
+      }
+      if (sum_res > 0.0) {
+        const double k = rho_p / sum_res;
+        for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
+      }
+      free_[s] = f_up;
+      static_[s] = s_up;
+      // Reported dynamic mass: persistent particles only. New-born mass is occupied mass whose
+      // motion no prediction has confirmed yet; counting it as dynamic would mark every new
+      // detection with a Doppler (clutter included) dynamic at once. It stays in the unknown share
+      // of the cell until its particles survive a cycle (docs/algorithm.md, step 5).
+      dynamic_[s] = rho_p;
+      born_[s] = rho_b;
+      if (rho_b != 0.0) born_list[n_born++] = s;
+    }
+    born_count_[ch] = n_born;
+  }
+}
+
+}  // namespace dualgrid::filter
