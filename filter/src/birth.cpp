@@ -123,6 +123,7 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
   const double vt_max = std::min(
       vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed - v_radial * v_radial)));
+  const bool uniform = params_.birth_velocity == BirthVelocity::kUniform;
   constexpr std::int64_t kBatch = 64;
   alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
   for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
@@ -138,10 +139,18 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
       births_.y[k] = (static_cast<double>(gy) + detail::ToUnit24(raw[1][t])) * r;
       float n0, n1;
       detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
-      // Radial component from the Doppler, tangential one unobservable: sampled uniformly, within
-      // what keeps the speed at most max_speed.
-      const Vector2 v = (v_radial + params_.birth_sigma_radial * n0) * los +
-                        vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
+      Vector2 v;
+      if (uniform) {
+        // Uniform in the disc |v| <= max_speed (area-uniform radius): no Doppler information.
+        const double speed = params_.max_speed * std::sqrt(detail::ToUnit24(raw2[0][t]));
+        const double angle = 2.0 * kPi * detail::ToUnit24(raw2[1][t]);
+        v = speed * Vector2(std::cos(angle), std::sin(angle));
+      } else {
+        // Radial component from the Doppler, tangential one unobservable: sampled uniformly,
+        // within what keeps the speed at most max_speed.
+        v = (v_radial + params_.birth_sigma_radial * n0) * los +
+            vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
+      }
       births_.vx[k] = v.x();
       births_.vy[k] = v.y();
       births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = mass;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace dualgrid::filter {
 
@@ -23,6 +24,64 @@ std::optional<WeightMode> ParseWeightMode(std::string_view name) {
   }
   return std::nullopt;
 }
+
+namespace {
+
+// One name table per switch: ToString and Parse read the same pairs.
+template <typename E, std::size_t N>
+std::string_view NameOf(const std::pair<E, std::string_view> (&table)[N], E v) {
+  for (const auto& [e, name] : table)
+    if (e == v) return name;
+  return "unknown";
+}
+template <typename E, std::size_t N>
+std::optional<E> ValueOf(const std::pair<E, std::string_view> (&table)[N], std::string_view name) {
+  for (const auto& [e, n] : table)
+    if (n == name) return e;
+  return std::nullopt;
+}
+constexpr std::pair<BirthVelocity, std::string_view> kBirthNames[] = {
+    {BirthVelocity::kDoppler, "doppler"}, {BirthVelocity::kUniform, "uniform"}};
+constexpr std::pair<ZeroLikelihood, std::string_view> kZeroNames[] = {
+    {ZeroLikelihood::kKeepPrediction, "keep_prediction"}, {ZeroLikelihood::kLiteral, "literal"}};
+constexpr std::pair<VelocityLikelihood, std::string_view> kLikelihoodNames[] = {
+    {VelocityLikelihood::kVector, "vector"}, {VelocityLikelihood::kRadial, "radial"}};
+constexpr std::pair<Normalisation, std::string_view> kNormNames[] = {
+    {Normalisation::kPerCell, "per_cell"}, {Normalisation::kLiteral, "literal"}};
+
+}  // namespace
+
+std::string_view ToString(BirthVelocity v) { return NameOf(kBirthNames, v); }
+std::string_view ToString(ZeroLikelihood v) { return NameOf(kZeroNames, v); }
+std::string_view ToString(VelocityLikelihood v) { return NameOf(kLikelihoodNames, v); }
+std::string_view ToString(Normalisation v) { return NameOf(kNormNames, v); }
+std::optional<BirthVelocity> ParseBirthVelocity(std::string_view n) {
+  return ValueOf(kBirthNames, n);
+}
+std::optional<ZeroLikelihood> ParseZeroLikelihood(std::string_view n) {
+  return ValueOf(kZeroNames, n);
+}
+std::optional<VelocityLikelihood> ParseVelocityLikelihood(std::string_view n) {
+  return ValueOf(kLikelihoodNames, n);
+}
+std::optional<Normalisation> ParseNormalisation(std::string_view n) {
+  return ValueOf(kNormNames, n);
+}
+
+std::optional<FilterParams> Preset(std::string_view name) {
+  FilterParams p;
+  if (name == "default" || name == "dualgrid") return p;
+  if (name == "paper") {
+    p.birth_velocity = BirthVelocity::kUniform;
+    p.zero_likelihood = ZeroLikelihood::kLiteral;
+    p.velocity_likelihood = VelocityLikelihood::kVector;
+    p.normalisation = Normalisation::kLiteral;
+    return p;
+  }
+  return std::nullopt;
+}
+
+std::string_view PresetNames() { return "default, dualgrid, paper"; }
 
 int FilterParams::CellsX() const {
   return std::max(1, static_cast<int>(std::lround(length_x / resolution)));
@@ -92,6 +151,11 @@ bool FilterParams::IsValid(std::string* error) const {
   if (!prob(decay_eps) || decay_eps >= 1.0) return Fail(error, "decay_eps must be in [0, 1)");
   if (mode != WeightMode::kPosition && mode != WeightMode::kVelocity && mode != WeightMode::kDual)
     return Fail(error, "mode is not a WeightMode");
+  if (ToString(birth_velocity) == "unknown") return Fail(error, "birth_velocity is not a value");
+  if (ToString(zero_likelihood) == "unknown") return Fail(error, "zero_likelihood is not a value");
+  if (ToString(velocity_likelihood) == "unknown")
+    return Fail(error, "velocity_likelihood is not a value");
+  if (ToString(normalisation) == "unknown") return Fail(error, "normalisation is not a value");
   return true;
 }
 

@@ -22,13 +22,28 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double max_speed2 = p.max_speed * p.max_speed;
   const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
   ParticleSet& q = sorted_;
-  // f_v of the static hypothesis (v = 0) per detection: once per detection, not per cell.
+  // Per detection, once per cycle: f_v of the static hypothesis (v = 0; the same in both
+  // likelihood forms, since a zero velocity has no line-of-sight component either), and for the
+  // radial likelihood the unit line of sight u and the signed compensated radial speed v_r . u.
   const int nz = static_cast<int>(z.size());
-  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grows only
+  if (static_cast<int>(det_fv0_.size()) < nz) {  // grow only
+    det_fv0_.resize(nz);
+    det_los_.resize(3 * static_cast<std::size_t>(nz));
+  }
   for (int j = 0; j < nz; ++j) {
     det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
+    Vector2 u = z[j].position - z[j].sensor_position;
+    const double n = u.norm();
+    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
+    det_los_[3 * j] = u.x();
+    det_los_[3 * j + 1] = u.y();
+    det_los_[3 * j + 2] = z[j].radial_velocity.dot(u);
   }
   const double* const fv0_of = det_fv0_.data();
+  const double* const los_of = det_los_.data();
+  const bool radial = p.velocity_likelihood == VelocityLikelihood::kRadial;
+  const bool literal_norm = p.normalisation == Normalisation::kLiteral;
+  const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
   const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
   const double static_persistence = p.static_persistence, free_decay = p.free_decay;
   const std::int64_t* const start = cell_start_.data();
@@ -123,6 +138,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
                                                  : std::max(lp, lv);  // eq. (14)
       };
       double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
+      double sum_mode = 0.0;  // sum_k w_k of eq. (9) with the particles' own weights (literal)
       // Candidate detections of all particles of the cell: the three contiguous item ranges of the
       // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
       std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
@@ -169,19 +185,31 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
           const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
           double fv = 0.0;
           if (jn >= 0) {
-            const double ex = q.vx[i] - z[jn].radial_velocity.x();
-            const double ey = q.vy[i] - z[jn].radial_velocity.y();
-            fv = ExpUnder(static_cast<float>(-(ex * ex + ey * ey) * inv_2v2));
+            double e2;
+            if (radial) {  // line-of-sight component against the measured radial speed
+              const double* u = los_of + 3 * jn;
+              const double e = q.vx[i] * u[0] + q.vy[i] * u[1] - u[2];
+              e2 = e * e;
+            } else {  // eq. (8): the full vector against mu_v = (v_rx, v_ry)
+              const double ex = q.vx[i] - z[jn].radial_velocity.x();
+              const double ey = q.vy[i] - z[jn].radial_velocity.y();
+              e2 = ex * ex + ey * ey;
+            }
+            fv = ExpUnder(static_cast<float>(-e2 * inv_2v2));
           }
           lp = fd * keep;                    // eq. (7)
           lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
         }
-        const double wp = lp * q.w_position[i], wv = lv * q.w_velocity[i];
+        // The literal normalisation sums the particles' own weights, so they share the cap of
+        // their mass; the per-cell form renormalises them below and needs no cap.
+        const double wcap = literal_norm ? cap : 1.0;
+        const double wp = lp * q.w_position[i] * wcap, wv = lv * q.w_velocity[i] * wcap;
         q.w_position[i] = wp;
         q.w_velocity[i] = wv;
         fast_mass += m;
         sum_pos += wp;
         sum_vel += wv;
+        sum_mode += mode_factor(wp, wv);
         a_dyn += m * mode_factor(lp, lv);
       }
       // The static hypothesis is scored like a particle with v = 0 at the cell centre.
@@ -200,35 +228,70 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       // such returns are clutter; their occupied mass stays unassigned (unknown).
       const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
       double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
-      if (a_static + a_dyn + a_birth <= 0.0) {
+      // Literal eqs. (9)-(12): the particles enter with their own accumulated weights.
+      if (literal_norm) a_dyn = sum_mode;
+      bool fell_back = false;
+      if (keep_prediction && a_static + a_dyn + a_birth <= 0.0) {
         // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
-        // the measurement cannot arbitrate, so the predicted split is kept.
+        // the measurement cannot arbitrate, so the predicted split is kept. (Literal eq. (7)
+        // instead lets the occupied mass become unknown: zero_likelihood = literal.)
         a_static = s_pred + slow_mass;
         a_dyn = fast_mass;
+        fell_back = true;
       }
-      double q_norm = a_static + a_dyn + a_birth;
+      // Literal: the not-occupied mass competes in the same sum (eq. 9). P_free is read as free
+      // plus unknown (1 - o_up): with free alone, a particle in a never-observed cell (no free, no
+      // static evidence) would make it 100 % dynamic (docs/algorithm.md, "Switches").
+      double a_free = literal_norm ? std::max(0.0, 1.0 - o_up) : 0.0;
+      const double free_part = a_free > 0.0 ? f_up / a_free : 0.0;  // free share of a_free
+      double q_norm = a_free + a_static + a_dyn + a_birth;
       // Subnormal likelihoods (e.g. a static mass decayed to 5e-324 and nothing else) lose their
       // precision in o_up * a / q_norm: the product rounds up to the smallest subnormal and the
       // share comes out as o_up * 1, breaking F + S <= 1 (found by the soak test,
       // docs/reliability.md). Scaling all three by 2^600 is exact and restores full precision;
       // normal values are untouched, so results elsewhere stay bit-identical.
+      double scale = 1.0;
       if (q_norm > 0.0 && q_norm < std::numeric_limits<double>::min()) {
         constexpr double kScale = 0x1p600;
+        scale = kScale;
+        a_free *= kScale;
         a_static *= kScale;
         a_dyn *= kScale;
         a_birth *= kScale;
-        q_norm = a_static + a_dyn + a_birth;
+        q_norm = a_free + a_static + a_dyn + a_birth;
       }
+      // Per cell: the shares of o_up; literal: the shares of 1 (eqs. 10-12).
+      const double share = literal_norm ? 1.0 : o_up;
       double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
       if (q_norm > 0.0) {
-        s_up = o_up * a_static / q_norm;
-        rho_p = o_up * a_dyn / q_norm;
-        rho_b = o_up * a_birth / q_norm;
+        s_up = share * a_static / q_norm;
+        rho_p = share * a_dyn / q_norm;
+        rho_b = share * a_birth / q_norm;
+        if (literal_norm) f_up = free_part * a_free / q_norm;
+      }
+      if (literal_norm) {
+        // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
+        // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
+        // A single mode's other weight is not in q_norm and would drift without bound (float
+        // overflow): it is normalised on its own to rho_p, as in the per-cell form.
+        const double k = q_norm > 0.0 ? scale / q_norm : 0.0;
+        const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
+        const bool own_v = fell_back || p.mode != WeightMode::kPosition;
+        const double kp = own_p ? k : (sum_pos > 0.0 ? rho_p / sum_pos : 0.0);
+        const double kv = own_v ? k : (sum_vel > 0.0 ? rho_p / sum_vel : 0.0);
+        for (std::int64_t i = lo; i < hi; ++i) {
+          if (q.weight[i] == 0.0) continue;
+          const double wp = fell_back ? q.weight[i] : q.w_position[i];
+          const double wv = fell_back ? q.weight[i] : q.w_velocity[i];
+          q.w_position[i] = static_cast<float>(wp * kp);
+          q.w_velocity[i] = static_cast<float>(wv * kv);
+          q.weight[i] = static_cast<float>(mode_factor(wp, wv) * k);
+        }
       }
 
-      // --- Normalise weights so that they sum to rho_p in the cell; w_resample by mode. ---
+      // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
       double sum_res = 0.0;
-      for (std::int64_t i = lo; i < hi; ++i) {
+      for (std::int64_t i = lo; i < hi && !literal_norm; ++i) {
         if (q.weight[i] == 0.0) continue;
         const double m = q.weight[i];
         const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
@@ -239,7 +302,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         q.weight[i] = wr;
         sum_res += wr;
       }
-      if (sum_res > 0.0) {
+      if (sum_res > 0.0 && !literal_norm) {
         const double k = rho_p / sum_res;
         for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
       }

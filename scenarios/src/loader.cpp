@@ -299,9 +299,31 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
   }
 }
 
-void ReadFilter(MapReader& root, filter::FilterParams* f) {
+// Reads a switch given by name into *out, naming the accepted values on error.
+template <typename E>
+void ReadSwitch(MapReader& r, const std::string& key, std::optional<E> (*parse)(std::string_view),
+                const char* accepted, E* out) {
+  if (!r.Has(key)) return;
+  std::string name;
+  r.Read(key, &name);
+  const std::optional<E> v = parse(name);
+  if (!v) r.Fail(key, std::string("expected ") + accepted + ", got '" + name + "'");
+  *out = *v;
+}
+
+void ReadFilter(MapReader& root, ScenarioConfig* config) {
+  filter::FilterParams* f = &config->filter;
   auto r = root.Map("filter");
   if (!r) return;
+  // A preset first: the keys below override it.
+  if (r->Has("preset")) {
+    r->Read("preset", &config->filter_preset);
+    const std::optional<filter::FilterParams> preset = filter::Preset(config->filter_preset);
+    if (!preset)
+      r->Fail("preset", "expected one of " + std::string(filter::PresetNames()) + ", got '" +
+                            config->filter_preset + "'");
+    *f = *preset;
+  }
   ReadFields(*r, kFilterDoubles, f);
   ReadFields(*r, kFilterInts, f);
   std::string mode(filter::ToString(f->mode));
@@ -309,6 +331,28 @@ void ReadFilter(MapReader& root, filter::FilterParams* f) {
   const auto parsed = filter::ParseWeightMode(mode);
   if (!parsed) r->Fail("mode", "expected 'position', 'velocity' or 'dual', got '" + mode + "'");
   f->mode = *parsed;
+  ReadSwitch(*r, "zero_likelihood", filter::ParseZeroLikelihood, "'keep_prediction' or 'literal'",
+             &f->zero_likelihood);
+  ReadSwitch(*r, "velocity_likelihood", filter::ParseVelocityLikelihood, "'vector' or 'radial'",
+             &f->velocity_likelihood);
+  ReadSwitch(*r, "normalisation", filter::ParseNormalisation, "'per_cell' or 'literal'",
+             &f->normalisation);
+  constexpr const char* kBirthNames = "'doppler' or 'uniform'";
+  if (r->IsMap("birth_velocity")) {
+    // Per mode: {position: uniform, velocity: doppler, dual: doppler}.
+    auto per_mode = r->Map("birth_velocity");
+    for (filter::WeightMode m : {filter::WeightMode::kPosition, filter::WeightMode::kVelocity,
+                                 filter::WeightMode::kDual}) {
+      filter::BirthVelocity v = f->birth_velocity;
+      const std::string key(filter::ToString(m));
+      if (!per_mode->Has(key)) continue;
+      ReadSwitch(*per_mode, key, filter::ParseBirthVelocity, kBirthNames, &v);
+      config->birth_velocity_by_mode[m] = v;
+    }
+    per_mode->Finish();
+  } else {
+    ReadSwitch(*r, "birth_velocity", filter::ParseBirthVelocity, kBirthNames, &f->birth_velocity);
+  }
   r->Finish();
   std::string error;
   if (!f->IsValid(&error)) Invalid(root.file(), "filter", error);
@@ -360,6 +404,14 @@ bool EvaluationConfig::IsValid(std::string* error) const {
   return true;
 }
 
+filter::FilterParams ScenarioConfig::FilterFor(filter::WeightMode mode) const {
+  filter::FilterParams p = filter;
+  p.mode = mode;
+  if (const auto it = birth_velocity_by_mode.find(mode); it != birth_velocity_by_mode.end())
+    p.birth_velocity = it->second;
+  return p;
+}
+
 namespace {
 
 ScenarioConfig LoadDocument(const std::function<YAML::Node()>& parse,
@@ -386,10 +438,83 @@ ScenarioConfig LoadDocument(const std::function<YAML::Node()>& parse,
 
 }  // namespace
 
-ScenarioConfig LoadScenario(const std::filesystem::path& file) {
+Override ParseOverride(const std::string& text) {
+  const std::size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError("--set '" + text + "': expected KEY=VALUE, e.g. filter.preset=paper");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+namespace {
+
+// Sets `o.key` in `doc` to the YAML value `o.value`, creating maps on the way.
+void ApplyOverride(YAML::Node doc, const Override& o) {
+  const std::string where = "--set " + o.key + "=" + o.value;
+  YAML::Node value;
+  try {
+    value = YAML::Load(o.value);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(where + ": the value is not valid YAML: " + e.msg);
+  }
+  std::vector<std::string> parts;
+  for (std::size_t a = 0;;) {
+    const std::size_t b = o.key.find('.', a);
+    parts.push_back(o.key.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) break;
+    a = b + 1;
+  }
+  // yaml-cpp nodes are handles: assigning to `node` would rebind it, so walk with reset().
+  YAML::Node node;
+  node.reset(doc);
+  std::string path;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::string& part = parts[i];
+    if (part.empty()) throw ConfigError(where + ": empty component in the key");
+    path += (path.empty() ? "" : ".") + part;
+    const bool last = i + 1 == parts.size();
+    if (node.IsSequence()) {
+      if (part.find_first_not_of("0123456789") != std::string::npos || part.size() > 6 ||
+          std::stoul(part) >= node.size())
+        throw ConfigError(where + ": '" + path + "' indexes a list of " +
+                          std::to_string(node.size()) + " entries; expected an index 0.." +
+                          std::to_string(node.size() == 0 ? 0 : node.size() - 1));
+      if (last) {
+        node[std::stoul(part)] = value;
+        return;
+      }
+      YAML::Node next = node[std::stoul(part)];
+      node.reset(next);
+      continue;
+    }
+    if (!node.IsMap() && !node.IsNull())
+      throw ConfigError(where + ": '" + path.substr(0, path.size() - part.size() - 1) +
+                        "' is not a map in the scenario file");
+    if (last) {
+      node[part] = value;
+      return;
+    }
+    YAML::Node next = node[part];
+    if (!next.IsDefined() || next.IsNull()) {  // a section the file does not have yet
+      node[part] = YAML::Node(YAML::NodeType::Map);
+      next.reset(node[part]);
+    }
+    node.reset(next);
+  }
+}
+
+}  // namespace
+
+ScenarioConfig LoadScenario(const std::filesystem::path& file,
+                            const std::vector<Override>& overrides) {
   if (!std::filesystem::is_regular_file(file))
     throw ConfigError(file.string() + ": scenario file not found");
-  return LoadDocument([&] { return YAML::LoadFile(file.string()); }, file);
+  return LoadDocument(
+      [&] {
+        YAML::Node doc = YAML::LoadFile(file.string());
+        for (const Override& o : overrides) ApplyOverride(doc, o);
+        return doc;
+      },
+      file);
 }
 
 ScenarioConfig LoadScenarioText(const std::string& text, const std::filesystem::path& file) {
@@ -400,6 +525,7 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   nlohmann::json j;
   j["scenario_file"] = c.file.string();
   j["scenario"] = c.sim.name;
+  j["overrides"] = c.overrides;
   j["seed"] = c.sim.seed;
   j["duration_s"] = c.sim.duration;
   j["step_length_s"] = c.sim.step_length;
@@ -418,6 +544,15 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   WriteFields(kFilterDoubles, c.filter, &j["filter"]);
   WriteFields(kFilterInts, c.filter, &j["filter"]);
   j["filter"]["mode"] = filter::ToString(c.filter.mode);
+  j["filter"]["preset"] = c.filter_preset.empty() ? "default" : c.filter_preset;
+  j["filter"]["zero_likelihood"] = filter::ToString(c.filter.zero_likelihood);
+  j["filter"]["velocity_likelihood"] = filter::ToString(c.filter.velocity_likelihood);
+  j["filter"]["normalisation"] = filter::ToString(c.filter.normalisation);
+  // Per mode always (the resolved value each filter runs with), so runs compare key by key.
+  for (filter::WeightMode m :
+       {filter::WeightMode::kPosition, filter::WeightMode::kVelocity, filter::WeightMode::kDual})
+    j["filter"]["birth_velocity"][std::string(filter::ToString(m))] =
+        filter::ToString(c.FilterFor(m).birth_velocity);
   auto& e = j["evaluation"];
   e["dynamic_threshold"] = c.evaluation.dynamic_threshold;
   e["min_cluster_mass"] = c.evaluation.min_cluster_mass;
@@ -437,7 +572,7 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
   std::string error;
   if (!config.sim.IsValid(&error)) Invalid(name, "", error);
   ReadRadar(root, config.sim, &config.radar);
-  ReadFilter(root, &config.filter);
+  ReadFilter(root, &config);
   ReadEvaluation(root, &config.evaluation);
   root.Finish();
   // Names the evaluation uses must exist: a typo would silently pick another vehicle.

@@ -70,6 +70,8 @@ bool MapReader::Has(const std::string& key) {
   return static_cast<bool>(node_[key]);
 }
 
+bool MapReader::IsMap(const std::string& key) { return Has(key) && node_[key].IsMap(); }
+
 YAML::Node MapReader::Get(const std::string& key) {
   known_.insert(key);
   return node_[key];

@@ -22,6 +22,8 @@ class MapReader {
 
   /// True if the key is present (marks it as known).
   bool Has(const std::string& key);
+  /// True if the key is present and holds a map (marks it as known).
+  bool IsMap(const std::string& key);
   /// Reads `key` into `*out` if present; leaves the default otherwise.
   void Read(const std::string& key, double* out);
   void Read(const std::string& key, int* out);

@@ -40,6 +40,17 @@ CLI::Validator NonEmptyPath() {
       "PATH");
 }
 
+CLI::Validator OverrideSpec() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        const std::size_t eq = s.find('=');
+        return eq == std::string::npos || eq == 0
+                   ? "expected KEY=VALUE (e.g. filter.preset=paper), got '" + s + "'"
+                   : "";
+      },
+      "KEY=VALUE");
+}
+
 CLI::Validator Number(double lo, double hi, bool lo_open) {
   const std::string range = (lo_open ? "(" : "[") + Shown(lo) + ", " + Shown(hi) + "]";
   return CLI::Validator(

@@ -27,6 +27,8 @@ int Cores();
 CLI::Validator WholeNumber(long long lo, long long hi);
 /// A non-empty path (an empty --out would write into the working folder).
 CLI::Validator NonEmptyPath();
+/// KEY=VALUE with a non-empty KEY (`--set`).
+CLI::Validator OverrideSpec();
 /// A finite number in (lo, hi] when lo_open, else [lo, hi].
 CLI::Validator Number(double lo, double hi, bool lo_open);
 

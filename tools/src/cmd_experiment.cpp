@@ -55,6 +55,7 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
                                    "--network-dir",
                                    o.run.run.network_dir.string()};
   if (o.run.run.duration) args.insert(args.end(), {"--duration", Exact(*o.run.run.duration)});
+  for (const std::string& set : o.run.run.sets) args.insert(args.end(), {"--set", set});
   std::string modes;
   for (const auto& m : o.run.modes) modes += (modes.empty() ? "" : ",") + m;
   args.insert(args.end(), {"--modes", modes});

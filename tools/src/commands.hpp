@@ -20,6 +20,8 @@ struct RunOptions {
   std::optional<double> duration;
   std::filesystem::path network_dir;
   bool quiet = false;
+  /// `--set KEY=VALUE` overrides of scenario keys, in order (scenario::Override).
+  std::vector<std::string> sets;
 };
 
 /// `dualgrid sim`: ground truth and radar detections, no filter.

@@ -45,6 +45,11 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
       "Folder of the built networks named in scenarios (`network: highway`)")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress or summary output");
+  cmd->add_option("--set", o->sets,
+                  "Override a scenario key, KEY=VALUE (repeatable): e.g. --set filter.preset=paper "
+                  "--set filter.num_particles=3000; a number in KEY indexes a list "
+                  "(traffic.vehicles.0.speed=20). Validated like the file")
+      ->check(OverrideSpec());
 }
 
 CLI::Validator DetectionFormat() { return CLI::IsMember({"none", "csv", "csv.gz"}); }

@@ -24,7 +24,10 @@ std::string Fixed(double v, int decimals) {
 }
 
 scenario::ScenarioConfig LoadConfig(const RunOptions& options) {
-  scenario::ScenarioConfig config = scenario::LoadScenario(options.scenario);
+  std::vector<scenario::Override> overrides;
+  for (const std::string& text : options.sets) overrides.push_back(scenario::ParseOverride(text));
+  scenario::ScenarioConfig config = scenario::LoadScenario(options.scenario, overrides);
+  config.overrides = options.sets;
   if (options.seed) config.sim.seed = *options.seed;
   if (options.duration) config.sim.duration = *options.duration;
   // The overrides go through the same validation as the file.
@@ -39,9 +42,9 @@ void CopyScenario(const scenario::ScenarioConfig& config, const std::filesystem:
   std::ifstream in(config.file);
   std::ostringstream copy;
   copy << "# Copy of " << config.file.string() << " as used for this run; command-line overrides:\n"
-       << "#   seed: " << config.sim.seed << ", duration: " << config.sim.duration << " s\n"
-       << "# network as resolved: " << config.sim.network << "\n"
-       << in.rdbuf();
+       << "#   seed: " << config.sim.seed << ", duration: " << config.sim.duration << " s\n";
+  for (const std::string& set : config.overrides) copy << "#   --set " << set << "\n";
+  copy << "# network as resolved: " << config.sim.network << "\n" << in.rdbuf();
   WriteTextFile(out / "scenario.yaml", copy.str());
 }
 

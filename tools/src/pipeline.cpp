@@ -51,8 +51,7 @@ Pipeline::Pipeline(const scenario::ScenarioConfig& config, const std::filesystem
       radar_(config.radar.sensors, config.radar.options, config.sim.seed),
       modes_(std::move(modes)) {
   for (filter::WeightMode m : modes_) {
-    filter::FilterParams p = config_.filter;
-    p.mode = m;
+    filter::FilterParams p = config_.FilterFor(m);
     // The same seed for every mode: birth and prediction noise are identical across modes until
     // their particle sets differ, so the comparison isolates the weights.
     filters_.push_back(std::make_unique<filter::DynamicGrid>(p, config_.sim.seed));

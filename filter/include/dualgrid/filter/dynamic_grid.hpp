@@ -150,6 +150,7 @@ class DynamicGrid {
   std::vector<std::int64_t> born_cells_;
   std::vector<std::int32_t> born_count_;
   std::vector<double> det_fv0_;         // per detection: f_v of a particle at v = 0
+  std::vector<double> det_los_;         // per detection: unit line of sight (x, y), v_r . u
   std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff).

@@ -20,6 +20,44 @@ std::string_view ToString(WeightMode mode);
 /// Inverse of ToString; std::nullopt for unknown names.
 std::optional<WeightMode> ParseWeightMode(std::string_view name);
 
+// Switches for the places where the paper is silent or where this filter departs from it. Each is
+// documented beside the paper's equation in docs/algorithm.md ("Switches"); the `paper` preset sets
+// every one to its literal reading.
+
+/// Velocity of new-born particles (step 7; the paper gives no birth model).
+enum class BirthVelocity {
+  kDoppler,  ///< radial part from the detection's Doppler, tangential part uniform.
+  kUniform,  ///< uniform in the disc |v| <= max_speed: no Doppler reaches position mode at all.
+};
+/// Eq. (7) in an observed cell where every hypothesis scores 0 (no detection near any of them).
+enum class ZeroLikelihood {
+  kKeepPrediction,  ///< the measurement cannot arbitrate: keep the predicted static/dynamic split.
+  kLiteral,         ///< eq. (7) as printed: all weights 0, the occupied mass becomes unknown.
+};
+/// f_v of eq. (8).
+enum class VelocityLikelihood {
+  kVector,  ///< the paper: N(v_p; mu_v = (v_rx, v_ry), sigma_v^2 I) on the full velocity vector.
+  kRadial,  ///< N(v_p . u; v_r, sigma_v^2): only the particle's line-of-sight component, the part
+            ///< a Doppler measures (u: unit line of sight, v_r: compensated radial speed).
+};
+/// The joint normalisation of eqs. (9)-(12).
+enum class Normalisation {
+  kPerCell,  ///< Nuss random-finite-set form: Dempster on free/occupied, then the occupied mass
+             ///< split by the hypotheses' likelihoods; particle weights sum to the dynamic mass.
+  kLiteral,  ///< q_norm = P_free + P_static + sum_k w_k with the particles' own (accumulated,
+             ///< unnormalised) weights, as printed; no unknown mass where it applies.
+};
+
+std::string_view ToString(BirthVelocity v);
+std::string_view ToString(ZeroLikelihood v);
+std::string_view ToString(VelocityLikelihood v);
+std::string_view ToString(Normalisation v);
+/// Inverses of ToString; std::nullopt for unknown names.
+std::optional<BirthVelocity> ParseBirthVelocity(std::string_view name);
+std::optional<ZeroLikelihood> ParseZeroLikelihood(std::string_view name);
+std::optional<VelocityLikelihood> ParseVelocityLikelihood(std::string_view name);
+std::optional<Normalisation> ParseNormalisation(std::string_view name);
+
 /// All tuning of DynamicGrid. Defaults: the paper's configuration (200 m x 25 m at 0.5 m, 10,000
 /// particles) and a nominal cycle of 0.05 s; per-cycle factors assume that cycle.
 struct FilterParams {
@@ -63,6 +101,12 @@ struct FilterParams {
   double decay_eps = 0.05;  ///< eps of eqs. (7), (8).
   WeightMode mode = WeightMode::kDual;
 
+  // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset.
+  BirthVelocity birth_velocity = BirthVelocity::kDoppler;
+  ZeroLikelihood zero_likelihood = ZeroLikelihood::kKeepPrediction;
+  VelocityLikelihood velocity_likelihood = VelocityLikelihood::kVector;
+  Normalisation normalisation = Normalisation::kPerCell;
+
   /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
   int CellsX() const;
   int CellsY() const;
@@ -78,5 +122,13 @@ struct FilterParams {
   /// True when every field is usable; otherwise names the offending field in *error.
   bool IsValid(std::string* error) const;
 };
+
+/// Named parameter sets. "paper": every switch at its literal reading of the paper (the paper's
+/// experiment as written); "dualgrid": the setting this project recommends (docs/results.md);
+/// "default": the struct defaults. Only the switches differ; sizes and kernels are the defaults.
+/// std::nullopt for an unknown name.
+std::optional<FilterParams> Preset(std::string_view name);
+/// Names accepted by Preset, for error messages: "default, dualgrid, paper".
+std::string_view PresetNames();
 
 }  // namespace dualgrid::filter

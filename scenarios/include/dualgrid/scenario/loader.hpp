@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -49,14 +50,35 @@ struct ScenarioConfig {
   sim::ScenarioSpec sim;
   RadarConfig radar;
   filter::FilterParams filter;
+  /// `filter.birth_velocity` given per mode ({position: uniform, ...}); modes not listed use
+  /// filter.birth_velocity.
+  std::map<filter::WeightMode, filter::BirthVelocity> birth_velocity_by_mode;
+  /// `filter.preset` as given ("" when none).
+  std::string filter_preset;
+  /// The command line's `--set KEY=VALUE` texts, as applied (recorded in config.json).
+  std::vector<std::string> overrides;
   EvaluationConfig evaluation;
+
+  /// The filter parameters of one weight mode: `filter` with that mode and its birth velocity.
+  filter::FilterParams FilterFor(filter::WeightMode mode) const;
 };
 
 /// Every resolved parameter, for the run folder's config.json (same keys and units as the file).
 nlohmann::json ConfigToJson(const ScenarioConfig& config);
 
-/// Loads and validates a scenario file. Throws ConfigError.
-ScenarioConfig LoadScenario(const std::filesystem::path& file);
+/// One command-line override `--set KEY=VALUE`: KEY a dotted path into the file ("filter.sigma_v",
+/// "traffic.vehicles.0.speed": a number indexes a list), VALUE any YAML value ("0.5", "paper",
+/// "[1, 2]"). Applied to the document before it is read, so it is validated like the file.
+struct Override {
+  std::string key;
+  std::string value;
+};
+/// Splits "KEY=VALUE"; throws ConfigError naming `text` when there is no '=' or no key.
+Override ParseOverride(const std::string& text);
+
+/// Loads and validates a scenario file, with `overrides` applied in order. Throws ConfigError.
+ScenarioConfig LoadScenario(const std::filesystem::path& file,
+                            const std::vector<Override>& overrides = {});
 
 /// The same for a scenario's text; `file` names it in errors and anchors relative network paths.
 /// Throws ConfigError and nothing else for any text (the fuzz target tests/fuzz/ checks this).
