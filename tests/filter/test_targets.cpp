@@ -1,9 +1,6 @@
 // Synthetic single targets with exact detections: the three weight modes on the paper's cases.
 #include <catch2/catch.hpp>
 
-#include <string>
-#include <vector>
-
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "synthetic.hpp"
 
@@ -11,77 +8,6 @@ using namespace dualgrid;
 using namespace dualgrid::filter;
 using namespace dualgrid::filter::testing;
 
-namespace {
-
-enum class Case { kRadial, kTangential, kStatic };
-
-struct Trace {
-  std::vector<TargetView> views;    // one per cycle
-  std::vector<std::string> broken;  // invariant violations, "cycle k: ..."
-};
-
-// dt = 0.05 s (the radar cycle of the project), 3 s. Car 4.5 m x 1.8 m at 25 m/s (90 km/h).
-//  kRadial: ego at rest, target ahead driving away along the long-range radar's line of sight
-//           (compensated radial speed = 25 m/s), detections on its rear face.
-//  kTangential: ego and target both at 25 m/s along x, target 9 m to the left, seen by the left
-//           radar abeam: the line of sight is perpendicular to the motion, detections near the
-//           foot point of the side face (+-0.6 m, so |v_r| <= 25 * 0.6 / 8 = 1.9 m/s).
-//  kStatic: parked box 30 m ahead of the resting ego, zero Doppler.
-Trace Run(Case c, WeightMode mode, std::uint64_t seed, int cycles = 60) {
-  FilterParams fp;
-  fp.mode = mode;
-  DynamicGrid g(fp, seed);
-  const double dt = 0.05;
-  Trace tr;
-  for (int k = 0; k < cycles; ++k) {
-    const double t = k * dt;
-    Pose2 ego;
-    Velocity ego_v = Velocity::Zero();
-    OrientedBox box{{0, 0}, 0.0, 4.5, 1.8};
-    Velocity v = Velocity::Zero();
-    SensorCoverage cov;
-    double half_span = 1.0;
-    switch (c) {
-      case Case::kRadial:
-        box.center = {20.0 + 25.0 * t, 0.3};
-        v = {25.0, 0.0};
-        cov = ForwardRadar(ego);
-        break;
-      case Case::kTangential:
-        ego.position = {25.0 * t, 0.0};
-        ego_v = {25.0, 0.0};
-        box.center = {25.0 * t, 9.0};
-        v = {25.0, 0.0};
-        cov = LeftRadar(ego);
-        half_span = 0.6;
-        break;
-      case Case::kStatic:
-        box.center = {30.0, 1.0};
-        cov = ForwardRadar(ego);
-        break;
-    }
-    std::vector<Measurement> z;
-    for (const Position& p : NearFacePoints(box, cov.origin, half_span, 0.5)) {
-      z.push_back(Detect(p, v, cov.origin));
-    }
-    g.Update({ego, ego_v}, z, std::span<const SensorCoverage>(&cov, 1), dt);
-    if (const auto b = g.CheckInvariants())
-      tr.broken.push_back("cycle " + std::to_string(k) + ": " + *b);
-    TargetView view = LookAt(g, box, 0.5);
-    view.mean_velocity -= v;  // store the error vector
-    tr.views.push_back(view);
-  }
-  return tr;
-}
-
-// Mean velocity error norm over cycles [from, to).
-double MeanVelocityError(const Trace& t, int from, int to) {
-  double s = 0.0;
-  for (int k = from; k < to; ++k) s += t.views[k].mean_velocity.norm();
-  return s / (to - from);
-}
-
-}  // namespace
 
 TEST_CASE("the grid's invariants hold after every cycle, in every case and mode",
           "[filter][targets][invariants]") {
