@@ -165,7 +165,6 @@ inline double MeanVelocityError(const Trace& t, int from, int to) {
   return s / (to - from);
 }
 
-
 inline Trace Run(Case c, WeightMode mode, std::uint64_t seed, int cycles = 60) {
   FilterParams fp;
   fp.mode = mode;

@@ -8,7 +8,6 @@ using namespace dualgrid;
 using namespace dualgrid::filter;
 using namespace dualgrid::filter::testing;
 
-
 TEST_CASE("the grid's invariants hold after every cycle, in every case and mode",
           "[filter][targets][invariants]") {
   const Case c = GENERATE(Case::kRadial, Case::kTangential, Case::kStatic);

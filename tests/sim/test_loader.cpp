@@ -166,3 +166,58 @@ TEST_CASE("config.json keys read back as scenario keys with the same values", "[
     CHECK(second.radar.sensors[i].mount.yaw == Approx(first.radar.sensors[i].mount.yaw));
   }
 }
+
+TEST_CASE("filter presets set the switches and single keys override them", "[loader][switches]") {
+  using filter::WeightMode;
+  const auto paper = LoadScenario(
+      Write("preset.yaml", std::string(kValid) + "filter: {preset: paper, sigma_v: 2.0}\n"));
+  CHECK(paper.filter_preset == "paper");
+  CHECK(paper.filter.birth_velocity == filter::BirthVelocity::kUniform);
+  CHECK(paper.filter.zero_likelihood == filter::ZeroLikelihood::kLiteral);
+  CHECK(paper.filter.velocity_likelihood == filter::VelocityLikelihood::kVector);
+  CHECK(paper.filter.normalisation == filter::Normalisation::kLiteral);
+  CHECK(paper.filter.sigma_v == 2.0);
+  // A key after the preset wins, wherever it stands in the map.
+  const auto mixed = LoadScenario(Write(
+      "mixed.yaml", std::string(kValid) + "filter: {normalisation: per_cell, preset: paper}\n"));
+  CHECK(mixed.filter.normalisation == filter::Normalisation::kPerCell);
+  CHECK(mixed.filter.zero_likelihood == filter::ZeroLikelihood::kLiteral);
+  // Per mode births; unlisted modes keep the section's value.
+  const auto per_mode = LoadScenario(Write(
+      "births.yaml",
+      std::string(kValid) + "filter: {birth_velocity: {position: uniform, velocity: doppler}}\n"));
+  CHECK(per_mode.FilterFor(WeightMode::kPosition).birth_velocity ==
+        filter::BirthVelocity::kUniform);
+  CHECK(per_mode.FilterFor(WeightMode::kVelocity).birth_velocity ==
+        filter::BirthVelocity::kDoppler);
+  CHECK(per_mode.FilterFor(WeightMode::kDual).birth_velocity == filter::BirthVelocity::kDoppler);
+  CHECK(per_mode.FilterFor(WeightMode::kPosition).mode == WeightMode::kPosition);
+  const nlohmann::json j = ConfigToJson(per_mode);
+  CHECK(j.at("filter").at("birth_velocity").at("position") == "uniform");
+  CHECK(j.at("filter").at("birth_velocity").at("dual") == "doppler");
+}
+
+TEST_CASE("--set overrides are applied to the document before it is read", "[loader][set]") {
+  const auto path = Write("set.yaml", kValid);
+  const auto c = LoadScenario(path, {scenario::ParseOverride("filter.preset=paper"),
+                                     scenario::ParseOverride("filter.num_particles=3000"),
+                                     scenario::ParseOverride("traffic.vehicles.0.speed=31.5"),
+                                     scenario::ParseOverride("duration=4")});
+  CHECK(c.filter_preset == "paper");
+  CHECK(c.filter.num_particles == 3000);
+  REQUIRE(c.sim.vehicles.size() == 1);
+  CHECK(c.sim.vehicles[0].speed == 31.5);
+  CHECK(c.sim.duration == 4.0);
+  // Validated as the file is: the error names the file and the key.
+  try {
+    LoadScenario(path, {scenario::ParseOverride("filter.sigma_v=-1")});
+    FAIL("expected a ConfigError");
+  } catch (const ConfigError& e) {
+    CHECK(std::string(e.what()).find("sigma_v") != std::string::npos);
+    CHECK(std::string(e.what()).find(path.string()) != std::string::npos);
+  }
+  CHECK_THROWS_AS(scenario::ParseOverride("no_equals"), ConfigError);
+  CHECK_THROWS_AS(LoadScenario(path, {scenario::ParseOverride("duration.x=1")}), ConfigError);
+  CHECK_THROWS_AS(LoadScenario(path, {scenario::ParseOverride("traffic.vehicles.5.speed=1")}),
+                  ConfigError);
+}
