@@ -17,6 +17,13 @@ constexpr double kMaxSpacing = 1.0;        // [m] keeps long faces' shapes for o
 constexpr double kCornerShare = 0.5;       // corners (dihedrals) reflect strongly
 constexpr double kOcclusionShrink = 1e-3;  // [m] a scatterer must not occlude itself
 constexpr int kAzimuthBins = 128;          // occluder lookup by azimuth
+// [m] a line of sight must run this far inside the ego's body to be blocked: the sensors sit on
+// its surface, and a ray leaving the surface (or grazing it) is not hidden.
+constexpr double kEgoBodyMargin = 0.05;
+// A face is visible only if the line of sight meets it at more than this grazing angle (sine):
+// a face seen exactly edge-on (a flank collinear with the sensor) returns nothing, and with it
+// its far corner, hidden behind the near one (docs/radar.md step 2).
+constexpr double kMinGrazingSin = 0.0087;  // sin(0.5 deg)
 
 /// Angular interval seen from the sensor, stored as centre direction and cos(half width) so
 /// membership is one dot product.
@@ -49,6 +56,29 @@ struct Occluder {
 };
 
 double Cross(const Vector2& u, const Vector2& v) { return u.x() * v.y() - u.y() * v.x(); }
+
+/// Length of the part of the segment p -> q inside the box (Liang-Barsky slab clipping in the
+/// box frame); 0 if it misses.
+double LengthInsideBox(const Occluder& o, const Position& p, const Position& q) {
+  const Vector2 lateral(-o.axis.y(), o.axis.x());
+  const Vector2 rp = p - o.a, d = q - p;
+  const double s[2] = {rp.dot(o.axis), rp.dot(lateral)};
+  const double v[2] = {d.dot(o.axis), d.dot(lateral)};
+  const double h[2] = {o.half_length, o.half_width};
+  double t0 = 0.0, t1 = 1.0;
+  for (int i = 0; i < 2; ++i) {
+    if (std::abs(v[i]) < 1e-12) {
+      if (std::abs(s[i]) > h[i]) return 0.0;
+      continue;
+    }
+    double ta = (-h[i] - s[i]) / v[i], tb = (h[i] - s[i]) / v[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return 0.0;
+  }
+  return (t1 - t0) * d.norm();
+}
 
 /// Does the segment p -> q cross the box (Liang-Barsky slab clipping in the box frame)?
 bool SegmentHitsBox(const Occluder& o, const Position& p, const Position& q) {
@@ -272,8 +302,17 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
       }
     }
   }
+  // The ego's own body: checked for every scatterer (the sensors sit on it, so its angular
+  // interval spans up to a half turn and does not fit the azimuth bins).
+  Occluder body;
+  const bool has_body = options_.occlusion && ego.length > 0.0 && ego.width > 0.0;
+  body.a = ego.pose.position;
+  body.axis = UnitVector(ego.pose.yaw);
+  body.half_length = 0.5 * ego.length;
+  body.half_width = 0.5 * ego.width;
   const auto occluded = [&](const Position& q, int owner, const Polar& truth) {
     if (!options_.occlusion) return false;
+    if (has_body && LengthInsideBox(body, s, q) > kEgoBodyMargin) return true;
     const Vector2 dir_local = local_of(q) / truth.range;
     const Position end = q - kOcclusionShrink * (q - s) / truth.range;
     const int bi =
@@ -321,7 +360,9 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
       const Position& a = c[e];
       const Position& b = c[(e + 1) % 4];
       const Vector2 normal(b.y() - a.y(), a.x() - b.x());  // outward for a CCW polygon
-      if (normal.dot(s - 0.5 * (a + b)) <= 0.0) continue;
+      const Vector2 to_sensor = s - 0.5 * (a + b);
+      const double nn = normal.norm() * to_sensor.norm();
+      if (!(nn > 0.0) || normal.dot(to_sensor) <= kMinGrazingSin * nn) continue;
       corner_visible[e] = corner_visible[(e + 1) % 4] = true;
       WalkEdge(a, b, s, p.range_resolution, p.azimuth_resolution,
                [&](const Position& q, double ds, double sin_phi) {
@@ -396,7 +437,7 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
       return static_cast<std::uint64_t>(std::max(0.0, std::floor(v / res)));
     };
     keys[i] = (bin(t.range, p.range_resolution) << (2 * kCellBits)) |
-              (bin(t.azimuth + 0.5 * p.fov, p.azimuth_resolution) << kCellBits) |
+              (model.AzimuthCell(t.azimuth) << kCellBits) |
               bin(t.range_rate - p.min_range_rate, p.range_rate_resolution);
   }
   std::vector<std::size_t> order(scatterers.size());

@@ -1,7 +1,9 @@
 #include "dualgrid/radar_model/sensor_model.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iterator>
 #include <stdexcept>
 
 namespace dualgrid::radar {
@@ -46,6 +48,28 @@ SensorModel::SensorModel(const SensorParams& params) : params_(params) {
       reference_snr_db - params_.reference_rcs_dbsm + 40.0 * std::log10(params_.reference_range);
   loop_gain_linear_ = std::pow(10.0, 0.1 * loop_gain_db_);
   threshold_snr_db_ = 20.0 * std::log10(erfcinv_2pfa_);
+  // Azimuth cell edges outwards from the boresight, each cell as wide as the resolution at its
+  // middle (one step of the midpoint rule), mirrored to the other side.
+  std::vector<double> half = {0.0};
+  while (half.back() < 0.5 * params_.fov) {
+    const double e = half.back();
+    half.push_back(e + params_.AzimuthResolutionAt(e + 0.5 * params_.AzimuthResolutionAt(e)));
+  }
+  azimuth_edges_.clear();
+  for (std::size_t k = half.size(); k-- > 1;) azimuth_edges_.push_back(-half[k]);
+  azimuth_edges_.insert(azimuth_edges_.end(), half.begin(), half.end());
+  const double h = 0.5 * params_.fov;
+  cells_in_view_ = 0.0;
+  for (std::size_t k = 0; k + 1 < azimuth_edges_.size(); ++k) {
+    const double lo = azimuth_edges_[k], hi = azimuth_edges_[k + 1];
+    cells_in_view_ += std::max(0.0, std::min(hi, h) - std::max(lo, -h)) / (hi - lo);
+  }
+}
+
+std::uint64_t SensorModel::AzimuthCell(double azimuth) const {
+  const auto it = std::upper_bound(azimuth_edges_.begin(), azimuth_edges_.end(), azimuth);
+  const auto k = std::distance(azimuth_edges_.begin(), it) - 1;
+  return static_cast<std::uint64_t>(std::clamp<std::ptrdiff_t>(k, 0, AzimuthCells() - 1));
 }
 
 double SensorModel::SnrDb(double rcs_dbsm, double range) const {
@@ -57,23 +81,23 @@ double SensorModel::DetectionProbabilityAt(double snr_linear) const {
 }
 
 double SensorModel::RangeSigma(double snr) const {
-  const double f = params_.range_bias_fraction;
-  return params_.range_resolution * std::sqrt(12.0 / (8.0 * kPi * kPi * snr) + f * f);
+  const double d = params_.range_resolution, a = params_.range_accuracy;
+  return std::sqrt(d * d * 12.0 / (8.0 * kPi * kPi * snr) + a * a);
 }
 
-double SensorModel::AzimuthSigma(double snr) const {
-  const double f = params_.azimuth_bias_fraction;
-  return params_.azimuth_resolution * std::sqrt(1.0 / (1.6 * 1.6 * 2.0 * snr) + f * f);
+double SensorModel::AzimuthSigma(double snr, double azimuth) const {
+  const double d = params_.AzimuthResolutionAt(azimuth), a = params_.AzimuthAccuracyAt(azimuth);
+  return std::sqrt(d * d / (1.6 * 1.6 * 2.0 * snr) + a * a);
 }
 
 double SensorModel::RangeRateSigma(double snr) const {
-  const double f = params_.range_rate_bias_fraction;
-  return params_.range_rate_resolution * std::sqrt(6.0 / (4.0 * kPi * kPi * snr) + f * f);
+  const double d = params_.range_rate_resolution, a = params_.range_rate_accuracy;
+  return std::sqrt(d * d * 6.0 / (4.0 * kPi * kPi * snr) + a * a);
 }
 
 double SensorModel::ResolutionCellCount() const {
   const SensorParams& p = params_;
-  return (p.max_range - p.min_range) / p.range_resolution * (p.fov / p.azimuth_resolution) *
+  return (p.max_range - p.min_range) / p.range_resolution * AzimuthCellsInView() *
          ((p.max_range_rate - p.min_range_rate) / p.range_rate_resolution);
 }
 
@@ -90,7 +114,7 @@ std::optional<Polar> SensorModel::Measure(const Polar& truth, double snr_linear,
   Polar m = truth;
   if (noise) {
     m.range += RangeSigma(snr_linear) * rng.Normal();
-    m.azimuth = WrapAngle(m.azimuth + AzimuthSigma(snr_linear) * rng.Normal());
+    m.azimuth = WrapAngle(m.azimuth + AzimuthSigma(snr_linear, truth.azimuth) * rng.Normal());
     m.range_rate += RangeRateSigma(snr_linear) * rng.Normal();
   }
   if (!InWindow(m)) return std::nullopt;

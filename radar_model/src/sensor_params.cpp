@@ -39,12 +39,28 @@ bool SensorParams::IsValid(std::string* error) const {
       (max_range_rate - min_range_rate) / range_rate_resolution >= kMaxBins)
     return Fail(error,
                 "range_rate_resolution: must be > 0 and give fewer than 2^20 range-rate cells");
-  if (!finite(range_bias_fraction) || range_bias_fraction < 0.0)
-    return Fail(error, "range_bias_fraction: must be >= 0");
-  if (!finite(azimuth_bias_fraction) || azimuth_bias_fraction < 0.0)
-    return Fail(error, "azimuth_bias_fraction: must be >= 0");
-  if (!finite(range_rate_bias_fraction) || range_rate_bias_fraction < 0.0)
-    return Fail(error, "range_rate_bias_fraction: must be >= 0");
+  if (!finite(range_accuracy) || range_accuracy < 0.0)
+    return Fail(error, "range_accuracy: must be >= 0 m");
+  if (!finite(azimuth_accuracy) || azimuth_accuracy < 0.0)
+    return Fail(error, "azimuth_accuracy: must be >= 0");
+  if (!finite(range_rate_accuracy) || range_rate_accuracy < 0.0)
+    return Fail(error, "range_rate_accuracy: must be >= 0 m/s");
+  if (off_boresight_resolution.size() != off_boresight.size() ||
+      off_boresight_accuracy.size() != off_boresight.size())
+    return Fail(error,
+                "off_boresight: off_boresight_deg, off_boresight_resolution and "
+                "off_boresight_accuracy must have the same length");
+  for (std::size_t k = 0; k < off_boresight.size(); ++k) {
+    if (!finite(off_boresight[k]) || off_boresight[k] < 0.0 || off_boresight[k] > kPi ||
+        (k > 0 && off_boresight[k] <= off_boresight[k - 1]))
+      return Fail(error, "off_boresight: angles must increase within [0, 180] deg");
+    if (!finite(off_boresight_resolution[k]) || off_boresight_resolution[k] < 1.0 ||
+        off_boresight_resolution[k] > 100.0)
+      return Fail(error, "off_boresight_resolution: factors must be in [1, 100]");
+    if (!finite(off_boresight_accuracy[k]) || off_boresight_accuracy[k] < 1.0 ||
+        off_boresight_accuracy[k] > 1000.0)
+      return Fail(error, "off_boresight_accuracy: factors must be in [1, 1000]");
+  }
   if (!finite(reference_range) || reference_range <= 0.0)
     return Fail(error, "reference_range: must be > 0 m");
   if (!finite(reference_rcs_dbsm)) return Fail(error, "reference_rcs_dbsm: must be finite");
@@ -57,13 +73,49 @@ bool SensorParams::IsValid(std::string* error) const {
   return true;
 }
 
-SensorParams DefaultShortRangeRadar() {
+namespace {
+
+// Piecewise-linear factor of the off-boresight profile at |az|: 1 before the first point,
+// constant beyond the last.
+double ProfileFactor(const std::vector<double>& at, const std::vector<double>& factor, double az) {
+  const double a = std::abs(az);
+  if (at.empty() || a < at.front()) return 1.0;
+  for (std::size_t k = 1; k < at.size(); ++k) {
+    if (a <= at[k]) {
+      const double t = (a - at[k - 1]) / (at[k] - at[k - 1]);
+      return factor[k - 1] + t * (factor[k] - factor[k - 1]);
+    }
+  }
+  return factor.back();
+}
+
+void MakeClean(SensorParams* p) {
+  p->range_accuracy = 0.05 * p->range_resolution;
+  p->azimuth_accuracy = 0.1 * p->azimuth_resolution;
+  p->range_rate_accuracy = 0.05 * p->range_rate_resolution;
+  p->off_boresight.clear();
+  p->off_boresight_resolution.clear();
+  p->off_boresight_accuracy.clear();
+}
+
+}  // namespace
+
+double SensorParams::AzimuthResolutionAt(double az) const {
+  return azimuth_resolution * ProfileFactor(off_boresight, off_boresight_resolution, az);
+}
+
+double SensorParams::AzimuthAccuracyAt(double az) const {
+  return azimuth_accuracy * ProfileFactor(off_boresight, off_boresight_accuracy, az);
+}
+
+SensorParams DefaultShortRangeRadar(Accuracy accuracy) {
   SensorParams p;  // the struct defaults are the corner radar (sources in docs/radar.md)
   p.name = "short_range";
+  if (accuracy == Accuracy::kClean) MakeClean(&p);
   return p;
 }
 
-SensorParams DefaultLongRangeRadar() {
+SensorParams DefaultLongRangeRadar(Accuracy accuracy) {
   SensorParams p;
   p.name = "long_range";
   // Delphi ESR long-range mode: 20 deg FOV, 1..174 m, -100..+40 m/s, 50 ms.
@@ -78,10 +130,19 @@ SensorParams DefaultLongRangeRadar() {
   p.range_rate_resolution = 0.37 / 3.6;
   p.reference_range = 174.0;
   p.update_period = 0.05;
+  // Accuracy: ARS408-21 far range (distance +-0.40 m, azimuth +-0.1 deg within its +-9 deg: no
+  // off-boresight profile over the 20 deg field of view); range rate: Delphi ESR +-0.12 m/s.
+  p.range_accuracy = 0.40;
+  p.azimuth_accuracy = DegToRad(0.1);
+  p.range_rate_accuracy = 0.12;
+  p.off_boresight.clear();
+  p.off_boresight_resolution.clear();
+  p.off_boresight_accuracy.clear();
+  if (accuracy == Accuracy::kClean) MakeClean(&p);
   return p;
 }
 
-std::vector<SensorParams> DefaultRig(double ego_length, double ego_width) {
+std::vector<SensorParams> DefaultRig(double ego_length, double ego_width, Accuracy accuracy) {
   if (!(ego_length > 0.0) || !(ego_width > 0.0) || !std::isfinite(ego_length) ||
       !std::isfinite(ego_width))
     throw std::invalid_argument("DefaultRig: ego_length and ego_width must be positive, got " +
@@ -97,12 +158,12 @@ std::vector<SensorParams> DefaultRig(double ego_length, double ego_width) {
                             {"rear_right", -x, -y, -135.0}};
   std::vector<SensorParams> rig;
   for (const Corner& c : corners) {
-    SensorParams p = DefaultShortRangeRadar();
+    SensorParams p = DefaultShortRangeRadar(accuracy);
     p.name = c.name;
     p.mount = Pose2{Position(c.x, c.y), DegToRad(c.yaw_deg)};
     rig.push_back(p);
   }
-  SensorParams front = DefaultLongRangeRadar();
+  SensorParams front = DefaultLongRangeRadar(accuracy);
   front.name = "front";
   front.mount = Pose2{Position(0.5 * ego_length, 0.0), 0.0};
   rig.push_back(front);

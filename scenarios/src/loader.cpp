@@ -193,9 +193,9 @@ const Field<SP, double> kSensorDoubles[] = {
     {"range_resolution", &SP::range_resolution},
     {"azimuth_resolution_deg", &SP::azimuth_resolution, true},
     {"range_rate_resolution", &SP::range_rate_resolution},
-    {"range_bias_fraction", &SP::range_bias_fraction},
-    {"azimuth_bias_fraction", &SP::azimuth_bias_fraction},
-    {"range_rate_bias_fraction", &SP::range_rate_bias_fraction},
+    {"range_accuracy", &SP::range_accuracy},
+    {"azimuth_accuracy_deg", &SP::azimuth_accuracy, true},
+    {"range_rate_accuracy", &SP::range_rate_accuracy},
     {"reference_range", &SP::reference_range},
     {"reference_rcs_dbsm", &SP::reference_rcs_dbsm},
     {"reference_pd", &SP::reference_pd},
@@ -235,6 +235,21 @@ void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
     m->Finish();
   }
   ReadFields(r, kSensorDoubles, p);
+  // The off-boresight profile (angles in degrees in the file).
+  if (r.Has("off_boresight_deg")) {
+    r.Read("off_boresight_deg", &p->off_boresight);
+    for (double& a : p->off_boresight) a = DegToRad(a);
+  }
+  r.Read("off_boresight_resolution", &p->off_boresight_resolution);
+  r.Read("off_boresight_accuracy", &p->off_boresight_accuracy);
+}
+
+void WriteSensorProfile(const radar::SensorParams& s, nlohmann::json* j) {
+  std::vector<double> deg;
+  for (double a : s.off_boresight) deg.push_back(RadToDeg(a));
+  (*j)["off_boresight_deg"] = deg;
+  (*j)["off_boresight_resolution"] = s.off_boresight_resolution;
+  (*j)["off_boresight_accuracy"] = s.off_boresight_accuracy;
 }
 
 // Turns "field: message" from an IsValid into a ConfigError under `section`.
@@ -253,8 +268,15 @@ void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
 
 void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* radar) {
   const auto& ego_type = spec.vehicle_types.at(spec.ego.type);
-  radar->sensors = radar::DefaultRig(ego_type.length, ego_type.width);
   auto section = root.Map("sensors");
+  std::string accuracy = "datasheet";
+  if (section) section->Read("accuracy", &accuracy);
+  if (accuracy != "datasheet" && accuracy != "clean")
+    section->Fail("accuracy", "expected 'datasheet' or 'clean', got '" + accuracy + "'");
+  radar->accuracy = accuracy;
+  radar->sensors = radar::DefaultRig(
+      ego_type.length, ego_type.width,
+      accuracy == "clean" ? radar::Accuracy::kClean : radar::Accuracy::kDataSheet);
   if (!section) return;
   std::string rig = "default";
   section->Read("rig", &rig);
@@ -267,7 +289,17 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
     for (const auto& s : radar->sensors) all += (all.empty() ? "" : ", ") + s.name;
     return all;
   };
-  for (auto& [name, r] : section->NamedMaps("overrides")) {
+  auto overrides = section->NamedMaps("overrides");
+  // "all" first (every sensor), then the named sensors.
+  std::stable_partition(overrides.begin(), overrides.end(),
+                        [](const auto& o) { return o.first == "all"; });
+  for (auto& [name, r] : overrides) {
+    if (name == "all") {
+      // Every sensor reads the same map; each read marks its keys as known.
+      for (auto& sensor : radar->sensors) ReadSensorFields(r, &sensor);
+      r.Finish();
+      continue;
+    }
     const std::string& sensor = name;  // structured bindings cannot be captured before C++20
     auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
                            [&](const radar::SensorParams& s) { return s.name == sensor; });
@@ -529,6 +561,7 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   j["seed"] = c.sim.seed;
   j["duration_s"] = c.sim.duration;
   j["step_length_s"] = c.sim.step_length;
+  j["sensors"]["accuracy"] = c.radar.accuracy;
   j["sensors"]["noise"] = c.radar.options.noise;
   j["sensors"]["false_alarms"] = c.radar.options.false_alarms;
   j["sensors"]["occlusion"] = c.radar.options.occlusion;
@@ -539,6 +572,7 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
                            {"y", s.mount.position.y()},
                            {"yaw_deg", RadToDeg(s.mount.yaw)}}}};
     WriteFields(kSensorDoubles, s, &sj);
+    WriteSensorProfile(s, &sj);
     j["sensors"]["rig"].push_back(sj);
   }
   WriteFields(kFilterDoubles, c.filter, &j["filter"]);

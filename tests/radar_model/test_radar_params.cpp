@@ -43,6 +43,15 @@ TEST_CASE("DefaultRig rejects non-positive ego dimensions", "[radar]") {
   CHECK_THROWS_AS(DefaultRig(4.5, 0.0), std::invalid_argument);
 }
 
+namespace {
+void Profile(SensorParams& p, std::vector<double> at, std::vector<double> resolution,
+             std::vector<double> accuracy) {
+  p.off_boresight = std::move(at);
+  p.off_boresight_resolution = std::move(resolution);
+  p.off_boresight_accuracy = std::move(accuracy);
+}
+}  // namespace
+
 TEST_CASE("Invalid sensor parameters are rejected naming the field", "[radar][params]") {
   using Mutate = std::function<void(SensorParams&)>;
   const auto [field, mutate] = GENERATE(table<std::string, Mutate>({
@@ -58,9 +67,14 @@ TEST_CASE("Invalid sensor parameters are rejected naming the field", "[radar][pa
       {"range_resolution", [](SensorParams& p) { p.range_resolution = 1e-6; }},
       {"azimuth_resolution", [](SensorParams& p) { p.azimuth_resolution = -0.1; }},
       {"range_rate_resolution", [](SensorParams& p) { p.range_rate_resolution = 0.0; }},
-      {"range_bias_fraction", [](SensorParams& p) { p.range_bias_fraction = -0.1; }},
-      {"azimuth_bias_fraction", [](SensorParams& p) { p.azimuth_bias_fraction = -0.1; }},
-      {"range_rate_bias_fraction", [](SensorParams& p) { p.range_rate_bias_fraction = -1; }},
+      {"range_accuracy", [](SensorParams& p) { p.range_accuracy = -0.1; }},
+      {"azimuth_accuracy", [](SensorParams& p) { p.azimuth_accuracy = -0.1; }},
+      {"range_rate_accuracy", [](SensorParams& p) { p.range_rate_accuracy = -1; }},
+      {"off_boresight", [](SensorParams& p) { Profile(p, {0, 1}, {1, 2}, {1}); }},
+      {"off_boresight", [](SensorParams& p) { Profile(p, {0.5, 0.5}, {1, 2}, {1, 2}); }},
+      {"off_boresight", [](SensorParams& p) { Profile(p, {0, 4}, {1, 2}, {1, 2}); }},
+      {"off_boresight_resolution", [](SensorParams& p) { Profile(p, {0, 1}, {0.5, 2}, {1, 2}); }},
+      {"off_boresight_accuracy", [](SensorParams& p) { Profile(p, {0, 1}, {1, 2}, {1, 1e9}); }},
       {"reference_range", [](SensorParams& p) { p.reference_range = 0.0; }},
       {"reference_rcs_dbsm", [](SensorParams& p) { p.reference_rcs_dbsm = INFINITY; }},
       {"reference_pd", [](SensorParams& p) { p.reference_pd = 1.0; }},

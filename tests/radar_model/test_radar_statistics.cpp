@@ -81,12 +81,14 @@ TEST_CASE("Measurement noise matches the resolution/SNR formulas", "[radar][stat
     range_rate.Add(m->range_rate - truth.range_rate);
   }
   REQUIRE(range.n > 1000);
-  const double sr = p.range_resolution *
-                    std::sqrt(12.0 / (8.0 * kPi * kPi * snr) + std::pow(p.range_bias_fraction, 2));
-  const double sa = p.azimuth_resolution *
-                    std::sqrt(1.0 / (1.6 * 1.6 * 2.0 * snr) + std::pow(p.azimuth_bias_fraction, 2));
-  const double srr = p.range_rate_resolution * std::sqrt(6.0 / (4.0 * kPi * kPi * snr) +
-                                                         std::pow(p.range_rate_bias_fraction, 2));
+  // At boresight (truth.azimuth = 0 here) the profile factors are 1.
+  const double sr = std::sqrt(std::pow(p.range_resolution, 2) * 12.0 / (8.0 * kPi * kPi * snr) +
+                              std::pow(p.range_accuracy, 2));
+  const double sa = std::sqrt(std::pow(p.azimuth_resolution, 2) / (1.6 * 1.6 * 2.0 * snr) +
+                              std::pow(p.azimuth_accuracy, 2));
+  const double srr =
+      std::sqrt(std::pow(p.range_rate_resolution, 2) * 6.0 / (4.0 * kPi * kPi * snr) +
+                std::pow(p.range_rate_accuracy, 2));
   CHECK(model.RangeSigma(snr) == Approx(sr));
   CHECK(model.AzimuthSigma(snr) == Approx(sa));
   CHECK(model.RangeRateSigma(snr) == Approx(srr));
@@ -125,8 +127,8 @@ TEST_CASE("A point-like target is detected at the ROC rate with the formula nois
   const SensorModel sensor(p);
   // Centre of a range cell and of an azimuth cell, static target seen from a static sensor.
   const double range = (std::floor(40.0 / p.range_resolution) + 0.5) * p.range_resolution;
-  const double az =
-      -0.5 * p.fov + (std::floor(0.5 * p.fov / p.azimuth_resolution) + 0.5) * p.azimuth_resolution;
+  // The first azimuth cell right of the boresight: [0, resolution at its middle).
+  const double az = 0.5 * p.AzimuthResolutionAt(0.5 * p.azimuth_resolution);
   const double rcs_dbsm = snr_db - sensor.SnrDb(0.0, range);
   Scene scene;
   scene.targets.push_back(
@@ -169,8 +171,18 @@ TEST_CASE("False-alarm count matches cells times rate", "[radar][statistics]") {
   SensorParams q = p;
   q.false_alarm_rate = pfa;
   const SensorModel sensor(q);
+  // Azimuth cells in view: the integral of 1 / resolution(az) over the field of view (the
+  // midpoint rule of the cell edges agrees to < 1 %), fov / resolution without a profile.
+  double azimuth_cells = 0.0;
+  const int steps = 100000;
+  for (int i = 0; i < steps; ++i) {
+    const double az = -0.5 * q.fov + (i + 0.5) * q.fov / steps;
+    azimuth_cells += q.fov / steps / q.AzimuthResolutionAt(az);
+  }
+  if (q.off_boresight.empty()) CHECK(azimuth_cells == Approx(q.fov / q.azimuth_resolution));
+  CHECK(sensor.AzimuthCellsInView() == Approx(azimuth_cells).epsilon(0.01));
   const double cells = (q.max_range - q.min_range) / q.range_resolution *
-                       (q.fov / q.azimuth_resolution) *
+                       sensor.AzimuthCellsInView() *
                        ((q.max_range_rate - q.min_range_rate) / q.range_rate_resolution);
   CHECK(sensor.ResolutionCellCount() == Approx(cells));
   const double lambda = cells * pfa;
@@ -195,4 +207,41 @@ TEST_CASE("False-alarm count matches cells times rate", "[radar][statistics]") {
   // Switched off: none.
   const RadarModel quiet({q}, ModelOptions{true, false, true}, 99);
   CHECK(quiet.ScanSensor(0, EgoMotion{}, Scene{}, 1).empty());
+}
+
+TEST_CASE("Azimuth resolution and accuracy follow the data-sheet profile off boresight",
+          "[radar][statistics]") {
+  // ARS408-21 near range: resolution 3.2 / 4.5 / 12.3 deg, accuracy 0.3 / 1 / 5 deg at
+  // 0 / 45 / 60 deg; linear in between, constant beyond 60 deg, symmetric.
+  const SensorParams p = DefaultShortRangeRadar();
+  const auto deg = [](double d) { return DegToRad(d); };
+  CHECK(p.AzimuthResolutionAt(0.0) == Approx(deg(3.2)));
+  CHECK(p.AzimuthResolutionAt(deg(45)) == Approx(deg(4.5)));
+  CHECK(p.AzimuthResolutionAt(deg(-60)) == Approx(deg(12.3)));
+  CHECK(p.AzimuthResolutionAt(deg(75)) == Approx(deg(12.3)));
+  CHECK(p.AzimuthResolutionAt(deg(30)) == Approx(deg(3.2 + 30.0 / 45.0 * 1.3)));
+  CHECK(p.AzimuthAccuracyAt(deg(45)) == Approx(deg(1.0)));
+  CHECK(p.AzimuthAccuracyAt(deg(60)) == Approx(deg(5.0)));
+  CHECK(p.AzimuthAccuracyAt(deg(-52.5)) == Approx(deg(3.0)));
+  // Measured noise follows it: 20,000 noisy azimuths at high SNR at 52.5 deg off boresight.
+  const SensorModel model(p);
+  const double snr = DbToLinear(40.0);
+  const Polar truth{40.0, deg(52.5), 0.0};
+  Moments azimuth;
+  for (int i = 0; i < 20000; ++i) {
+    CounterRng rng(5, RngPurpose::kTest, 52, i);
+    if (const std::optional<Polar> m = model.Measure(truth, snr, true, rng))
+      azimuth.Add(m->azimuth - truth.azimuth);
+  }
+  CHECK(StdMatches(azimuth, model.AzimuthSigma(snr, truth.azimuth)));
+  CHECK(model.AzimuthSigma(snr, truth.azimuth) > 2.5 * model.AzimuthSigma(snr, 0.0));
+  // Cells widen with the resolution: fewer cells per degree off boresight.
+  const auto cell = [&](double d) { return static_cast<double>(model.AzimuthCell(deg(d))); };
+  CHECK(cell(3.3) - cell(0.1) == 1.0);
+  CHECK(cell(70.0) - cell(55.0) <= 2.0);
+  CHECK(model.AzimuthCell(deg(-0.1)) + 1 == model.AzimuthCell(deg(0.1)));
+  // The clean setting: no profile, MATLAB's bias fractions as floors.
+  const SensorParams clean = DefaultShortRangeRadar(Accuracy::kClean);
+  CHECK(clean.AzimuthResolutionAt(deg(60)) == Approx(clean.azimuth_resolution));
+  CHECK(clean.range_rate_accuracy == Approx(0.05 * clean.range_rate_resolution));
 }

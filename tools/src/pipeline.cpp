@@ -72,7 +72,7 @@ radar::Scene Pipeline::BuildScene() {
 bool Pipeline::Step() {
   if (!simulation_.Step()) return false;
   const sim::Frame& f = frame();
-  ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate};
+  ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
   // The first filter cycle (the ego may depart late) predicts over one step.
   const double dt = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
   last_time_ = f.time;

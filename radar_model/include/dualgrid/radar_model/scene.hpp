@@ -36,6 +36,10 @@ struct EgoMotion {
   Pose2 pose{};
   Velocity velocity = Velocity::Zero();
   double yaw_rate = 0.0;
+  /// The ego's own body, a box centred on pose [m]: it hides what lies behind it from sensors
+  /// mounted on it (a line of sight running more than 5 cm inside it is blocked). 0: no body.
+  double length = 0.0;
+  double width = 0.0;
 };
 
 /// One radar detection.

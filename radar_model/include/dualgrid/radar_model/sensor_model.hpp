@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/radar_model/sensor_params.hpp"
@@ -42,12 +43,21 @@ class SensorModel {
     return loop_gain_linear_ * rcs_m2 / (r2 * r2);
   }
   double DetectionProbabilityAt(double snr_linear) const;
-  /// Standard deviations at a linear SNR:
-  /// sigma_R = dR sqrt(12 / (8 pi^2 SNR) + fR^2), sigma_az = dAz sqrt(1 / (1.6^2 2 SNR) + fAz^2),
-  /// sigma_rr = dRR sqrt(6 / ((2 pi)^2 SNR) + fRR^2).
+  /// Standard deviations at a linear SNR: the SNR term of MATLAB's model plus the accuracy
+  /// floor a in quadrature, sigma_R = sqrt(dR^2 12 / (8 pi^2 SNR) + a_R^2),
+  /// sigma_az = sqrt(dAz(az)^2 / (1.6^2 2 SNR) + a_az(az)^2) with the off-boresight profile at
+  /// azimuth az [rad], sigma_rr = sqrt(dRR^2 6 / ((2 pi)^2 SNR) + a_rr^2).
   double RangeSigma(double snr_linear) const;
-  double AzimuthSigma(double snr_linear) const;
+  double AzimuthSigma(double snr_linear, double azimuth = 0.0) const;
   double RangeRateSigma(double snr_linear) const;
+  /// Azimuth resolution cell of `azimuth` [rad]: cells are azimuth_resolution wide at boresight
+  /// and widen off boresight with the profile; one cell edge lies on the boresight.
+  std::uint64_t AzimuthCell(double azimuth) const;
+  /// Azimuth cells touching the field of view (the outermost ones reach beyond it).
+  int AzimuthCells() const { return static_cast<int>(azimuth_edges_.size()) - 1; }
+  /// Azimuth cells inside the field of view, the outermost counted by the share of them inside
+  /// it (fov / azimuth_resolution without an off-boresight profile): the false-alarm count.
+  double AzimuthCellsInView() const { return cells_in_view_; }
   /// Number of (range, azimuth, range-rate) resolution cells in the sensor's window.
   double ResolutionCellCount() const;
   /// Expected false alarms per scan: cells times false_alarm_rate.
@@ -69,6 +79,8 @@ class SensorModel {
   double loop_gain_db_ = 0.0;
   double loop_gain_linear_ = 0.0;
   double threshold_snr_db_ = 0.0;
+  std::vector<double> azimuth_edges_;  // increasing, from <= -fov/2 to >= fov/2 [rad]
+  double cells_in_view_ = 0.0;
 };
 
 }  // namespace dualgrid::radar

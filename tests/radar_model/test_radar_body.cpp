@@ -1,0 +1,173 @@
+// The ego's own body hides what lies behind it from its corner radars, and a face seen exactly
+// edge-on returns nothing (docs/radar.md, steps 2 and 5).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "dualgrid/radar_model/radar_model.hpp"
+
+using namespace dualgrid;
+using namespace dualgrid::radar;
+
+namespace {
+
+constexpr double kEgoLength = 4.5, kEgoWidth = 1.8;
+
+int SensorIndex(const std::vector<SensorParams>& rig, const std::string& name) {
+  for (std::size_t i = 0; i < rig.size(); ++i)
+    if (rig[i].name == name) return static_cast<int>(i);
+  FAIL("no sensor " << name);
+  return -1;
+}
+
+// Length of the part of segment a -> b inside the axis-aligned box |x| <= hl, |y| <= hw, by
+// walking it in 1 mm steps (independent of the model's slab clipping).
+double InsideLength(const Position& a, const Position& b, double hl, double hw) {
+  const double len = (b - a).norm();
+  const int steps = static_cast<int>(len / 1e-3) + 1;
+  int inside = 0;
+  for (int i = 0; i < steps; ++i) {
+    const Position p = a + (i + 0.5) / steps * (b - a);
+    inside += std::abs(p.x()) < hl && std::abs(p.y()) < hw;
+  }
+  return inside * len / steps;
+}
+
+}  // namespace
+
+TEST_CASE("the ego's body hides targets from the corner radars behind it", "[radar][body]") {
+  // A truck in the left lane ahead: front_right (at the front right wheel, looking -45 deg) sees
+  // it only through the ego's front (its line of sight runs ~1 m inside the body).
+  const auto rig = DefaultRig(kEgoLength, kEgoWidth);
+  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  Scene scene;
+  scene.targets.push_back({1, OrientedBox{{10.0, 3.5}, 0.0, 12.0, 2.5}, {25, 0}, 0.0, 20.0});
+  EgoMotion ghost;  // no body: the old model
+  ghost.velocity = {25, 0};
+  EgoMotion ego = ghost;
+  ego.length = kEgoLength;
+  ego.width = kEgoWidth;
+  const int fr = SensorIndex(rig, "front_right"), fl = SensorIndex(rig, "front_left");
+  REQUIRE(!model.VisibleScatterers(fr, ghost, scene).empty());  // not vacuous
+  CHECK(model.VisibleScatterers(fr, ego, scene).empty());
+  // The front_left radar, on the truck's side, still sees it.
+  CHECK(!model.VisibleScatterers(fl, ego, scene).empty());
+  // Occlusion off: the body is transparent too (ModelOptions::occlusion switches every occluder).
+  const RadarModel open(rig, ModelOptions{false, false, false}, 1);
+  CHECK(!open.VisibleScatterers(fr, ego, scene).empty());
+}
+
+TEST_CASE("no visible scatterer's line of sight runs through the ego's body",
+          "[radar][body][property]") {
+  // Small targets all around the ego (rings of 3-30 m): every scatterer any sensor reports has a
+  // line of sight at most 5 cm (the model's margin) + 2 mm (the 1 mm walk) inside the body.
+  const auto rig = DefaultRig(kEgoLength, kEgoWidth);
+  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  EgoMotion ego;
+  ego.length = kEgoLength;
+  ego.width = kEgoWidth;
+  Scene scene;
+  int id = 0;
+  for (double r : {3.0, 6.0, 12.0, 30.0})
+    for (int k = 0; k < 36; ++k)
+      scene.targets.push_back(
+          {id++, OrientedBox{r * UnitVector(k * kPi / 18.0), 0.3, 0.5, 0.5}, {0, 0}, 0.0, 20.0});
+  std::size_t seen = 0;
+  double worst = 0.0;
+  for (int s = 0; s < static_cast<int>(rig.size()); ++s) {
+    const Position origin = SensorWorldPose(rig[s], ego.pose).position;
+    for (const Scatterer& sc : model.VisibleScatterers(s, ego, scene)) {
+      ++seen;
+      worst = std::max(worst, InsideLength(origin, sc.position, 0.5 * kEgoLength, 0.5 * kEgoWidth));
+    }
+  }
+  // Not vacuous: without the body the same sensors report more (those seen through it).
+  EgoMotion ghost;
+  std::size_t seen_through = 0;
+  for (int s = 0; s < static_cast<int>(rig.size()); ++s)
+    seen_through += model.VisibleScatterers(s, ghost, scene).size();
+  INFO("scatterers " << seen << " (" << seen_through << " without the body), deepest line of "
+                     << "sight inside the body " << worst << " m");
+  CHECK(seen > 100);
+  CHECK(seen_through > seen);
+  CHECK(worst <= 0.052);
+}
+
+TEST_CASE("a flank seen exactly edge-on hides its far corner", "[radar][body]") {
+  // A car ahead in the ego's lane, as wide as the ego: its right flank lies on the line y = -0.9
+  // through the front_right radar. Only its rear face (x = 17.75) faces the sensor; the flank's
+  // far corner (x = 22.25) is behind the near one and must not be reported (it was: 4.5 m behind
+  // the visible face, simple road seed 1). No ego body here: it would hide this line of sight
+  // (along its own flank) as well, and the test is of the edge-on rule alone.
+  const auto rig = DefaultRig(kEgoLength, kEgoWidth);
+  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  const EgoMotion ego;
+  // The flank offset by +-1 um from the sensors' lines (as rounding puts it in a simulation):
+  // edge-on in effect, with the sensor in front of it by a hair on one side.
+  Scene scene;
+  for (const double offset : {1e-6, -1e-6, 0.0}) {
+    scene.targets = {{1, OrientedBox{{20.0, offset}, 0.0, 4.5, 1.8}, {20, 0}, 0.0, 10.0}};
+    for (const char* name : {"front_right", "front_left"}) {
+      const auto visible = model.VisibleScatterers(SensorIndex(rig, name), ego, scene);
+      REQUIRE(!visible.empty());
+      for (const Scatterer& sc : visible) {
+        INFO(name << " offset " << offset << ": scatterer at " << sc.position.transpose());
+        CHECK(sc.position.x() <= 17.75 + 1e-9);
+      }
+    }
+  }
+  // A flank turned 2 deg towards the sensor (clockwise) is visible again (the tolerance is
+  // 0.5 deg).
+  scene.targets[0].box.yaw = DegToRad(-2.0);
+  bool flank = false;
+  for (const Scatterer& sc : model.VisibleScatterers(SensorIndex(rig, "front_right"), ego, scene))
+    flank = flank || sc.position.x() > 18.5;
+  CHECK(flank);
+}
+
+namespace {
+
+// Share of scans with at least one detection of a 10 dBsm car (4.5 m x 1.8 m) seen from behind,
+// its centre at `range` along sensor `name`'s boresight; noise on, no clutter.
+double CarDetectionRate(const std::string& name, double range, int scans) {
+  const auto rig = DefaultRig(kEgoLength, kEgoWidth);
+  const RadarModel model(rig, ModelOptions{true, false, true}, 3);
+  const int s = SensorIndex(rig, name);
+  EgoMotion ego;
+  ego.length = kEgoLength;
+  ego.width = kEgoWidth;
+  const Pose2 sensor = SensorWorldPose(rig[s], ego.pose);
+  Scene scene;
+  scene.targets.push_back(
+      {1, OrientedBox{sensor.position + range * UnitVector(sensor.yaw), sensor.yaw, 4.5, 1.8},
+       Velocity::Zero(), 0.0, 10.0});
+  int hit = 0;
+  for (int k = 0; k < scans; ++k) {
+    bool any = false;
+    for (const Detection& d : model.ScanSensor(s, ego, scene, static_cast<std::uint64_t>(k)))
+      any = any || d.source_id == 1;
+    hit += any;
+  }
+  return static_cast<double>(hit) / scans;
+}
+
+}  // namespace
+
+TEST_CASE("a car at the data-sheet range is detected in the documented share of scans",
+          "[radar][detection]") {
+  // docs/radar.md ("Detection range"): reference_pd = 0.9 is the probability for a point
+  // scatterer of reference_rcs_dbsm (10 dBsm) at reference_range. A car's 10 dBsm are spread
+  // over its visible corners and face samples, several resolution cells, each weaker than the
+  // point: the share of scans with >= 1 detection of the car at the data-sheet range is lower.
+  // Documented (measured with this test, 2,000 scans each): corner radar at 77.5 m 0.78, front
+  // radar at 167 m 0.77; the band is 5 binomial standard errors, 5 sqrt(p (1 - p) / n) = 0.047.
+  const int n = 2000;
+  const double corner = CarDetectionRate("front_left", 77.5, n);
+  const double front = CarDetectionRate("front", 167.0, n);
+  INFO("P(>= 1 detection per scan): corner at 77.5 m " << corner << ", front at 167 m " << front);
+  CHECK(std::abs(corner - 0.78) < 5.0 * std::sqrt(0.78 * 0.22 / n));
+  CHECK(std::abs(front - 0.77) < 5.0 * std::sqrt(0.77 * 0.23 / n));
+  // Closer in, the car is detected (almost) every scan: the data-sheet range is where it fades.
+  CHECK(CarDetectionRate("front_left", 40.0, 500) > 0.98);
+}
