@@ -290,16 +290,15 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
     return all;
   };
   auto overrides = section->NamedMaps("overrides");
-  // "all" first (every sensor), then the named sensors.
-  std::stable_partition(overrides.begin(), overrides.end(),
-                        [](const auto& o) { return o.first == "all"; });
+  // "all" first (every sensor), then the named sensors. (No reordering of the readers: assigning
+  // a YAML::Node assigns the node it refers to.)
   for (auto& [name, r] : overrides) {
-    if (name == "all") {
-      // Every sensor reads the same map; each read marks its keys as known.
-      for (auto& sensor : radar->sensors) ReadSensorFields(r, &sensor);
-      r.Finish();
-      continue;
-    }
+    if (name != "all") continue;
+    for (auto& sensor : radar->sensors) ReadSensorFields(r, &sensor);
+    r.Finish();
+  }
+  for (auto& [name, r] : overrides) {
+    if (name == "all") continue;
     const std::string& sensor = name;  // structured bindings cannot be captured before C++20
     auto it = std::find_if(radar->sensors.begin(), radar->sensors.end(),
                            [&](const radar::SensorParams& s) { return s.name == sensor; });

@@ -221,3 +221,34 @@ TEST_CASE("--set overrides are applied to the document before it is read", "[loa
   CHECK_THROWS_AS(LoadScenario(path, {scenario::ParseOverride("traffic.vehicles.5.speed=1")}),
                   ConfigError);
 }
+
+TEST_CASE("sensors.accuracy and sensors.overrides.all", "[loader][sensors]") {
+  const auto clean = LoadScenario(Write(
+      "clean.yaml",
+      std::string(kValid) + "sensors:\n  accuracy: clean\n  overrides:\n"
+                            "    all: {range_rate_accuracy: 0.3}\n"
+                            "    front: {range_rate_accuracy: 0.05, off_boresight_deg: [0, 5],\n"
+                            "            off_boresight_resolution: [1, 2],\n"
+                            "            off_boresight_accuracy: [1, 3]}\n"));
+  CHECK(clean.radar.accuracy == "clean");
+  for (const auto& s : clean.radar.sensors) {
+    INFO(s.name);
+    // The named override wins over "all", whatever their order in the file.
+    CHECK(s.range_rate_accuracy == (s.name == "front" ? 0.05 : 0.3));
+    if (s.name != "front") CHECK(s.off_boresight.empty());  // clean: no profile
+    CHECK(s.azimuth_accuracy == Approx(0.1 * s.azimuth_resolution));
+  }
+  const auto& front = clean.radar.sensors.back();
+  REQUIRE(front.name == "front");
+  CHECK(front.AzimuthResolutionAt(DegToRad(5.0)) == Approx(2.0 * front.azimuth_resolution));
+  const nlohmann::json j = ConfigToJson(clean);
+  CHECK(j.at("sensors").at("accuracy") == "clean");
+  CHECK(j.at("sensors").at("rig").back().at("off_boresight_deg").at(1) == Approx(5.0));
+  // Data sheet by default; bad values name the key.
+  CHECK(LoadScenario(Write("ds.yaml", kValid)).radar.accuracy == "datasheet");
+  CHECK(ErrorOf(std::string(kValid) + "sensors: {accuracy: perfect}\n")
+            .find("sensors.accuracy") != std::string::npos);
+  CHECK(ErrorOf(std::string(kValid) +
+                "sensors: {overrides: {all: {off_boresight_deg: [0, 10]}}}\n")
+            .find("off_boresight") != std::string::npos);
+}
