@@ -81,8 +81,7 @@ TEST_CASE("A valid scenario loads with defaults filled in", "[loader]") {
 
 TEST_CASE("The shipped scenarios load", "[loader]") {
   const std::string name = GENERATE("scenarios/highway.yaml", "scenarios/simple_road.yaml",
-                                    "scenarios/ablation/highway_noclutter.yaml",
-                                    "scenarios/ablation/simple_road_noclutter.yaml");
+                                    "scenarios/soak.yaml");
   const auto c = LoadScenario(name);
   CHECK(c.sim.duration > 0);
   CHECK_FALSE(c.sim.vehicles.empty());
