@@ -79,7 +79,21 @@ struct TangentialOptions {
   bool quiet = false;
 };
 
+/// `dualgrid regress`.
+struct RegressOptions {
+  std::filesystem::path suite;
+  std::filesystem::path out = "run/regress";
+  std::filesystem::path network_dir;
+  std::vector<std::string> sets;  ///< --set overrides applied to every case
+  std::filesystem::path record;   ///< --record: write the suite with measured bands here
+  bool require_digests = false;   ///< a changed digest fails the suite
+  int jobs = 0;                   ///< seed runs at a time; 0: one per core
+  bool quiet = false;
+  std::string executable;
+};
+
 int RunSim(const SimOptions& options);
+int RunRegress(const RegressOptions& options);
 int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);
 int RunExperiment(const ExperimentOptions& options);

@@ -21,7 +21,8 @@ using namespace dualgrid::tools;
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (SUMO error, an output not written); 2 bad input "
     "(command line, scenario or network file; nothing simulated); 3 experiment: some seed runs "
-    "failed (the others are aggregated); 130/143 stopped by SIGINT/SIGTERM (results of the "
+    "failed (the others are aggregated), regress: a case did not run; regress: 1 a check failed; "
+    "130/143 stopped by SIGINT/SIGTERM (results of the "
     "simulated part written, marked incomplete). Details: docs/cli.md.";
 
 // An option whose default is shown in --help.
@@ -202,6 +203,35 @@ int main(int argc, char** argv) {
       ->check(NonEmptyPath());
   tangential->add_flag("--quiet,-q", tan.quiet, "No summary");
 
+  RegressOptions reg;
+  reg.network_dir = network_dir;
+  auto* regress = app.add_subcommand(
+      "regress",
+      "Run a regression suite (cases = scenario + overrides + seeds, with bands and orderings on "
+      "the metrics) and report pass/fail; exit 0 all pass, 1 a check failed, 2 bad suite, 3 a "
+      "case did not run (docs/regression.md)");
+  regress->add_option("suite", reg.suite, "Suite file (e.g. tests/regression/suite.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  Opt(regress, "--out,-o", &reg.out, "Folder for the case runs and the reports")
+      ->check(NonEmptyPath());
+  regress
+      ->add_option("--record", reg.record,
+                   "Also write the suite with bands recorded from this run (mean ± max(3 CI, "
+                   "floor)) and the digests to this file")
+      ->check(NonEmptyPath());
+  regress->add_flag("--require-digests", reg.require_digests,
+                    "A changed digest (same seed, different outputs) fails the suite");
+  regress->add_option("--set", reg.sets, "Override a scenario key in every case, KEY=VALUE")
+      ->check(OverrideSpec());
+  regress
+      ->add_option("--jobs,-j", reg.jobs,
+                   "Seed runs at a time (default: one per core, each with one OpenMP thread)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
+  Opt(regress, "--network-dir", &reg.network_dir, "Folder of the built networks")
+      ->check(CLI::ExistingDirectory);
+  regress->add_flag("--quiet,-q", reg.quiet, "No progress output");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -211,6 +241,10 @@ int main(int argc, char** argv) {
   }
   try {
     if (sim->parsed()) return RunSim(sim_options);
+    if (regress->parsed()) {
+      reg.executable = SelfPath(argv[0]);
+      return RunRegress(reg);
+    }
     if (tangential->parsed()) return RunTangential(tan);
     if (snapshot->parsed()) return RunSnapshot(snap);
     if (run->parsed()) {

@@ -1,0 +1,318 @@
+// `dualgrid regress SUITE.yaml`: runs each case of a regression suite as an experiment, checks
+// its bands and orderings, and reports (table, JSON, JUnit XML). docs/regression.md.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "dualgrid/scenario/suite.hpp"
+#include "exit_codes.hpp"
+#include "output.hpp"
+#include "signals.hpp"
+
+namespace dualgrid::tools {
+
+namespace {
+
+// Files whose digests make a case's determinism fingerprint: what it measured, not how long it
+// took (summary.json) or where (config.json holds paths).
+constexpr const char* kDigestFiles[] = {"clusters.csv", "objects.csv", "table.csv"};
+
+nlohmann::json ReadJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
+  }
+}
+
+// mode.metric -> value, from an experiment's table.json.
+std::map<std::string, eval::MetricValue> ReadTable(const std::filesystem::path& table) {
+  std::map<std::string, eval::MetricValue> out;
+  const nlohmann::json doc = ReadJson(table);  // (a temporary would die before the loop)
+  for (const auto& m : doc.at("metrics")) {
+    for (const auto& [mode, v] : m.at("values").items()) {
+      if (!v.contains("mean") || v.at("mean").is_null()) continue;  // undefined in this run
+      eval::MetricValue mv;
+      mv.mean = v.at("mean").get<double>();
+      if (v.contains("ci95_half_width") && !v.at("ci95_half_width").is_null())
+        mv.half_width = v.at("ci95_half_width").get<double>();
+      mv.n = v.value("n", 0);
+      out[mode + "." + m.at("key").get<std::string>()] = mv;
+    }
+  }
+  return out;
+}
+
+// FNV-1a 64 over "file=digest;" of the fingerprint files of the first seed's run folder.
+std::string CaseDigest(const std::filesystem::path& seed_dir) {
+  const nlohmann::json summary = ReadJson(seed_dir / "summary.json");
+  const nlohmann::json& digests = summary.at("digests");
+  std::uint64_t h = 1469598103934665603ull;
+  for (const char* f : kDigestFiles) {
+    const std::string part = std::string(f) + "=" + digests.value(f, std::string("missing")) + ";";
+    for (unsigned char c : part) {
+      h ^= c;
+      h *= 1099511628211ull;
+    }
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::string XmlEscape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        o += "&amp;";
+        break;
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o += c;
+    }
+  }
+  return o;
+}
+
+struct CaseResult {
+  std::string name;
+  bool ran = false;   // the experiment finished with every seed
+  std::string error;  // why not
+  double wall_s = 0.0;
+  std::string digest;         // "" when it did not run
+  std::string digest_status;  // "same", "changed", "not recorded", "—"
+};
+
+}  // namespace
+
+int RunRegress(const RegressOptions& o) {
+  scenario::RegressionSuite suite = scenario::LoadSuite(o.suite);
+  // Command-line overrides apply to every case, after its own; checked before anything runs.
+  for (auto& c : suite.cases) {
+    c.sets.insert(c.sets.end(), o.sets.begin(), o.sets.end());
+    std::vector<scenario::Override> overrides;
+    for (const std::string& s : c.sets) overrides.push_back(scenario::ParseOverride(s));
+    try {
+      scenario::LoadScenario(c.scenario, overrides);
+    } catch (const scenario::ConfigError& e) {
+      throw scenario::ConfigError(o.suite.string() + ": case '" + c.name +
+                                  "' with --set: " + e.what());
+    }
+  }
+  PrepareOutputFolder(o.out);
+  std::vector<CaseResult> results;
+  eval::Measured measured;
+  for (std::size_t i = 0; i < suite.cases.size() && !StopSignal(); ++i) {
+    const auto& c = suite.cases[i];
+    CaseResult r;
+    r.name = c.name;
+    if (!o.quiet)
+      std::cerr << "regress: case " << i + 1 << "/" << suite.cases.size() << " " << c.name << " ("
+                << c.seeds << " seeds)\n";
+    const auto t0 = std::chrono::steady_clock::now();
+    ExperimentOptions e;
+    e.run.run.scenario = c.scenario;
+    e.run.run.out = o.out / c.name;
+    e.run.run.network_dir = o.network_dir;
+    e.run.run.sets = c.sets;
+    e.run.run.duration = c.duration;
+    e.run.run.quiet = true;
+    e.run.modes = c.modes;
+    e.run.figures = false;
+    e.seeds = c.seeds;
+    e.first_seed = c.first_seed;
+    e.jobs = o.jobs;
+    e.executable = o.executable;
+    e.run.threads = (o.jobs > 0 ? o.jobs : 2) > 1 ? 1 : 0;
+    try {
+      const int code = RunExperiment(e);
+      r.ran = code == kExitOk;
+      if (!r.ran) r.error = "experiment exited " + std::to_string(code) + " (see its folder)";
+    } catch (const std::exception& ex) {
+      r.error = ex.what();
+    }
+    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (r.ran) {
+      try {
+        measured[c.name] = ReadTable(e.run.run.out / "table.json");
+        r.digest = CaseDigest(e.run.run.out / "seeds" / ("seed_" + std::to_string(c.first_seed)));
+        r.digest_status = c.digest.empty()       ? "not recorded"
+                          : c.digest == r.digest ? "same"
+                                                 : "changed";
+      } catch (const std::exception& ex) {
+        r.ran = false;
+        r.error = ex.what();
+      }
+    }
+    if (!r.ran) r.digest_status = "—";
+    if (!o.quiet)
+      std::cerr << "regress: case " << c.name << (r.ran ? " done" : " FAILED: " + r.error) << " in "
+                << static_cast<int>(r.wall_s) << " s\n";
+    results.push_back(r);
+  }
+  const bool stopped = StopSignal() != 0;
+
+  // Checks.
+  std::vector<eval::Verdict> verdicts;
+  for (const auto& c : suite.cases) {
+    auto v = eval::CheckCase(c.name, c.bands, c.orderings, measured);
+    verdicts.insert(verdicts.end(), v.begin(), v.end());
+  }
+  {
+    auto v = eval::CheckCase("suite", {}, suite.orderings, measured);
+    verdicts.insert(verdicts.end(), v.begin(), v.end());
+  }
+  const int failed_checks = static_cast<int>(
+      std::count_if(verdicts.begin(), verdicts.end(), [](const auto& v) { return !v.pass; }));
+  const int failed_runs = static_cast<int>(
+      std::count_if(results.begin(), results.end(), [](const auto& r) { return !r.ran; }));
+  int changed = 0;
+  for (const auto& r : results) changed += r.digest_status == "changed";
+  const bool digest_fail = o.require_digests && changed > 0;
+
+  // Report: table on stdout.
+  std::ostringstream md;
+  md << "### regression suite " << suite.name << " (" << o.suite.string() << ")\n\n"
+     << "| case | check | expected | measured (mean ± 95 % CI) | verdict |\n"
+     << "|---|---|---|---|---|\n";
+  for (const auto& v : verdicts)
+    md << "| " << v.case_name << " | " << v.check << " | " << v.expected << " | " << v.measured
+       << " | " << (v.pass ? "pass" : "**FAIL**: " + v.why) << " |\n";
+  md << "\n| case | run | digest of seed outputs |\n|---|---|---|\n";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    const auto& c = suite.cases[i];
+    std::string d = r.digest_status;
+    if (d == "changed") d = "**changed** (recorded " + c.digest + ", now " + r.digest + ")";
+    if (d == "same" || d == "not recorded") d += " " + r.digest;
+    md << "| " << r.name << " | " << (r.ran ? "ok" : "**failed**: " + r.error) << " ("
+       << static_cast<int>(r.wall_s) << " s) | " << d << " |\n";
+  }
+  md << "\n" << verdicts.size() - failed_checks << " of " << verdicts.size() << " checks pass";
+  if (failed_runs) md << "; " << failed_runs << " case(s) did not run";
+  if (changed)
+    md << "; " << changed << " digest(s) changed (the same seeds no longer give the same "
+       << "outputs: expected after an intended change, refresh with --record)";
+  if (stopped) md << "; stopped by a signal before every case ran";
+  md << ".\n";
+  std::cout << md.str();
+  WriteTextFile(o.out / "report.md", md.str());
+
+  nlohmann::json j;
+  j["suite"] = suite.name;
+  j["file"] = o.suite.string();
+  for (const auto& v : verdicts)
+    j["checks"].push_back({{"case", v.case_name},
+                           {"check", v.check},
+                           {"expected", v.expected},
+                           {"measured", v.measured},
+                           {"pass", v.pass},
+                           {"why", v.why}});
+  for (std::size_t i = 0; i < results.size(); ++i)
+    j["cases"].push_back({{"name", results[i].name},
+                          {"ran", results[i].ran},
+                          {"error", results[i].error},
+                          {"wall_s", results[i].wall_s},
+                          {"digest", results[i].digest},
+                          {"recorded_digest", suite.cases[i].digest},
+                          {"digest_status", results[i].digest_status}});
+  j["failed_checks"] = failed_checks;
+  j["failed_runs"] = failed_runs;
+  j["changed_digests"] = changed;
+  j["complete"] = !stopped && failed_runs == 0;
+  WriteTextFile(o.out / "report.json", j.dump(2) + "\n");
+
+  // JUnit XML: one testsuite per case, a testcase per check and one for the digest.
+  std::ostringstream x;
+  x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"" << XmlEscape(suite.name)
+    << "\" tests=\"" << verdicts.size() + results.size() << "\" failures=\""
+    << failed_checks + (digest_fail ? changed : 0) << "\" errors=\"" << failed_runs << "\">\n";
+  for (std::size_t i = 0; i < suite.cases.size() + 1; ++i) {
+    const std::string name = i < suite.cases.size() ? suite.cases[i].name : "suite";
+    x << "  <testsuite name=\"" << XmlEscape(name) << "\">\n";
+    if (i < results.size()) {
+      const auto& r = results[i];
+      x << "    <testcase classname=\"" << XmlEscape(name) << "\" name=\"run and digest\" time=\""
+        << r.wall_s << "\">";
+      if (!r.ran)
+        x << "<error message=\"" << XmlEscape(r.error) << "\"/>";
+      else if (r.digest_status == "changed")
+        x << (digest_fail ? "<failure message=\"" : "<skipped message=\"")
+          << XmlEscape("digest changed: recorded " + suite.cases[i].digest + ", now " + r.digest)
+          << "\"/>";
+      x << "</testcase>\n";
+    }
+    for (const auto& v : verdicts) {
+      if (v.case_name != name) continue;
+      x << "    <testcase classname=\"" << XmlEscape(name) << "\" name=\"" << XmlEscape(v.check)
+        << "\">";
+      if (!v.pass)
+        x << "<failure message=\""
+          << XmlEscape("expected " + v.expected + ", measured " + v.measured + ": " + v.why)
+          << "\"/>";
+      x << "</testcase>\n";
+    }
+    x << "  </testsuite>\n";
+  }
+  x << "</testsuites>\n";
+  WriteTextFile(o.out / "junit.xml", x.str());
+
+  if (!o.record.empty()) {
+    if (failed_runs > 0 || stopped) {
+      std::cerr << "dualgrid: error: --record: not written, " << failed_runs
+                << " case(s) did not run: a baseline needs every case\n";
+      return kExitSomeSeedsFailed;
+    }
+    scenario::RegressionSuite rec = suite;
+    for (std::size_t i = 0; i < rec.cases.size(); ++i) {
+      auto& c = rec.cases[i];
+      // The case's own overrides only (the command line's were for this run).
+      c.sets.resize(c.sets.size() - o.sets.size());
+      std::vector<eval::MetricRef> refs;
+      for (const auto& b : c.bands) refs.push_back(b.metric);
+      for (const auto& metric : c.record)
+        for (const auto& mode : c.modes) refs.push_back({"", mode, metric});
+      c.bands.clear();
+      std::set<std::string> seen;
+      for (const auto& ref : refs) {
+        if (!seen.insert(ref.ToString()).second) continue;
+        const auto& m = measured.at(c.name);
+        const auto it = m.find(ref.mode + "." + ref.metric);
+        if (it == m.end()) continue;  // undefined in this run: no band
+        c.bands.push_back(eval::RecordBand(ref, it->second));
+      }
+      c.digest = results[i].digest;
+    }
+    const auto folder = std::filesystem::absolute(o.record).parent_path();
+    WriteTextFile(o.record,
+                  "# Regression suite recorded by `dualgrid regress " + o.suite.string() +
+                      " --record`: bands = mean ± max(3 × 95 % CI half-width, a per-metric "
+                      "floor) (docs/regression.md).\n" +
+                      scenario::SuiteToYaml(rec, folder));
+    if (!o.quiet) std::cerr << "regress: recorded " << o.record.string() << "\n";
+  }
+  if (stopped) return StopExitCode();
+  if (failed_runs > 0) return kExitSomeSeedsFailed;
+  if (failed_checks > 0 || digest_fail) return kExitRunFailed;  // 1: a check failed
+  return kExitOk;
+}
+
+}  // namespace dualgrid::tools
