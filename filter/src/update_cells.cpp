@@ -274,18 +274,23 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
         // A single mode's other weight is not in q_norm and would drift without bound (float
         // overflow): it is normalised on its own to rho_p, as in the per-cell form.
-        const double k = q_norm > 0.0 ? scale / q_norm : 0.0;
+        // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
+        // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
+        // <= 1. The other weight's share is w / sum <= 1, times rho_p.
         const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
         const bool own_v = fell_back || p.mode != WeightMode::kPosition;
-        const double kp = own_p ? k : (sum_pos > 0.0 ? rho_p / sum_pos : 0.0);
-        const double kv = own_v ? k : (sum_vel > 0.0 ? rho_p / sum_vel : 0.0);
+        const auto norm = [&](double w, bool own, double sum) {
+          if (!(q_norm > 0.0)) return 0.0;
+          if (own) return w * scale / q_norm;
+          return sum > 0.0 ? rho_p * (w / sum) : 0.0;
+        };
         for (std::int64_t i = lo; i < hi; ++i) {
           if (q.weight[i] == 0.0) continue;
           const double wp = fell_back ? q.weight[i] : q.w_position[i];
           const double wv = fell_back ? q.weight[i] : q.w_velocity[i];
-          q.w_position[i] = static_cast<float>(wp * kp);
-          q.w_velocity[i] = static_cast<float>(wv * kv);
-          q.weight[i] = static_cast<float>(mode_factor(wp, wv) * k);
+          q.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
+          q.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
+          q.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
         }
       }
 

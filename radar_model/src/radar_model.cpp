@@ -481,7 +481,12 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
     for (std::uint32_t k = 0; k < n; ++k) {
       Polar m;
       m.range = rng.Uniform(p.min_range, p.max_range);
-      m.azimuth = rng.Uniform(-0.5 * p.fov, 0.5 * p.fov);
+      // Uniform over the azimuth cells (each cell has the same false-alarm probability), not
+      // over the angle: rejection with the acceptance azimuth_resolution / resolution(az) >= 1 %
+      // (profile factors <= 100), so wide off-boresight cells get no more than their share.
+      do {
+        m.azimuth = rng.Uniform(-0.5 * p.fov, 0.5 * p.fov);
+      } while (rng.Uniform() * p.AzimuthResolutionAt(m.azimuth) > p.azimuth_resolution);
       m.range_rate = rng.Uniform(p.min_range_rate, p.max_range_rate);
       out.push_back(make_detection(m, model.ThresholdSnrDb(), -1, true));
     }

@@ -33,7 +33,7 @@ bool SensorParams::IsValid(std::string* error) const {
       max_range / range_resolution >= kMaxBins)
     return Fail(error, "range_resolution: must be > 0 and give fewer than 2^20 range cells");
   if (!finite(azimuth_resolution) || azimuth_resolution <= 0.0 ||
-      fov / azimuth_resolution >= kMaxBins)
+      fov / azimuth_resolution >= kMaxBins - 4)  // + the partial cells at the edges
     return Fail(error, "azimuth_resolution: must be > 0 and give fewer than 2^20 azimuth cells");
   if (!finite(range_rate_resolution) || range_rate_resolution <= 0.0 ||
       (max_range_rate - min_range_rate) / range_rate_resolution >= kMaxBins)

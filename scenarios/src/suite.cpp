@@ -84,8 +84,15 @@ RegressionSuite LoadSuite(const std::filesystem::path& file) {
   for (auto& c : cases) {
     RegressionCase rc;
     c.Require("name", &rc.name);
-    if (rc.name.empty() || rc.name.find_first_of(":/ \t") != std::string::npos)
-      c.Fail("name", "must be non-empty, without ':', '/' or blanks");
+    // The name is a folder under --out and a JUnit suite name: letters, digits, '_' and '-',
+    // not starting with '-' and not a name the reports use.
+    const bool name_ok =
+        !rc.name.empty() && rc.name.size() <= 64 && rc.name[0] != '-' && rc.name != "suite" &&
+        rc.name.find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") == std::string::npos;
+    if (!name_ok)
+      c.Fail("name", "expected 1-64 letters, digits, '_' or '-' (not starting with '-', not "
+                     "'suite'), got '" + rc.name + "'");
     if (!names.insert(rc.name).second) c.Fail("name", "'" + rc.name + "' names two cases");
     std::string scenario;
     c.Require("scenario", &scenario);
