@@ -127,13 +127,20 @@ stage_table() {
           rule+="---:|"
         done
       done
+      if [[ $group == "D_v D" ]]; then
+        header+=" dual − best single (D_v) |"
+        rule+="---:|"
+      fi
       echo "$header"
       echo "$rule"
       for dir in "$OUT/$scen"/*/; do
         [[ -f "$dir/table.csv" ]] || continue
         name=$(basename "$dir")
         awk -F, -v name="$name" -v metrics="$group" '
-          NR > 1 { v[$2 "," $4] = ($6 == "" ? "—" : sprintf("%.2f", $6)) ($7 == "" ? "" : sprintf(" ± %.2f", $7)) }
+          NR > 1 {
+            v[$2 "," $4] = ($6 == "" ? "—" : sprintf("%.2f", $6)) ($7 == "" ? "" : sprintf(" ± %.2f", $7))
+            if ($6 != "") mean[$2 "," $4] = $6
+          }
           END {
             n = split(metrics, ms, " ")
             row = "| " name " |"
@@ -143,6 +150,10 @@ stage_table() {
                 key = ms[i] "," modes[k]
                 row = row " " ((key in v) ? v[key] : "—") " |"
               }
+            }
+            if (metrics == "D_v D") {
+              p = mean["D_v,position"]; q = mean["D_v,velocity"]; d = mean["D_v,dual"]
+              row = row " " ((d == "" || p == "" || q == "") ? "—" : sprintf("%+.1f", d - (p > q ? p : q))) " |"
             }
             print row
           }' "$dir/table.csv"
