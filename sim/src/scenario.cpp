@@ -73,8 +73,13 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   if (!CheckVehicle(ego, "ego", *this, error)) return false;
   if (!(ego.depart < duration))
     return Fail(error, "ego.depart", "must be before the end (duration)");
-  if (!(ego_speed.speed > 0.0 && ego_speed.speed <= kMaxTrafficSpeed))
-    return Fail(error, "ego.speed_policy.speed", "must be in (0, 70] m/s");
+  if (!(ego_speed.speed >= 0.0 && ego_speed.speed <= kMaxTrafficSpeed))
+    return Fail(error, "ego.speed_policy.speed", "must be in [0, 70] m/s");
+  // A parked ego (speed 0) is held by the fixed policy; cruising at 0 would be no policy at all.
+  if (ego_speed.speed == 0.0 && ego_speed.mode != SpeedPolicy::Mode::kFixed)
+    return Fail(error, "ego.speed_policy.speed", "0 (a parked ego) needs mode: fixed");
+  if (ego_speed.speed == 0.0 && ego.speed != 0.0)
+    return Fail(error, "ego.speed", "must be 0 for a parked ego (speed_policy.speed 0)");
   std::set<std::string> ids{ego.id};
   for (std::size_t i = 0; i < vehicles.size(); ++i) {
     const std::string f = "traffic.vehicles[" + std::to_string(i) + "]";

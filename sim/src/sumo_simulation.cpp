@@ -331,7 +331,8 @@ void SumoSimulation::ApplyDepartures() {
   for (const std::string& id : libsumo::Simulation::getDepartedIDList()) {
     const std::uint64_t index = departures_++;
     if (id == spec_.ego.id) {
-      libsumo::Vehicle::setMaxSpeed(id, spec_.ego_speed.speed);
+      // SUMO needs a positive maximum speed; a parked ego is held by setSpeed(0) each step.
+      libsumo::Vehicle::setMaxSpeed(id, std::max(spec_.ego_speed.speed, 0.1));
       if (!spec_.ego.lane_change)
         libsumo::Vehicle::setLaneChangeMode(id, kLaneChangeModeScriptedOnly);
       continue;

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "aspect_case.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "output.hpp"
@@ -114,7 +115,33 @@ std::string Parallel(const TangentialOptions& o) {
 }  // namespace
 
 int RunTangential(const TangentialOptions& o) {
+  if (o.out.extension() != ".yaml" && o.out.extension() != ".yml")
+    throw std::invalid_argument("--out must name a .yaml file, got '" + o.out.string() + "'");
+  if (o.kind == "aspect") {
+    AspectCase c;
+    c.sensor = o.sensor;
+    c.angle_deg = o.angle;
+    c.range = o.range;
+    c.speed = o.speed.value_or(15.0);
+    c.ego_speed = o.ego_speed;
+    c.target = o.target;
+    c.count = o.count;
+    c.interval = o.interval;
+    c.grid_width = o.grid_width;
+    c.seed = o.seed;
+    if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
+    const std::string what = WriteAspectCase(c, o.out);
+    scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
+    if (!o.quiet)
+      std::cout << "wrote " << o.out.string() << " (" << what
+                << "); run it with: dualgrid run " << o.out.string() << " --out run/"
+                << o.out.stem().string() << "\n";
+    return 0;
+  }
   // Ranges of single options are checked by the command line; these depend on the kind.
+  if (!(o.ego_speed > 0.0))
+    throw std::invalid_argument("--ego-speed must be > 0 for " + o.kind +
+                                " traffic (a parked ego: --kind aspect)");
   const Resolved r = Resolve(o);
   if (o.kind == "parallel" && !(std::abs(r.speed - o.ego_speed) <= 5.0))
     throw std::invalid_argument(

@@ -65,7 +65,9 @@ struct SnapshotOptions {
 
 /// `dualgrid tangential`: writes a tangential-motion stress scenario.
 struct TangentialOptions {
-  std::string kind = "crossing";  ///< "crossing" (ahead, across the front radar) or "parallel"
+  /// "crossing" (ahead, across the front radar), "parallel" (alongside) or "aspect" (any aspect
+  /// angle to any sensor, aspect_case.hpp).
+  std::string kind = "crossing";
   int count = 4;                  ///< stress vehicles
   double ego_speed = 20.0;        ///< [m/s]
   /// Stress vehicles' speed over ground [m/s]; default: crossing 15, parallel ego speed + 0.3.
@@ -77,6 +79,13 @@ struct TangentialOptions {
   std::uint64_t seed = 1;
   std::filesystem::path out;
   bool quiet = false;
+  // kind aspect:
+  std::string sensor = "front";
+  double angle = 90.0;     ///< [deg]
+  double range = 20.0;     ///< [m]
+  std::string target = "car";
+  double interval = 6.0;   ///< [s]
+  double grid_width = 25.0;  ///< [m]
 };
 
 /// `dualgrid regress`.

@@ -192,11 +192,29 @@ int main(int argc, char** argv) {
                          "Write a tangential-motion stress scenario (traffic crossing ahead of the "
                          "ego, or driving alongside it), to run with `dualgrid run`");
   Opt(tangential, "--kind", &tan.kind,
-      "crossing (ahead, across the front radar) or parallel (alongside, across the corner "
-      "radars)")
-      ->check(CLI::IsMember({"crossing", "parallel"}));
+      "crossing (ahead, across the front radar), parallel (alongside, across the corner "
+      "radars), or aspect (any --angle to any --sensor's line of sight; docs/stress.md)")
+      ->check(CLI::IsMember({"crossing", "parallel", "aspect"}));
+  Opt(tangential, "--sensor", &tan.sensor,
+      "aspect: the radar whose line of sight the angle refers to")
+      ->check(CLI::IsMember({"front", "front_left", "front_right", "rear_left", "rear_right"}));
+  Opt(tangential, "--angle", &tan.angle,
+      "aspect: angle between the targets' velocity over ground and the line of sight [deg] "
+      "(0 receding, 90 across, 180 approaching)")
+      ->check(Number(0.0, 180.0, false));
+  Opt(tangential, "--range", &tan.range,
+      "aspect: distance sensor -> target centre when on the sensor's boresight [m]")
+      ->check(Number(1.0, 200.0, false));
+  Opt(tangential, "--target", &tan.target, "aspect: car, truck or cyclist")
+      ->check(CLI::IsMember({"car", "truck", "cyclist"}));
+  Opt(tangential, "--interval", &tan.interval, "aspect: seconds between the targets")
+      ->check(Number(1.0, 60.0, false));
+  Opt(tangential, "--grid-width", &tan.grid_width,
+      "aspect: the grid's width (filter.width_y) [m]; the paper's is 25")
+      ->check(Number(5.0, 400.0, false));
   Opt(tangential, "--count", &tan.count, "Number of stress vehicles")->check(WholeNumber(1, 12));
-  Opt(tangential, "--ego-speed", &tan.ego_speed, "Ego speed [m/s]")->check(Number(0.0, 40.0, true));
+  Opt(tangential, "--ego-speed", &tan.ego_speed, "Ego speed [m/s] (0, a parked ego: aspect only)")
+      ->check(Number(0.0, 40.0, false));
   tangential
       ->add_option("--speed", tan.speed,
                    "Stress vehicles' speed over ground [m/s] (default: crossing 15; parallel "
