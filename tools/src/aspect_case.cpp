@@ -30,7 +30,9 @@ constexpr double kFirstTime = 6.0;    // [s] reference time of the first target
 constexpr double kLeadTime = 8.0;     // [s] a target drives this long before its reference time
 constexpr double kTailTime = 4.0;     // [s] simulated after the last reference time
 constexpr double kEgoStartX = 0.0;    // [m] ego centre at t = 0 (road from x = -100)
-constexpr int kMinFrames = 40;        // frames in the grid a target needs (2 x min_frames_in_grid)
+// Frames in the grid a target needs: evaluation.min_frames_in_grid (20) plus half a second, so
+// that a target that is scored has also been in view for a while.
+constexpr int kMinFrames = 30;
 
 struct TargetType {
   const char* name;
@@ -118,6 +120,18 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
   const double duration = kFirstTime + (c.count - 1) * c.interval + kTailTime;
   const double half_l = 0.5 * type->length;
 
+  // Frames with the centre inside the world-aligned 200 m x `width` grid around the ego (half a
+  // cell of margin for the grid's snapping to whole cells).
+  const auto frames_in = [&](const Position& p, double t_ref, double depart, double width) {
+    int frames = 0;
+    for (double time = depart; time <= duration + 1e-9; time += kStep) {
+      const Position centre = p + c.speed * (time - t_ref) * dir;
+      const double ex = kEgoStartX + c.ego_speed * time;
+      frames += std::abs(centre.x() - ex) < 99.5 && std::abs(centre.y()) < 0.5 * width - 0.5;
+    }
+    return frames;
+  };
+  const auto FramesInGrid = frames_in;
   struct Target {
     double t_ref, depart, pos0, before, after;
     Position p;
@@ -130,7 +144,6 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
   };
   std::vector<Road> roads;
   std::vector<Target> targets;
-  double max_abs_y = 0.0;
   for (int k = 0; k < c.count; ++k) {
     Target t;
     t.t_ref = kFirstTime + k * c.interval;
@@ -152,27 +165,36 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
     }
     roads[t.road].before = std::max(roads[t.road].before, t.before);
     roads[t.road].after = std::max(roads[t.road].after, t.after);
-    // Frames with the centre inside the world-aligned 200 m x grid_width grid around the ego
-    // (half a cell of margin for the grid's snapping to whole cells).
-    for (double time = t.depart; time <= duration + 1e-9; time += kStep) {
-      const Position centre = t.p + c.speed * (time - t.t_ref) * dir;
-      const double ex = kEgoStartX + c.ego_speed * time;
-      if (std::abs(centre.x() - ex) < 99.5 && std::abs(centre.y()) < 0.5 * c.grid_width - 0.5)
-        ++t.frames_in_grid;
-    }
-    max_abs_y = std::max(max_abs_y, std::abs(t.p.y()));
+    t.frames_in_grid = FramesInGrid(t.p, t.t_ref, t.depart, c.grid_width);
     targets.push_back(t);
   }
-  for (std::size_t k = 0; k < targets.size(); ++k) {
-    if (targets[k].frames_in_grid >= kMinFrames) continue;
-    const double need = 5.0 * std::ceil((2.0 * (max_abs_y + type->length) + 2.0) / 5.0);
+  // Every target must be scored and must be inside the grid at its reference point, where the
+  // aspect angle is the asked one. The suggested width is the smallest multiple of 5 m that does.
+  const auto fits = [&](double width) {
+    for (const auto& t : targets)
+      if (frames_in(t.p, t.t_ref, t.depart, width) < kMinFrames ||
+          std::abs(t.p.y()) > 0.5 * width - 0.5 - half_l)
+        return false;
+    return true;
+  };
+  if (!fits(c.grid_width)) {
+    double need = 0.0;
+    for (double w = 5.0 * std::ceil(c.grid_width / 5.0); w <= 400.0 && need == 0.0; w += 5.0)
+      if (fits(w)) need = w;
+    const Target& t = targets.front();
+    std::string why = std::abs(t.p.y()) > 0.5 * c.grid_width - 0.5 - half_l
+                          ? "its reference point, " + F(c.range, 1) + " m on the " + c.sensor +
+                                " radar's boresight, lies " + F(std::abs(t.p.y()), 1) +
+                                " m to the side of the ego, outside the " + F(c.grid_width, 0) +
+                                " m wide grid"
+                          : "it would be in the " + F(c.grid_width, 0) + " m wide grid for " +
+                                std::to_string(frames_in(t.p, t.t_ref, t.depart, c.grid_width)) +
+                                " frames, fewer than the " + std::to_string(kMinFrames) +
+                                " a scored target needs";
     throw std::invalid_argument(
-        "target " + std::to_string(k + 1) + " would be in the grid for " +
-        std::to_string(targets[k].frames_in_grid) + " frames (" + std::to_string(kMinFrames) +
-        " needed to be scored): at " + F(c.range, 1) + " m on the " + c.sensor +
-        " radar's boresight it passes " + F(targets[k].p.y(), 1) + " m to the side, outside the " +
-        F(c.grid_width, 0) + " m wide grid; use --grid-width " + F(need, 0) +
-        " or a shorter --range");
+        "the targets would not be scored: " + why + "; " +
+        (need > 0.0 ? "use --grid-width " + F(need, 0) + ", " : "") +
+        "a lower --speed or a shorter --range");
   }
 
   // Network: the ego's road along world x, and one straight road per target through its
