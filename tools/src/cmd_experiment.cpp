@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "child_process.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
@@ -32,13 +33,6 @@ namespace {
 // A seed run's output log: seeds/seed_N.log beside its folder seeds/seed_N/.
 std::filesystem::path LogPath(const std::filesystem::path& seed_dir) {
   return seed_dir.parent_path() / (seed_dir.filename().string() + ".log");
-}
-
-// Exact decimal text of a double (std::to_string rounds to 6 decimals).
-std::string Exact(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
 }
 
 pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesystem::path& dir,
@@ -69,52 +63,8 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.check_invariants) args.push_back("--check-invariants");
   if (o.run.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.run.threads)});
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
   // Beside the run folder, which the run itself prepares (docs/output.md).
-  const std::string log = LogPath(dir).string();
-  const pid_t parent = getpid();
-  // fork + exec rather than posix_spawn: the child must die with the experiment
-  // (PR_SET_PDEATHSIG), or a killed experiment leaves its runs running on their own. Between
-  // fork and exec only async-signal-safe calls.
-  const pid_t pid = fork();
-  if (pid < 0)
-    throw std::runtime_error("cannot start " + o.executable + ": " + std::strerror(errno));
-  if (pid == 0) {
-    // Its own process group: Ctrl-C on the terminal reaches the experiment only, which forwards
-    // it once (a run that got SIGINT twice would stop at once, without its partial results).
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(143);  // the parent died before prctl took effect
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0) _exit(126);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    close(fd);
-    execv(o.executable.c_str(), argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-// A run folder is finished only when its summary.json, written last, says so.
-bool RunComplete(const std::filesystem::path& dir) {
-  try {
-    std::ifstream in(dir / "summary.json");
-    return in && nlohmann::json::parse(in).value("complete", false);
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-// The last non-empty line of a run's log: its error message.
-std::string LastLine(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::string line, last;
-  while (std::getline(in, line))
-    if (!line.empty()) last = line;
-  return last;
+  return StartChild(std::move(args), LogPath(dir));
 }
 
 }  // namespace
