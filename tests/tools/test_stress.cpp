@@ -59,11 +59,10 @@ TEST_CASE("aspect cases put the target at the asked aspect angle", "[cli][stress
                           Case{"front_left", 90.0, 0.0, 60.0}, Case{"front_left", 180.0, 0.0, 60.0},
                           Case{"rear_right", 120.0, 8.0, 60.0});
   const fs::path dir = TempDir("stress", c.sensor + "_" + std::to_string(int(c.angle)));
-  const auto gen = Run("tangential --kind aspect --sensor " + c.sensor + " --angle " +
-                       std::to_string(c.angle) + " --range 20 --speed 15 --ego-speed " +
-                       std::to_string(c.ego_speed) + " --grid-width " +
-                       std::to_string(c.grid_width) + " --count 1 -q --out " +
-                       (dir / "case.yaml").string());
+  const auto gen =
+      Run("tangential --kind aspect --sensor " + c.sensor + " --angle " + std::to_string(c.angle) +
+          " --range 20 --speed 15 --ego-speed " + std::to_string(c.ego_speed) + " --grid-width " +
+          std::to_string(c.grid_width) + " --count 1 -q --out " + (dir / "case.yaml").string());
   INFO(gen.output);
   REQUIRE(gen.code == 0);
   const auto sim = Run("sim " + (dir / "case.yaml").string() + " --out " + (dir / "sim").string() +
@@ -100,8 +99,8 @@ TEST_CASE("aspect cases put the target at the asked aspect angle", "[cli][stress
   doppler /= n;
   const double lx = tx - sx, ly = ty - sy;
   const double measured =
-      std::acos(std::clamp((vx * lx + vy * ly) / (std::hypot(vx, vy) * std::hypot(lx, ly)), -1.0,
-                           1.0)) *
+      std::acos(
+          std::clamp((vx * lx + vy * ly) / (std::hypot(vx, vy) * std::hypot(lx, ly)), -1.0, 1.0)) *
       180.0 / kPi;
   const double speed = std::hypot(vx, vy);
   const double expected_doppler = 15.0 * std::cos(c.angle * kPi / 180.0);
@@ -119,20 +118,22 @@ TEST_CASE("aspect cases that could not be scored are refused with what to change
           "[cli][stress]") {
   const fs::path dir = TempDir("stress", "refused");
   // 20 m on the front_left boresight lies 15 m to the side: outside the 25 m wide grid.
-  const auto narrow = Run("tangential --kind aspect --sensor front_left --angle 90 --range 20 "
-                          "--ego-speed 0 -q --out " +
-                          (dir / "a.yaml").string());
+  const auto narrow =
+      Run("tangential --kind aspect --sensor front_left --angle 90 --range 20 "
+          "--ego-speed 0 -q --out " +
+          (dir / "a.yaml").string());
   CHECK(narrow.code == 2);
   CHECK(narrow.output.find("--grid-width") != std::string::npos);
   CHECK(CountLines(narrow.output) == 1);
-  const auto far = Run("tangential --kind aspect --sensor front_left --range 150 --ego-speed 0 "
-                       "--grid-width 400 -q --out " +
-                       (dir / "b.yaml").string());
+  const auto far =
+      Run("tangential --kind aspect --sensor front_left --range 150 --ego-speed 0 "
+          "--grid-width 400 -q --out " +
+          (dir / "b.yaml").string());
   CHECK(far.code == 2);
   CHECK(far.output.find("--range") != std::string::npos);
   // Crossing and parallel traffic need a moving ego.
-  const auto parked = Run("tangential --kind crossing --ego-speed 0 -q --out " +
-                          (dir / "c.yaml").string());
+  const auto parked =
+      Run("tangential --kind crossing --ego-speed 0 -q --out " + (dir / "c.yaml").string());
   CHECK(parked.code == 2);
   CHECK(parked.output.find("--ego-speed") != std::string::npos);
 }

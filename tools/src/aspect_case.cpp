@@ -25,11 +25,11 @@ namespace dualgrid::tools {
 namespace {
 
 constexpr double kEgoLength = 4.5, kEgoWidth = 1.8;
-constexpr double kStep = 0.05;        // [s] step length of the generated scenario
-constexpr double kFirstTime = 6.0;    // [s] reference time of the first target
-constexpr double kLeadTime = 8.0;     // [s] a target drives this long before its reference time
-constexpr double kTailTime = 4.0;     // [s] simulated after the last reference time
-constexpr double kEgoStartX = 0.0;    // [m] ego centre at t = 0 (road from x = -100)
+constexpr double kStep = 0.05;      // [s] step length of the generated scenario
+constexpr double kFirstTime = 6.0;  // [s] reference time of the first target
+constexpr double kLeadTime = 8.0;   // [s] a target drives this long before its reference time
+constexpr double kTailTime = 4.0;   // [s] simulated after the last reference time
+constexpr double kEgoStartX = 0.0;  // [m] ego centre at t = 0 (road from x = -100)
 // Frames in the grid a target needs: evaluation.min_frames_in_grid (20) plus half a second, so
 // that a target that is scored has also been in view for a while.
 constexpr int kMinFrames = 30;
@@ -55,14 +55,11 @@ std::string F(double v, int digits = 3) {
 void Netconvert(const std::filesystem::path& nod, const std::filesystem::path& edg,
                 const std::filesystem::path& net, const std::filesystem::path& log) {
   const std::string exe = DUALGRID_NETCONVERT;
-  std::vector<std::string> args = {exe,
-                                   "--node-files", nod.string(),
-                                   "--edge-files", edg.string(),
-                                   "--no-turnarounds", "true",
-                                   "--offset.disable-normalization", "true",
-                                   "--xml-validation", "never",
-                                   "--no-warnings", "true",
-                                   "--output-file", net.string()};
+  std::vector<std::string> args = {
+      exe,          "--node-files",     nod.string(), "--edge-files",
+      edg.string(), "--no-turnarounds", "true",       "--offset.disable-normalization",
+      "true",       "--xml-validation", "never",      "--no-warnings",
+      "true",       "--output-file",    net.string()};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -73,7 +70,8 @@ void Netconvert(const std::filesystem::path& nod, const std::filesystem::path& e
   // SUMO_HOME for netconvert's data files, unless the user set it.
   std::vector<std::string> env_store;
   for (char** e = environ; *e; ++e) env_store.emplace_back(*e);
-  if (!std::getenv("SUMO_HOME")) env_store.push_back(std::string("SUMO_HOME=") + DUALGRID_SUMO_HOME);
+  if (!std::getenv("SUMO_HOME"))
+    env_store.push_back(std::string("SUMO_HOME=") + DUALGRID_SUMO_HOME);
   std::vector<char*> envp;
   for (auto& e : env_store) envp.push_back(e.data());
   envp.push_back(nullptr);
@@ -84,7 +82,8 @@ void Netconvert(const std::filesystem::path& nod, const std::filesystem::path& e
     throw std::runtime_error("cannot start netconvert (" + exe + "): " + std::strerror(rc));
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw std::runtime_error("lost netconvert: " + std::string(std::strerror(errno)));
+    if (errno != EINTR)
+      throw std::runtime_error("lost netconvert: " + std::string(std::strerror(errno)));
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw std::runtime_error("netconvert failed building " + net.string() + " (see " +
@@ -108,10 +107,10 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
   if (!sensor)
     throw std::invalid_argument("--sensor: expected one of " + names + ", got '" + c.sensor + "'");
   if (c.range <= sensor->min_range + 1.0 || c.range >= sensor->max_range - 5.0)
-    throw std::invalid_argument("--range: the " + c.sensor + " radar sees " + F(sensor->min_range, 1) +
-                                "-" + F(sensor->max_range, 0) + " m; expected a range within (" +
-                                F(sensor->min_range + 1.0, 1) + ", " +
-                                F(sensor->max_range - 5.0, 0) + ") m, got " + F(c.range, 1));
+    throw std::invalid_argument("--range: the " + c.sensor + " radar sees " +
+                                F(sensor->min_range, 1) + "-" + F(sensor->max_range, 0) +
+                                " m; expected a range within (" + F(sensor->min_range + 1.0, 1) +
+                                ", " + F(sensor->max_range - 5.0, 0) + ") m, got " + F(c.range, 1));
   const double theta = DegToRad(c.angle_deg);
   const double psi = sensor->mount.yaw;  // ego yaw 0: world yaw of the boresight
   const Vector2 los = UnitVector(psi);
@@ -147,8 +146,8 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
   for (int k = 0; k < c.count; ++k) {
     Target t;
     t.t_ref = kFirstTime + k * c.interval;
-    const Position sensor_at = Position(kEgoStartX + c.ego_speed * t.t_ref, 0.0) +
-                               sensor->mount.position;
+    const Position sensor_at =
+        Position(kEgoStartX + c.ego_speed * t.t_ref, 0.0) + sensor->mount.position;
     t.p = sensor_at + c.range * los;
     t.depart = std::max(0.0, std::round((t.t_ref - kLeadTime) / kStep) * kStep);
     t.pos0 = type->length + 0.1;  // front bumper on the edge at departure
@@ -191,10 +190,9 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
                                 std::to_string(frames_in(t.p, t.t_ref, t.depart, c.grid_width)) +
                                 " frames, fewer than the " + std::to_string(kMinFrames) +
                                 " a scored target needs";
-    throw std::invalid_argument(
-        "the targets would not be scored: " + why + "; " +
-        (need > 0.0 ? "use --grid-width " + F(need, 0) + ", " : "") +
-        "a lower --speed or a shorter --range");
+    throw std::invalid_argument("the targets would not be scored: " + why + "; " +
+                                (need > 0.0 ? "use --grid-width " + F(need, 0) + ", " : "") +
+                                "a lower --speed or a shorter --range");
   }
 
   // Network: the ego's road along world x, and one straight road per target through its
@@ -233,13 +231,14 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
     << c.sensor << " --angle " << c.angle_deg << " --range " << c.range << " --speed " << c.speed
     << " --ego-speed " << c.ego_speed << " --target " << c.target << " --count " << c.count
     << " --interval " << c.interval << " --grid-width " << c.grid_width << " --seed " << c.seed
-    << "\n# Geometry (docs/stress.md): at its reference time t_k each target's centre is " << c.range
-    << " m from the " << c.sensor << " radar on its boresight (world yaw " << F(RadToDeg(psi), 1)
-    << " deg),\n# moving at " << c.speed << " m/s over ground at aspect angle " << c.angle_deg
+    << "\n# Geometry (docs/stress.md): at its reference time t_k each target's centre is "
+    << c.range << " m from the " << c.sensor << " radar on its boresight (world yaw "
+    << F(RadToDeg(psi), 1) << " deg),\n# moving at " << c.speed
+    << " m/s over ground at aspect angle " << c.angle_deg
     << " deg to the line of sight (0 = receding along it, 90 = across it, 180 = approaching):\n"
     << "# compensated radial speed there v cos(theta) = " << F(c.speed * std::cos(theta), 2)
-    << " m/s. Ego: a " << kEgoLength << " m car on a straight road along world x at "
-    << c.ego_speed << " m/s" << (c.ego_speed == 0.0 ? " (parked)" : "") << ".\n";
+    << " m/s. Ego: a " << kEgoLength << " m car on a straight road along world x at " << c.ego_speed
+    << " m/s" << (c.ego_speed == 0.0 ? " (parked)" : "") << ".\n";
   for (std::size_t k = 0; k < targets.size(); ++k)
     y << "#   target_" << k + 1 << ": t_k = " << F(targets[k].t_ref, 2) << " s at ("
       << F(targets[k].p.x(), 2) << ", " << F(targets[k].p.y(), 2) << "), departs "
@@ -254,30 +253,26 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
     << "\n\nvehicle_types:\n  car: {length: 4.5, width: 1.8, max_speed: 50.0, rcs_dbsm: 10.0}\n";
   if (c.target != "car")
     y << "  " << type->name << ": {length: " << type->length << ", width: " << type->width
-      << ", max_speed: 50.0, rcs_dbsm: " << type->rcs_dbsm << ", vclass: " << type->vclass
-      << "}\n";
+      << ", max_speed: 50.0, rcs_dbsm: " << type->rcs_dbsm << ", vclass: " << type->vclass << "}\n";
   y << "\nroutes:\n  ego: [ego_road]\n";
-  for (std::size_t k = 0; k < roads.size(); ++k)
-    y << "  t" << k + 1 << ": [t" << k + 1 << "]\n";
+  for (std::size_t k = 0; k < roads.size(); ++k) y << "  t" << k + 1 << ": [t" << k + 1 << "]\n";
   y << "\nego: {type: car, route: ego, lane: 0, position: " << F(ego_front, 2)
     << ", speed: " << c.ego_speed << ", speed_policy: {mode: fixed, speed: " << c.ego_speed
     << "}}\n\ntraffic:\n  vehicles:\n";
   for (std::size_t k = 0; k < targets.size(); ++k)
     y << "    - {id: target_" << k + 1 << ", type: " << type->name << ", route: t"
-      << targets[k].road + 1 << ", lane: 0, depart: " << F(targets[k].depart, 2)
-      << ", position: "
+      << targets[k].road + 1 << ", lane: 0, depart: " << F(targets[k].depart, 2) << ", position: "
       << F(roads[targets[k].road].before + half_l -
-               c.speed * (targets[k].t_ref - targets[k].depart), 2)
-      << ", speed: " << c.speed << ", desired_speed: " << c.speed
-      << ", lane_change: false}\n";
+               c.speed * (targets[k].t_ref - targets[k].depart),
+           2)
+      << ", speed: " << c.speed << ", desired_speed: " << c.speed << ", lane_change: false}\n";
   if (c.grid_width != 25.0) y << "\nfilter: {width_y: " << c.grid_width << "}\n";
   y << "\nevaluation:\n  focus_object: target_1\n  snapshot_times: [";
-  for (std::size_t k = 0; k < targets.size(); ++k)
-    y << (k ? ", " : "") << F(targets[k].t_ref, 2);
+  for (std::size_t k = 0; k < targets.size(); ++k) y << (k ? ", " : "") << F(targets[k].t_ref, 2);
   y << "]\n";
   WriteTextFile(out, y.str());
-  return "aspect " + F(c.angle_deg, 1) + " deg to the " + c.sensor + " radar at " +
-         F(c.range, 1) + " m, v cos(theta) = " + F(c.speed * std::cos(theta), 2) + " m/s";
+  return "aspect " + F(c.angle_deg, 1) + " deg to the " + c.sensor + " radar at " + F(c.range, 1) +
+         " m, v cos(theta) = " + F(c.speed * std::cos(theta), 2) + " m/s";
 }
 
 }  // namespace dualgrid::tools

@@ -133,9 +133,8 @@ int RunTangential(const TangentialOptions& o) {
     const std::string what = WriteAspectCase(c, o.out);
     scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
     if (!o.quiet)
-      std::cout << "wrote " << o.out.string() << " (" << what
-                << "); run it with: dualgrid run " << o.out.string() << " --out run/"
-                << o.out.stem().string() << "\n";
+      std::cout << "wrote " << o.out.string() << " (" << what << "); run it with: dualgrid run "
+                << o.out.string() << " --out run/" << o.out.stem().string() << "\n";
     return 0;
   }
   // Ranges of single options are checked by the command line; these depend on the kind.

@@ -68,8 +68,8 @@ struct TangentialOptions {
   /// "crossing" (ahead, across the front radar), "parallel" (alongside) or "aspect" (any aspect
   /// angle to any sensor, aspect_case.hpp).
   std::string kind = "crossing";
-  int count = 4;                  ///< stress vehicles
-  double ego_speed = 20.0;        ///< [m/s]
+  int count = 4;            ///< stress vehicles
+  double ego_speed = 20.0;  ///< [m/s]
   /// Stress vehicles' speed over ground [m/s]; default: crossing 15, parallel ego speed + 0.3.
   std::optional<double> speed;
   double first_distance = 30.0;  ///< crossing: distance ahead of the ego of the first crossing [m]
@@ -81,10 +81,10 @@ struct TangentialOptions {
   bool quiet = false;
   // kind aspect:
   std::string sensor = "front";
-  double angle = 90.0;     ///< [deg]
-  double range = 20.0;     ///< [m]
+  double angle = 90.0;  ///< [deg]
+  double range = 20.0;  ///< [m]
   std::string target = "car";
-  double interval = 6.0;   ///< [s]
+  double interval = 6.0;     ///< [s]
   double grid_width = 25.0;  ///< [m]
 };
 
@@ -101,7 +101,30 @@ struct RegressOptions {
   std::string executable;
 };
 
+/// `dualgrid sweep`.
+struct SweepOptions {
+  std::string scenario;  ///< a scenario file, or "tangential" (the generator)
+  std::filesystem::path out;
+  std::vector<std::string> sets;  ///< KEY=LIST axes (sweep_spec.hpp)
+  int seeds = 3;
+  std::uint64_t first_seed = 1;
+  std::vector<std::string> modes = {"position", "velocity", "dual"};
+  std::optional<double> duration;
+  int jobs = 0;      ///< local runs at a time; 0: one per core
+  std::string emit;  ///< "": run locally; "list": runs.txt only; "slurm": + slurm.sh
+  std::filesystem::path network_dir;
+  bool quiet = false;
+  std::string executable;
+};
+/// `dualgrid collect`.
+struct CollectOptions {
+  std::filesystem::path dir;
+  bool quiet = false;
+};
+
 int RunSim(const SimOptions& options);
+int RunSweep(const SweepOptions& options);
+int RunCollect(const CollectOptions& options);
 int RunRegress(const RegressOptions& options);
 int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);

@@ -264,6 +264,50 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   regress->add_flag("--quiet,-q", reg.quiet, "No progress output");
 
+  SweepOptions sw;
+  sw.network_dir = network_dir;
+  auto* sweep = app.add_subcommand(
+      "sweep",
+      "Run a scenario (or the tangential generator) over a grid of key values and seeds: "
+      "locally, or as a run list / Slurm job array (docs/stress.md)");
+  sweep
+      ->add_option("scenario", sw.scenario,
+                   "Scenario file, or 'tangential' to sweep the stress-case generator "
+                   "(keys tangential.angle, tangential.sensor, ...)")
+      ->required();
+  sweep->add_option("--out,-o", sw.out, "Sweep folder (resumable: finished runs are kept)")
+      ->required()
+      ->check(NonEmptyPath());
+  sweep
+      ->add_option("--set", sw.sets,
+                   "KEY=LIST to sweep (repeatable): values a,b,c and/or ranges first:step:last, "
+                   "e.g. filter.sigma_v=0.5,1,2 or tangential.angle=0:15:90")
+      ->required();
+  Opt(sweep, "--seeds", &sw.seeds, "Seeds per setting")->check(WholeNumber(1, kMaxSeeds));
+  Opt(sweep, "--first-seed", &sw.first_seed, "First seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  sweep->add_option("--modes", sw.modes, "Weight modes (default: all three)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"position", "velocity", "dual"}));
+  sweep->add_option("--duration", sw.duration, "Simulated time per run [s]")
+      ->check(Number(0.0, kMaxDuration, true));
+  sweep->add_option("--jobs,-j", sw.jobs, "Runs at a time (default: one per core, 1 thread each)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
+  sweep
+      ->add_option("--emit", sw.emit,
+                   "Do not run: 'list' writes runs.txt (one shell command per run, e.g. for GNU "
+                   "parallel), 'slurm' also slurm.sh (a job array); then `dualgrid collect`")
+      ->check(CLI::IsMember({"list", "slurm"}));
+  Opt(sweep, "--network-dir", &sw.network_dir, "Folder of the built networks")
+      ->check(CLI::ExistingDirectory);
+  sweep->add_flag("--quiet,-q", sw.quiet, "No progress output");
+
+  CollectOptions col;
+  auto* collect = app.add_subcommand(
+      "collect", "Merge the finished runs of a sweep folder into tables and figures");
+  collect->add_option("dir", col.dir, "Sweep folder")->required()->check(CLI::ExistingDirectory);
+  collect->add_flag("--quiet,-q", col.quiet, "No summary output");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -273,6 +317,11 @@ int main(int argc, char** argv) {
   }
   try {
     if (sim->parsed()) return RunSim(sim_options);
+    if (sweep->parsed()) {
+      sw.executable = SelfPath(argv[0]);
+      return RunSweep(sw);
+    }
+    if (collect->parsed()) return RunCollect(col);
     if (regress->parsed()) {
       reg.executable = SelfPath(argv[0]);
       return RunRegress(reg);

@@ -1,0 +1,474 @@
+// `dualgrid sweep`: a scenario (or the tangential generator) over a grid of key values and
+// seeds, run locally (-j), or emitted as a run list / Slurm job array; `dualgrid collect` merges
+// the finished runs into tidy and aggregated tables and metric-vs-value figures.
+// docs/stress.md ("Sweeps").
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "cli_checks.hpp"
+#include "commands.hpp"
+#include "dualgrid/eval/aggregate.hpp"
+#include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/viz/charts.hpp"
+#include "exit_codes.hpp"
+#include "figures.hpp"
+#include "output.hpp"
+#include "progress.hpp"
+#include "signals.hpp"
+#include "sweep_spec.hpp"
+
+namespace dualgrid::tools {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kGenerator = "tangential";
+constexpr const char* kMetrics[] = {"D", "D_v", "delta_x", "delta_v", "t_d"};
+
+// Sets one `tangential.KEY` option of the generator; throws std::invalid_argument.
+void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std::string& value) {
+  const auto number = [&](double lo, double hi, bool lo_open) {
+    std::size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || !std::isfinite(v) || (lo_open ? v <= lo : v < lo) || v > hi)
+      throw std::invalid_argument("tangential." + key + ": expected a number in " +
+                                  (lo_open ? "(" : "[") + Exact(lo) + ", " + Exact(hi) +
+                                  "], got '" + value + "'");
+    return v;
+  };
+  const auto one_of = [&](std::initializer_list<const char*> allowed) {
+    std::string all;
+    for (const char* a : allowed) {
+      if (value == a) return value;
+      all += (all.empty() ? "" : ", ") + std::string(a);
+    }
+    throw std::invalid_argument("tangential." + key + ": expected one of " + all + ", got '" +
+                                value + "'");
+  };
+  if (key == "kind")
+    o->kind = one_of({"crossing", "parallel", "aspect"});
+  else if (key == "sensor")
+    o->sensor = one_of({"front", "front_left", "front_right", "rear_left", "rear_right"});
+  else if (key == "target")
+    o->target = one_of({"car", "truck", "cyclist"});
+  else if (key == "angle")
+    o->angle = number(0.0, 180.0, false);
+  else if (key == "range")
+    o->range = number(1.0, 200.0, false);
+  else if (key == "speed")
+    o->speed = number(0.0, 40.0, true);
+  else if (key == "ego_speed")
+    o->ego_speed = number(0.0, 40.0, false);
+  else if (key == "count")
+    o->count = static_cast<int>(number(1.0, 12.0, false));
+  else if (key == "interval")
+    o->interval = number(1.0, 60.0, false);
+  else if (key == "grid_width")
+    o->grid_width = number(5.0, 400.0, false);
+  else if (key == "first_distance")
+    o->first_distance = number(10.0, 600.0, false);
+  else if (key == "spacing")
+    o->spacing = number(0.0, 600.0, true);
+  else if (key == "seed")
+    o->seed = static_cast<std::uint64_t>(number(0.0, 9007199254740991.0, false));
+  else
+    throw std::invalid_argument(
+        "tangential." + key +
+        ": unknown generator option (expected kind, sensor, target, angle, range, speed, "
+        "ego_speed, count, interval, grid_width, first_distance, spacing, seed)");
+}
+
+std::string SettingLabel(const std::vector<SweepAxis>& axes, const std::vector<std::string>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < axes.size(); ++i)
+    s += (s.empty() ? "" : ", ") + axes[i].key + "=" + v[i];
+  return s;
+}
+
+std::string CsvCell(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+std::string ShellQuote(const std::string& s) {
+  std::string o = "'";
+  for (char c : s) o += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return o + "'";
+}
+
+}  // namespace
+
+int RunSweep(const SweepOptions& o) {
+  if (o.sets.empty()) throw std::invalid_argument("--set: give at least one KEY=LIST to sweep");
+  std::vector<SweepAxis> axes;
+  for (const auto& s : o.sets) {
+    SweepAxis a = ParseSweepAxis(s);
+    for (const auto& b : axes)
+      if (b.key == a.key) throw std::invalid_argument("--set " + s + ": key given twice");
+    axes.push_back(std::move(a));
+  }
+  const bool generator = o.scenario == kGenerator;
+  if (!generator && !fs::is_regular_file(o.scenario))
+    throw std::invalid_argument("scenario '" + o.scenario + "' not found (a file, or '" +
+                                kGenerator + "' to sweep the stress-case generator)");
+  for (const auto& a : axes)
+    if (!generator && a.key.rfind("tangential.", 0) == 0)
+      throw std::invalid_argument("--set " + a.key + ": generator keys need the scenario '" +
+                                  std::string(kGenerator) + "'");
+  const auto settings = SweepSettings(axes);
+  const fs::path out = fs::absolute(o.out);
+  // Resumable: an earlier sweep folder is kept (its finished runs are skipped), but only if it
+  // was a sweep of the same plan.
+  nlohmann::json plan;
+  plan["scenario"] = generator ? std::string(kGenerator) : fs::absolute(o.scenario).string();
+  for (const auto& a : axes) plan["axes"].push_back({{"key", a.key}, {"values", a.values}});
+  plan["seeds"] = o.seeds;
+  plan["first_seed"] = o.first_seed;
+  plan["modes"] = o.modes;
+  plan["duration"] = o.duration ? nlohmann::json(*o.duration) : nlohmann::json(nullptr);
+  const fs::path plan_file = out / "plan.json";
+  if (fs::exists(plan_file)) {
+    nlohmann::json old;
+    try {
+      old = nlohmann::json::parse(std::ifstream(plan_file));
+    } catch (const std::exception&) {
+    }
+    nlohmann::json cmp = old;
+    cmp.erase("settings");
+    cmp.erase("runs");
+    if (cmp != plan)
+      throw std::invalid_argument(out.string() +
+                                  " holds a sweep of another plan (plan.json differs); use a new "
+                                  "--out or remove it");
+  } else {
+    PrepareOutputFolder(out);
+  }
+
+  // Scenarios and run commands; every setting is validated before anything runs.
+  std::ostringstream list;
+  std::vector<std::pair<std::vector<std::string>, fs::path>> runs;  // args, folder
+  for (std::size_t si = 0; si < settings.size(); ++si) {
+    const auto& values = settings[si];
+    char id[16];
+    std::snprintf(id, sizeof id, "s%03zu", si + 1);
+    const std::string label = SettingLabel(axes, values);
+    fs::path scenario =
+        generator ? out / "scenarios" / (std::string(id) + ".yaml") : fs::absolute(o.scenario);
+    std::vector<std::string> sets;
+    TangentialOptions gen;
+    gen.kind = "aspect";
+    gen.quiet = true;
+    for (std::size_t k = 0; k < axes.size(); ++k) {
+      if (axes[k].key.rfind("tangential.", 0) == 0)
+        SetGeneratorOption(&gen, axes[k].key.substr(11), values[k]);
+      else
+        sets.push_back(axes[k].key + "=" + values[k]);
+    }
+    try {
+      if (generator) {
+        gen.out = scenario;
+        RunTangential(gen);
+      }
+      std::vector<scenario::Override> overrides;
+      for (const auto& s : sets) overrides.push_back(scenario::ParseOverride(s));
+      scenario::LoadScenario(scenario, overrides);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument("setting " + std::string(id) + " (" + label + "): " + e.what());
+    }
+    plan["settings"].push_back(
+        {{"id", id}, {"values", values}, {"label", label}, {"scenario", scenario.string()}});
+    for (int k = 0; k < o.seeds; ++k) {
+      const std::uint64_t seed = o.first_seed + k;
+      const fs::path folder = out / "runs" / id / ("seed_" + std::to_string(seed));
+      std::vector<std::string> args = {o.executable,
+                                       "run",
+                                       scenario.string(),
+                                       "--out",
+                                       folder.string(),
+                                       "--seed",
+                                       std::to_string(seed),
+                                       "-q",
+                                       "--no-figures",
+                                       "--threads",
+                                       "1",
+                                       "--network-dir",
+                                       o.network_dir.string()};
+      std::string modes;
+      for (const auto& m : o.modes) modes += (modes.empty() ? "" : ",") + m;
+      args.insert(args.end(), {"--modes", modes});
+      if (o.duration) args.insert(args.end(), {"--duration", Exact(*o.duration)});
+      for (const auto& s : sets) args.insert(args.end(), {"--set", s});
+      std::string line;
+      for (const auto& a : args) line += (line.empty() ? "" : " ") + ShellQuote(a);
+      list << line << " > " << ShellQuote(folder.string() + ".log") << " 2>&1\n";
+      plan["runs"].push_back({{"setting", id}, {"seed", seed}, {"folder", folder.string()}});
+      runs.emplace_back(std::move(args), folder);
+    }
+  }
+  // Every setting is valid: now the run folders' parents (logs sit beside the folders, and
+  // runs.txt redirects into them).
+  for (const auto& run : runs) fs::create_directories(run.second.parent_path());
+  WriteTextFile(plan_file, plan.dump(2) + "\n");
+  WriteTextFile(out / "runs.txt", list.str());
+
+  if (o.emit == "slurm") {
+    std::ostringstream sh;
+    sh << "#!/bin/bash\n# Slurm job array of the sweep in " << out.string()
+       << ": one task per line of runs.txt (docs/stress.md).\n"
+       << "#SBATCH --job-name=dualgrid-sweep\n#SBATCH --array=1-" << runs.size() << "\n"
+       << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n#SBATCH --mem=2G\n"
+       << "#SBATCH --time=02:00:00\n#SBATCH --output=" << (out / "slurm").string()
+       << "/task_%a.out\nexport OMP_NUM_THREADS=1\n"
+       << "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " << ShellQuote((out / "runs.txt").string())
+       << ")\n[ -n \"$line\" ] || { echo \"no run $SLURM_ARRAY_TASK_ID\" >&2; exit 2; }\n"
+       << "eval \"$line\"\n";
+    fs::create_directories(out / "slurm");
+    WriteTextFile(out / "slurm.sh", sh.str());
+    std::cout << "wrote " << (out / "slurm.sh").string() << " (" << runs.size()
+              << " tasks); submit: sbatch " << (out / "slurm.sh").string()
+              << "; then: dualgrid collect " << out.string() << "\n";
+    return kExitOk;
+  }
+  if (o.emit == "list") {
+    std::cout << "wrote " << (out / "runs.txt").string() << " (" << runs.size()
+              << " runs); e.g. parallel -j " << Cores() << " < " << (out / "runs.txt").string()
+              << "; then: dualgrid collect " << out.string() << "\n";
+    return kExitOk;
+  }
+
+  // Local: `jobs` runs at a time, one OpenMP thread each (processes x threads <= cores).
+  const int jobs = o.jobs > 0 ? o.jobs : Cores();
+  if (!o.quiet)
+    std::cerr << "sweep: " << settings.size() << " settings x " << o.seeds
+              << " seeds = " << runs.size() << " runs, " << jobs << " at a time, 1 thread each\n";
+  std::vector<std::size_t> todo;
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    if (!RunComplete(runs[i].second)) todo.push_back(i);
+  if (!o.quiet && todo.size() < runs.size())
+    std::cerr << "sweep: " << runs.size() - todo.size() << " runs finished earlier, skipped\n";
+  Progress progress("sweep", static_cast<int>(todo.size()), !o.quiet);
+  std::map<pid_t, std::size_t> running;
+  std::size_t next = 0;
+  int done = 0, failed = 0;
+  bool forwarded = false;
+  while (true) {
+    while (!StopSignal() && next < todo.size() && static_cast<int>(running.size()) < jobs) {
+      const auto& [args, folder] = runs[todo[next++]];
+      fs::create_directories(folder.parent_path());
+      running[StartChild(args, folder.string() + ".log")] = todo[next - 1];
+    }
+    if (StopSignal() && !forwarded) {
+      for (const auto& [pid, i] : running) kill(pid, StopSignal());
+      forwarded = true;
+    }
+    if (running.empty()) break;
+    int status = 0;
+    const pid_t pid = wait(&status);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      throw std::runtime_error("lost track of the sweep's runs: " +
+                               std::string(std::strerror(errno)));
+    }
+    const std::size_t i = running.at(pid);
+    running.erase(pid);
+    ++done;
+    if (!RunComplete(runs[i].second)) {
+      ++failed;
+      if (!StopSignal())
+        std::cerr << "dualgrid: run " << runs[i].second.string()
+                  << " failed: " << LastLine(runs[i].second.string() + ".log") << "\n";
+    }
+    progress.Update(done, std::to_string(done) + "/" + std::to_string(todo.size()) + " runs");
+  }
+  progress.Finish();
+  const int collected = RunCollect(CollectOptions{out, o.quiet});
+  if (StopSignal()) return StopExitCode();
+  return failed > 0 ? kExitSomeSeedsFailed : collected;
+}
+
+int RunCollect(const CollectOptions& o) {
+  const fs::path out = fs::absolute(o.dir);
+  nlohmann::json plan;
+  try {
+    plan = nlohmann::json::parse(std::ifstream(out / "plan.json"));
+  } catch (const std::exception&) {
+    throw std::invalid_argument(out.string() + ": no readable plan.json (not a sweep folder)");
+  }
+  std::vector<std::string> keys;
+  for (const auto& a : plan.at("axes")) keys.push_back(a.at("key"));
+  std::map<std::string, nlohmann::json> setting_of;
+  for (const auto& s : plan.at("settings")) setting_of[s.at("id")] = s;
+  // Tidy rows: setting x seed x mode x metric.
+  std::ostringstream tidy;
+  tidy << "setting";
+  for (const auto& k : keys) tidy << "," << CsvCell(k);
+  tidy << ",seed,mode,metric,value\n";
+  // (setting, mode, metric) -> samples
+  std::map<std::tuple<std::string, std::string, std::string>, std::vector<double>> samples;
+  std::vector<std::string> missing;
+  int complete = 0;
+  for (const auto& r : plan.at("runs")) {
+    const fs::path folder = r.at("folder").get<std::string>();
+    const std::string sid = r.at("setting");
+    if (!RunComplete(folder)) {
+      std::string why = LastLine(folder.string() + ".log");
+      missing.push_back(folder.string() + (why.empty() ? " (not run)" : ": " + why));
+      continue;
+    }
+    ++complete;
+    nlohmann::json table;
+    try {
+      table = nlohmann::json::parse(std::ifstream(folder / "table.json"));
+    } catch (const std::exception& e) {
+      missing.push_back(folder.string() + ": table.json unreadable");
+      continue;
+    }
+    const auto& values = setting_of.at(sid).at("values");
+    for (const auto& m : table.at("metrics")) {
+      for (const auto& [mode, v] : m.at("values").items()) {
+        if (!v.contains("mean") || v.at("mean").is_null()) continue;
+        const double x = v.at("mean").get<double>();
+        tidy << sid;
+        for (const auto& val : values) tidy << "," << CsvCell(val.get<std::string>());
+        tidy << "," << r.at("seed").get<std::uint64_t>() << "," << mode << ","
+             << m.at("key").get<std::string>() << "," << Exact(x) << "\n";
+        samples[{sid, mode, m.at("key").get<std::string>()}].push_back(x);
+      }
+    }
+  }
+  WriteTextFile(out / "tidy.csv", tidy.str());
+  // Aggregate: mean and 95 % CI over the seeds per setting, mode and metric.
+  std::ostringstream agg;
+  agg << "setting";
+  for (const auto& k : keys) agg << "," << CsvCell(k);
+  agg << ",mode,metric,n,mean,ci95_half_width\n";
+  nlohmann::json aj = nlohmann::json::array();
+  for (const auto& [key, xs] : samples) {
+    const auto& [sid, mode, metric] = key;
+    const eval::Summary s = eval::Summarize(xs);
+    agg << sid;
+    for (const auto& val : setting_of.at(sid).at("values"))
+      agg << "," << CsvCell(val.get<std::string>());
+    agg << "," << mode << "," << metric << "," << s.n << "," << Exact(s.mean) << ","
+        << (s.half_width ? Exact(*s.half_width) : "") << "\n";
+    aj.push_back({{"setting", sid},
+                  {"values", setting_of.at(sid).at("values")},
+                  {"mode", mode},
+                  {"metric", metric},
+                  {"n", s.n},
+                  {"mean", s.mean},
+                  {"ci95_half_width", s.half_width ? nlohmann::json(*s.half_width) : nullptr}});
+  }
+  WriteTextFile(out / "aggregate.csv", agg.str());
+  const int total = static_cast<int>(plan.at("runs").size());
+  nlohmann::json summary = {{"complete", complete == total},
+                            {"runs", total},
+                            {"runs_complete", complete},
+                            {"missing", missing},
+                            {"aggregate", aj}};
+  WriteTextFile(out / "sweep.json", summary.dump(2) + "\n");
+
+  // Figures: each metric against the first numeric axis with several values, one line per mode
+  // (mean) with dashed mean +- CI; one figure per combination of the other axes.
+  std::vector<std::string> warnings;
+  const auto axes = plan.at("axes");
+  int xaxis = -1;
+  for (std::size_t i = 0; i < axes.size() && xaxis < 0; ++i) {
+    bool numeric = axes[i].at("values").size() > 1;
+    for (const auto& v : axes[i].at("values")) {
+      try {
+        std::size_t used = 0;
+        const std::string t = v.get<std::string>();
+        std::stod(t, &used);
+        numeric = numeric && used == t.size();
+      } catch (const std::exception&) {
+        numeric = false;
+      }
+    }
+    if (numeric) xaxis = static_cast<int>(i);
+  }
+  // Figures are redrawn from the tables each time: earlier ones (other groupings) go first.
+  fs::remove_all(out / "figures");
+  if (xaxis >= 0) {
+    fs::create_directories(out / "figures");
+    // Group settings by the values of the other axes.
+    std::map<std::string, std::vector<std::string>> groups;  // label of others -> setting ids
+    for (const auto& s : plan.at("settings")) {
+      std::string others;
+      for (std::size_t i = 0; i < keys.size(); ++i)
+        if (static_cast<int>(i) != xaxis && axes[i].at("values").size() > 1)
+          others +=
+              (others.empty() ? "" : "_") + keys[i] + "=" + s.at("values")[i].get<std::string>();
+      groups[others].push_back(s.at("id"));
+    }
+    for (const char* metric : kMetrics) {
+      for (const auto& [others, ids] : groups) {
+        viz::LineChart chart;
+        chart.title = std::string(metric) + " vs " + keys[xaxis] +
+                      (others.empty() ? "" : " (" + others + ")");
+        chart.x_label = keys[xaxis];
+        chart.y_label = metric;
+        bool any = false;
+        for (const char* mode : {"position", "velocity", "dual"}) {
+          viz::LineSeries mean{mode, {}, {}}, lo{std::string(mode) + " 95 % CI", {}, {}},
+              hi{"", {}, {}};
+          lo.dashed = hi.dashed = true;
+          lo.line_width = hi.line_width = 1.0;
+          if (const auto c = viz::ModeFromName(mode)) lo.color = hi.color = viz::ModeColor(*c);
+          for (const auto& sid : ids) {
+            const auto it = samples.find({sid, mode, metric});
+            if (it == samples.end()) continue;
+            const eval::Summary s = eval::Summarize(it->second);
+            const double x = std::stod(setting_of.at(sid).at("values")[xaxis].get<std::string>());
+            mean.x.push_back(x);
+            mean.y.push_back(s.mean);
+            lo.x.push_back(x);
+            hi.x.push_back(x);
+            lo.y.push_back(s.mean - s.half_width.value_or(0.0));
+            hi.y.push_back(s.mean + s.half_width.value_or(0.0));
+          }
+          if (mean.x.empty()) continue;
+          any = true;
+          chart.series.push_back(mean);
+          chart.series.push_back(lo);
+          chart.series.push_back(hi);
+        }
+        if (!any) continue;
+        std::string name =
+            std::string(metric) + "_vs_" + keys[xaxis] + (others.empty() ? "" : "__" + others);
+        for (char& ch : name)
+          if (ch == '/' || ch == ' ' || ch == ',' || ch == '=') ch = ch == '=' ? '-' : '_';
+        const fs::path png = out / "figures" / (name + ".png");
+        TryFigure(
+            png, [&] { viz::RenderLineChart(chart, png.string()); }, &warnings);
+      }
+    }
+  }
+  if (!o.quiet) {
+    std::cerr << "collect: " << complete << " of " << total << " runs complete; tables in "
+              << out.string() << " (tidy.csv, aggregate.csv, sweep.json)";
+    if (xaxis >= 0) std::cerr << ", figures/";
+    std::cerr << "\n";
+    for (const auto& m : missing) std::cerr << "collect: missing " << m << "\n";
+  }
+  return complete == total ? kExitOk : kExitSomeSeedsFailed;
+}
+
+}  // namespace dualgrid::tools
