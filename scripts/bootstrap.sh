@@ -7,7 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake pkg-config sumo sumo-tools libeigen3-dev libyaml-cpp-dev catch2 libcli11-dev
-  nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev zlib1g-dev)
+  nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev zlib1g-dev
+  parallel)
 BUILD_DIR=${DUALGRID_BUILD_DIR:-build}
 
 source scripts/lib/install_missing.sh

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A single-node Slurm on this machine, for testing `dualgrid sweep --emit slurm` (docs/stress.md).
-# Needs the Debian packages slurm-wlm and munge (installed by scripts/bootstrap.sh cluster) and root.
+# Needs the Debian packages slurm-wlm and munge (apt-get install slurm-wlm munge) and root.
 #   scripts/slurm_single_node.sh start [STATE_DIR]   start munged, slurmctld, slurmd; wait for idle
 #   scripts/slurm_single_node.sh stop  [STATE_DIR]   stop the daemons started by `start`
 # No systemd, no cgroups, no slurm user: the settings of ../shared/notes-style single-node setups.
