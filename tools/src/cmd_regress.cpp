@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_checks.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/suite.hpp"
 #include "exit_codes.hpp"
@@ -148,7 +149,8 @@ int RunRegress(const RegressOptions& o) {
     e.first_seed = c.first_seed;
     e.jobs = o.jobs;
     e.executable = o.executable;
-    e.run.threads = (o.jobs > 0 ? o.jobs : 2) > 1 ? 1 : 0;
+    // Seeds run `jobs` at a time with one OpenMP thread each: processes x threads <= cores.
+    e.run.threads = (o.jobs > 0 ? o.jobs : Cores()) > 1 ? 1 : 0;
     try {
       const int code = RunExperiment(e);
       r.ran = code == kExitOk;
