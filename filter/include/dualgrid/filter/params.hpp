@@ -101,10 +101,11 @@ struct FilterParams {
   double decay_eps = 0.05;  ///< eps of eqs. (7), (8).
   WeightMode mode = WeightMode::kDual;
 
-  // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset.
+  // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset,
+  // the best setting of the ablation in docs/results.md; Preset("paper") gives the literal ones.
   BirthVelocity birth_velocity = BirthVelocity::kDoppler;
   ZeroLikelihood zero_likelihood = ZeroLikelihood::kKeepPrediction;
-  VelocityLikelihood velocity_likelihood = VelocityLikelihood::kVector;
+  VelocityLikelihood velocity_likelihood = VelocityLikelihood::kRadial;
   Normalisation normalisation = Normalisation::kPerCell;
 
   /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
