@@ -313,7 +313,8 @@ int RunRegress(const RegressOptions& o) {
     WriteTextFile(o.record,
                   "# Regression suite recorded by `dualgrid regress " + o.suite.string() +
                       " --record`: bands = mean ± max(3 × 95 % CI half-width, a per-metric "
-                      "floor) (docs/regression.md).\n" +
+                      "floor) (docs/regression.md);\n# orderings are copied unchanged: claims "
+                      "written by hand.\n" +
                       scenario::SuiteToYaml(rec, folder));
     if (!o.quiet) std::cerr << "regress: recorded " << o.record.string() << "\n";
   }
