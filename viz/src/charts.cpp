@@ -381,7 +381,9 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
   for (std::size_t i = 0; i < chart.series.size(); ++i) {
     const LineSeries& s = chart.series[i];
     const Rgba color = SeriesColor(s.name, s.color, static_cast<int>(i));
-    legend.push_back({s.name, color, s.dashed ? Marker::kDashedLine : Marker::kLine});
+    // A series without a name (e.g. the second line of a band) has no legend entry.
+    if (!s.name.empty())
+      legend.push_back({s.name, color, s.dashed ? Marker::kDashedLine : Marker::kLine});
     cairo_new_path(cr);
     SetColor(cr, color);
     for (std::size_t k = 0; k < s.x.size(); ++k) {

@@ -34,7 +34,7 @@ struct BarChart {
 };
 
 struct LineSeries {
-  std::string name;
+  std::string name;  ///< legend label; empty: no legend entry
   std::vector<double> x;
   std::vector<double> y;  ///< same size as x; NaN (or <= 0 on a log axis) breaks the line
   std::optional<Rgba> color;
