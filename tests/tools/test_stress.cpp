@@ -117,14 +117,28 @@ TEST_CASE("aspect cases put the target at the asked aspect angle", "[cli][stress
 TEST_CASE("aspect cases that could not be scored are refused with what to change",
           "[cli][stress]") {
   const fs::path dir = TempDir("stress", "refused");
-  // 20 m on the front_left boresight lies 15 m to the side: outside the 25 m wide grid.
+  // 20 m on the front_left boresight lies 15 m to the side: outside an explicit 25 m wide grid.
   const auto narrow =
       Run("tangential --kind aspect --sensor front_left --angle 90 --range 20 "
-          "--ego-speed 0 -q --out " +
+          "--ego-speed 0 --grid-width 25 -q --out " +
           (dir / "a.yaml").string());
   CHECK(narrow.code == 2);
-  CHECK(narrow.output.find("--grid-width") != std::string::npos);
+  CHECK(narrow.output.find("--grid-width 40") != std::string::npos);
   CHECK(CountLines(narrow.output) == 1);
+  // Without --grid-width (and without --kind: the aspect options imply it) the grid is widened
+  // to the width the error named, and the header says so.
+  const auto widened =
+      Run("tangential --sensor front_left --angle 90 --range 20 --ego-speed 0 "
+          "-q --out " +
+          (dir / "w.yaml").string());
+  CHECK(widened.code == 0);
+  const std::string text = Slurp(dir / "w.yaml");
+  CHECK(text.find("filter: {width_y: 40}") != std::string::npos);
+  CHECK(text.find("widened from the paper's 25 m to 40 m") != std::string::npos);
+  const auto mixed =
+      Run("tangential --kind crossing --angle 30 -q --out " + (dir / "m.yaml").string());
+  CHECK(mixed.code == 2);
+  CHECK(mixed.output.find("options of --kind aspect") != std::string::npos);
   const auto far =
       Run("tangential --kind aspect --sensor front_left --range 150 --ego-speed 0 "
           "--grid-width 400 -q --out " +

@@ -92,7 +92,8 @@ void Netconvert(const std::filesystem::path& nod, const std::filesystem::path& e
 
 }  // namespace
 
-std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& out) {
+std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path& out) {
+  AspectCase c = asked;  // the grid width may be widened below
   const TargetType* type = nullptr;
   for (const auto& t : kTypes)
     if (c.target == t.name) type = &t;
@@ -176,6 +177,18 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
         return false;
     return true;
   };
+  std::string widened;
+  if (!fits(c.grid_width)) {
+    double need = 0.0;
+    for (double w = 5.0 * std::ceil(c.grid_width / 5.0); w <= 400.0 && need == 0.0; w += 5.0)
+      if (fits(w)) need = w;
+    if (c.auto_grid_width && need > 0.0) {
+      widened = "# The grid is widened from the paper's " + F(c.grid_width, 0) + " m to " +
+                F(need, 0) + " m (filter.width_y) so that every target is scored.\n";
+      c.grid_width = need;
+      for (auto& t : targets) t.frames_in_grid = frames_in(t.p, t.t_ref, t.depart, need);
+    }
+  }
   if (!fits(c.grid_width)) {
     double need = 0.0;
     for (double w = 5.0 * std::ceil(c.grid_width / 5.0); w <= 400.0 && need == 0.0; w += 5.0)
@@ -243,7 +256,7 @@ std::string WriteAspectCase(const AspectCase& c, const std::filesystem::path& ou
     y << "#   target_" << k + 1 << ": t_k = " << F(targets[k].t_ref, 2) << " s at ("
       << F(targets[k].p.x(), 2) << ", " << F(targets[k].p.y(), 2) << "), departs "
       << F(targets[k].depart, 2) << " s, " << targets[k].frames_in_grid << " frames in the grid\n";
-  y << "# Network: " << out.stem().string() << ".net.xml, built by netconvert from "
+  y << widened << "# Network: " << out.stem().string() << ".net.xml, built by netconvert from "
     << out.stem().string() << ".nod.xml/.edg.xml (roads cross without junctions).\n"
     << "name: aspect_" << c.sensor << "_" << F(c.angle_deg, 0) << "\n"
     << "description: targets at aspect angle " << c.angle_deg << " deg to the " << c.sensor

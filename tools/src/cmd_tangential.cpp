@@ -127,7 +127,8 @@ int RunTangential(const TangentialOptions& o) {
     c.target = o.target;
     c.count = o.count;
     c.interval = o.interval;
-    c.grid_width = o.grid_width;
+    c.grid_width = o.grid_width.value_or(25.0);
+    c.auto_grid_width = !o.grid_width;
     c.seed = o.seed;
     if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
     const std::string what = WriteAspectCase(c, o.out);

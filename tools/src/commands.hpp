@@ -84,8 +84,9 @@ struct TangentialOptions {
   double angle = 90.0;  ///< [deg]
   double range = 20.0;  ///< [m]
   std::string target = "car";
-  double interval = 6.0;     ///< [s]
-  double grid_width = 25.0;  ///< [m]
+  double interval = 6.0;  ///< [s]
+  /// [m]; unset: the paper's 25 m, widened when a target would not be scored.
+  std::optional<double> grid_width;
 };
 
 /// `dualgrid regress`.

@@ -209,8 +209,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"car", "truck", "cyclist"}));
   Opt(tangential, "--interval", &tan.interval, "aspect: seconds between the targets")
       ->check(Number(1.0, 60.0, false));
-  Opt(tangential, "--grid-width", &tan.grid_width,
-      "aspect: the grid's width (filter.width_y) [m]; the paper's is 25")
+  tangential
+      ->add_option("--grid-width", tan.grid_width,
+                   "aspect: the grid's width (filter.width_y) [m] (default: the paper's 25, "
+                   "widened when a target would not be scored in it)")
       ->check(Number(5.0, 400.0, false));
   Opt(tangential, "--count", &tan.count, "Number of stress vehicles")->check(WholeNumber(1, 12));
   Opt(tangential, "--ego-speed", &tan.ego_speed, "Ego speed [m/s] (0, a parked ego: aspect only)")
@@ -326,7 +328,20 @@ int main(int argc, char** argv) {
       reg.executable = SelfPath(argv[0]);
       return RunRegress(reg);
     }
-    if (tangential->parsed()) return RunTangential(tan);
+    if (tangential->parsed()) {
+      // The aspect options imply --kind aspect; with another kind they would be ignored.
+      bool aspect_options = false;
+      for (const char* name :
+           {"--sensor", "--angle", "--range", "--target", "--interval", "--grid-width"})
+        aspect_options = aspect_options || tangential->count(name) > 0;
+      if (aspect_options && tangential->count("--kind") == 0) tan.kind = "aspect";
+      if (aspect_options && tan.kind != "aspect")
+        throw std::invalid_argument(
+            "--sensor, --angle, --range, --target, --interval and "
+            "--grid-width are options of --kind aspect, not " +
+            tan.kind);
+      return RunTangential(tan);
+    }
     if (snapshot->parsed()) return RunSnapshot(snap);
     if (run->parsed()) {
       run_options.figures = !run_no_figures;
