@@ -61,9 +61,11 @@ std::string Crossing(const TangentialOptions& o) {
      << "ego: {type: car, route: east, lane: 0, position: 100, speed: " << o.ego_speed
      << ", speed_policy: {mode: fixed, speed: " << o.ego_speed << "}}\n\n"
      << "traffic:\n  vehicles:\n";
+  std::string snapshots;  // when each car crosses the ego's road: it is in view then
   for (int i = 0; i < o.count; ++i) {
     const double d = o.first_distance + i * r.spacing;
     const double t_i = (800.0 - d - x0) / o.ego_speed;
+    snapshots += (snapshots.empty() ? "" : ", ") + Fixed(t_i, 2);
     const double approach = (600.0 + 0.5 * kCarLength) / r.speed;
     double depart = t_i - approach, position = 0.0;
     if (depart < 0.0) {
@@ -77,7 +79,7 @@ std::string Crossing(const TangentialOptions& o) {
   }
   os << "\nobstacles:\n  parked:\n"
      << "    - {id: parked_1, center: [400, -6.0], yaw: 0.0, length: 4.5, width: 1.8}\n"
-     << "\nevaluation:\n  focus_object: cross_1\n";
+     << "\nevaluation:\n  focus_object: cross_1\n  snapshot_times: [" << snapshots << "]\n";
   return os.str();
 }
 
@@ -156,6 +158,14 @@ int RunTangential(const TangentialOptions& o) {
                                 o.kind + " traffic" +
                                 (o.kind == "parallel" ? " (18 m + ego speed x 1 s)" : "") +
                                 ", got " + Fixed(r.spacing, 1) + " m");
+  // A crossing car is in the 25 m wide grid for 25 m / speed: it must stay the 30 frames (1.5 s)
+  // a scored target needs (min_frames_in_grid = 20, plus half a second).
+  if (o.kind == "crossing" && 25.0 / r.speed < 1.5)
+    throw std::invalid_argument(
+        "--speed " + Fixed(r.speed, 1) + " m/s: a crossing car would be in the 25 m wide grid for " +
+        Fixed(25.0 / r.speed, 2) +
+        " s, too short to be scored (1.5 s); use --speed <= 16.6, or --kind aspect (any angle, "
+        "a widened grid)");
   if (o.kind == "crossing" && o.first_distance + (o.count - 1) * r.spacing > 600.0)
     throw std::invalid_argument(
         "--first-distance + (--count - 1) x --spacing must be <= 600 m (the crossing road's "
