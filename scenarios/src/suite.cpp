@@ -86,20 +86,23 @@ RegressionSuite LoadSuite(const std::filesystem::path& file) {
     c.Require("name", &rc.name);
     // The name is a folder under --out and a JUnit suite name: letters, digits, '_' and '-',
     // not starting with '-' and not a name the reports use.
-    const bool name_ok =
-        !rc.name.empty() && rc.name.size() <= 64 && rc.name[0] != '-' && rc.name != "suite" &&
-        rc.name.find_first_not_of(
-            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") == std::string::npos;
+    const bool name_ok = !rc.name.empty() && rc.name.size() <= 64 && rc.name[0] != '-' &&
+                         rc.name != "suite" &&
+                         rc.name.find_first_not_of(
+                             "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_-") ==
+                             std::string::npos;
     if (!name_ok)
-      c.Fail("name", "expected 1-64 letters, digits, '_' or '-' (not starting with '-', not "
-                     "'suite'), got '" + rc.name + "'");
+      c.Fail("name",
+             "expected 1-64 letters, digits, '_' or '-' (not starting with '-', not "
+             "'suite'), got '" +
+                 rc.name + "'");
     if (!names.insert(rc.name).second) c.Fail("name", "'" + rc.name + "' names two cases");
     std::string scenario;
     c.Require("scenario", &scenario);
-    rc.scenario = std::filesystem::path(scenario).is_absolute()
+    rc.scenario = scenario == "tangential" || std::filesystem::path(scenario).is_absolute()
                       ? std::filesystem::path(scenario)
                       : std::filesystem::absolute(file.parent_path() / scenario).lexically_normal();
-    if (!std::filesystem::is_regular_file(rc.scenario))
+    if (!rc.IsGenerator() && !std::filesystem::is_regular_file(rc.scenario))
       c.Fail("scenario", "'" + scenario + "' not found (read relative to the suite file: " +
                              rc.scenario.string() + ")");
     c.Read("set", &rc.sets);
@@ -125,10 +128,11 @@ RegressionSuite LoadSuite(const std::filesystem::path& file) {
     rc.orderings = ReadOrderings(c);
     c.Finish();
     // The scenario must load with the overrides: a bad key fails here, before anything runs.
+    // (A generated scenario is checked when `regress` generates it, before anything runs.)
     std::vector<Override> overrides;
     try {
       for (const std::string& s : rc.sets) overrides.push_back(ParseOverride(s));
-      LoadScenario(rc.scenario, overrides);
+      if (!rc.IsGenerator()) LoadScenario(rc.scenario, overrides);
     } catch (const ConfigError& e) {
       throw ConfigError(file.string() + ": case '" + rc.name + "': " + e.what());
     }
@@ -177,7 +181,8 @@ std::string SuiteToYaml(const RegressionSuite& suite, const std::filesystem::pat
     y << YAML::BeginMap;
     y << YAML::Key << "name" << YAML::Value << c.name;
     y << YAML::Key << "scenario" << YAML::Value
-      << std::filesystem::relative(c.scenario, relative_to).string();
+      << (c.IsGenerator() ? c.scenario.string()
+                          : std::filesystem::relative(c.scenario, relative_to).string());
     if (!c.sets.empty()) y << YAML::Key << "set" << YAML::Value << YAML::Flow << c.sets;
     y << YAML::Key << "modes" << YAML::Value << YAML::Flow << c.modes;
     if (c.duration) y << YAML::Key << "duration" << YAML::Value << *c.duration;

@@ -21,6 +21,8 @@ namespace dualgrid::tools {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 // Files whose digests make a case's determinism fingerprint: what it measured, not how long it
 // took (summary.json) or where (config.json holds paths).
 constexpr const char* kDigestFiles[] = {"clusters.csv", "objects.csv", "table.csv"};
@@ -113,9 +115,35 @@ int RunRegress(const RegressOptions& o) {
         "--record with --set: a recorded baseline must be measured on the suite as written; put "
         "the overrides into the cases' `set` lists instead");
   scenario::RegressionSuite suite = scenario::LoadSuite(o.suite);
-  // Command-line overrides apply to every case, after its own; checked before anything runs.
+  const scenario::RegressionSuite as_written = suite;  // what --record writes back
+  PrepareOutputFolder(o.out);
+  // Command-line overrides apply to every case, after its own; generated scenarios are written
+  // now; everything is checked before anything runs.
   for (auto& c : suite.cases) {
     c.sets.insert(c.sets.end(), o.sets.begin(), o.sets.end());
+    if (c.IsGenerator()) {
+      TangentialOptions gen;
+      gen.kind = "aspect";
+      gen.quiet = true;
+      std::vector<std::string> rest;
+      try {
+        for (const std::string& s : c.sets) {
+          if (s.rfind("tangential.", 0) != 0) {
+            rest.push_back(s);
+            continue;
+          }
+          const std::size_t eq = s.find('=');
+          SetGeneratorOption(&gen, s.substr(11, eq - 11), s.substr(eq + 1));
+        }
+        gen.out = fs::absolute(o.out / "scenarios" / (c.name + ".yaml"));
+        fs::create_directories(gen.out.parent_path());
+        RunTangential(gen);
+      } catch (const std::invalid_argument& e) {
+        throw scenario::ConfigError(o.suite.string() + ": case '" + c.name + "': " + e.what());
+      }
+      c.scenario = gen.out;
+      c.sets = rest;
+    }
     std::vector<scenario::Override> overrides;
     for (const std::string& s : c.sets) overrides.push_back(scenario::ParseOverride(s));
     try {
@@ -125,7 +153,6 @@ int RunRegress(const RegressOptions& o) {
                                   "' with --set: " + e.what());
     }
   }
-  PrepareOutputFolder(o.out);
   std::vector<CaseResult> results;
   eval::Measured measured;
   for (std::size_t i = 0; i < suite.cases.size() && !StopSignal(); ++i) {
@@ -291,7 +318,7 @@ int RunRegress(const RegressOptions& o) {
                 << " case(s) did not run: a baseline needs every case\n";
       return kExitSomeSeedsFailed;
     }
-    scenario::RegressionSuite rec = suite;
+    scenario::RegressionSuite rec = as_written;
     for (std::size_t i = 0; i < rec.cases.size(); ++i) {
       auto& c = rec.cases[i];
       std::vector<eval::MetricRef> refs;

@@ -35,6 +35,8 @@ namespace fs = std::filesystem;
 constexpr const char* kGenerator = "tangential";
 constexpr const char* kMetrics[] = {"D", "D_v", "delta_x", "delta_v", "t_d"};
 
+}  // namespace
+
 // Sets one `tangential.KEY` option of the generator; throws std::invalid_argument.
 void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std::string& value) {
   const auto number = [&](double lo, double hi, bool lo_open) {
@@ -92,6 +94,8 @@ void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std:
         ": unknown generator option (expected kind, sensor, target, angle, range, speed, "
         "ego_speed, count, interval, grid_width, first_distance, spacing, seed)");
 }
+
+namespace {
 
 std::string SettingLabel(const std::vector<SweepAxis>& axes, const std::vector<std::string>& v) {
   std::string s;

@@ -162,8 +162,8 @@ int RunTangential(const TangentialOptions& o) {
   // a scored target needs (min_frames_in_grid = 20, plus half a second).
   if (o.kind == "crossing" && 25.0 / r.speed < 1.5)
     throw std::invalid_argument(
-        "--speed " + Fixed(r.speed, 1) + " m/s: a crossing car would be in the 25 m wide grid for " +
-        Fixed(25.0 / r.speed, 2) +
+        "--speed " + Fixed(r.speed, 1) +
+        " m/s: a crossing car would be in the 25 m wide grid for " + Fixed(25.0 / r.speed, 2) +
         " s, too short to be scored (1.5 s); use --speed <= 16.6, or --kind aspect (any angle, "
         "a widened grid)");
   if (o.kind == "crossing" && o.first_distance + (o.count - 1) * r.spacing > 600.0)

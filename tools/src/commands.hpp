@@ -123,6 +123,10 @@ struct CollectOptions {
   bool quiet = false;
 };
 
+/// Sets the generator option `key` (a `tangential.KEY` of sweeps and suites, without the
+/// prefix) from its text; throws std::invalid_argument naming the key and what was expected.
+void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std::string& value);
+
 int RunSim(const SimOptions& options);
 int RunSweep(const SweepOptions& options);
 int RunCollect(const CollectOptions& options);

@@ -17,8 +17,11 @@ namespace dualgrid::scenario {
 /// checks on its aggregated table.
 struct RegressionCase {
   std::string name;
-  std::filesystem::path scenario;  ///< absolute (the file gives it relative to the suite)
-  std::vector<std::string> sets;   ///< KEY=VALUE overrides, as for --set
+  /// Absolute (the file gives it relative to the suite); "tangential" for the stress-case
+  /// generator, whose options are the `tangential.*` entries of `sets` (as for `dualgrid sweep`).
+  std::filesystem::path scenario;
+  bool IsGenerator() const { return scenario == "tangential"; }
+  std::vector<std::string> sets;  ///< KEY=VALUE overrides, as for --set
   std::vector<std::string> modes = {"position", "velocity", "dual"};
   std::optional<double> duration;  ///< [s], as `--duration` (the scenario's when empty)
   int seeds = 3;
