@@ -147,8 +147,8 @@ std::vector<Verdict> CheckCase(const std::string& case_name, const std::vector<B
       v.why = "not measured (the case failed, or the metric is undefined in this run)";
     } else {
       v.measured = Shown(*m);
-      v.pass = std::isfinite(m->mean) && (!b.min || m->mean >= *b.min) &&
-               (!b.max || m->mean <= *b.max);
+      v.pass =
+          std::isfinite(m->mean) && (!b.min || m->mean >= *b.min) && (!b.max || m->mean <= *b.max);
       if (!v.pass && !std::isfinite(m->mean))
         v.why = "mean is not a finite number";
       else if (!v.pass)

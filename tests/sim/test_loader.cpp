@@ -80,8 +80,8 @@ TEST_CASE("A valid scenario loads with defaults filled in", "[loader]") {
 }
 
 TEST_CASE("The shipped scenarios load", "[loader]") {
-  const std::string name = GENERATE("scenarios/highway.yaml", "scenarios/simple_road.yaml",
-                                    "scenarios/soak.yaml");
+  const std::string name =
+      GENERATE("scenarios/highway.yaml", "scenarios/simple_road.yaml", "scenarios/soak.yaml");
   const auto c = LoadScenario(name);
   CHECK(c.sim.duration > 0);
   CHECK(!(c.sim.vehicles.empty() && c.sim.flows.empty()));
@@ -222,13 +222,13 @@ TEST_CASE("--set overrides are applied to the document before it is read", "[loa
 }
 
 TEST_CASE("sensors.accuracy and sensors.overrides.all", "[loader][sensors]") {
-  const auto clean = LoadScenario(Write(
-      "clean.yaml",
-      std::string(kValid) + "sensors:\n  accuracy: clean\n  overrides:\n"
-                            "    all: {range_rate_accuracy: 0.3}\n"
-                            "    front: {range_rate_accuracy: 0.05, off_boresight_deg: [0, 5],\n"
-                            "            off_boresight_resolution: [1, 2],\n"
-                            "            off_boresight_accuracy: [1, 3]}\n"));
+  const auto clean = LoadScenario(
+      Write("clean.yaml", std::string(kValid) +
+                              "sensors:\n  accuracy: clean\n  overrides:\n"
+                              "    all: {range_rate_accuracy: 0.3}\n"
+                              "    front: {range_rate_accuracy: 0.05, off_boresight_deg: [0, 5],\n"
+                              "            off_boresight_resolution: [1, 2],\n"
+                              "            off_boresight_accuracy: [1, 3]}\n"));
   CHECK(clean.radar.accuracy == "clean");
   for (const auto& s : clean.radar.sensors) {
     INFO(s.name);
@@ -245,9 +245,8 @@ TEST_CASE("sensors.accuracy and sensors.overrides.all", "[loader][sensors]") {
   CHECK(j.at("sensors").at("rig").back().at("off_boresight_deg").at(1) == Approx(5.0));
   // Data sheet by default; bad values name the key.
   CHECK(LoadScenario(Write("ds.yaml", kValid)).radar.accuracy == "datasheet");
-  CHECK(ErrorOf(std::string(kValid) + "sensors: {accuracy: perfect}\n")
-            .find("sensors.accuracy") != std::string::npos);
-  CHECK(ErrorOf(std::string(kValid) +
-                "sensors: {overrides: {all: {off_boresight_deg: [0, 10]}}}\n")
+  CHECK(ErrorOf(std::string(kValid) + "sensors: {accuracy: perfect}\n").find("sensors.accuracy") !=
+        std::string::npos);
+  CHECK(ErrorOf(std::string(kValid) + "sensors: {overrides: {all: {off_boresight_deg: [0, 10]}}}\n")
             .find("off_boresight") != std::string::npos);
 }

@@ -26,7 +26,7 @@ class ConfigError : public std::runtime_error {
 /// The `sensors:` section: the radar rig and which model effects are on.
 struct RadarConfig {
   std::vector<radar::SensorParams> sensors;  ///< default: radar::DefaultRig of the ego's box
-  std::string accuracy = "datasheet";  ///< `sensors.accuracy`: "datasheet" or "clean"
+  std::string accuracy = "datasheet";        ///< `sensors.accuracy`: "datasheet" or "clean"
   radar::ModelOptions options;
 };
 
