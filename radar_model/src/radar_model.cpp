@@ -5,7 +5,9 @@
 #include <cassert>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 namespace dualgrid::radar {
 namespace {
@@ -57,9 +59,10 @@ struct Occluder {
 
 double Cross(const Vector2& u, const Vector2& v) { return u.x() * v.y() - u.y() * v.x(); }
 
-/// Length of the part of the segment p -> q inside the box (Liang-Barsky slab clipping in the
-/// box frame); 0 if it misses.
-double LengthInsideBox(const Occluder& o, const Position& p, const Position& q) {
+/// The parameter interval [t0, t1] of p + t (q - p), t in [0, 1], inside the box (Liang-Barsky
+/// slab clipping in the box frame); std::nullopt if the segment misses it.
+std::optional<std::pair<double, double>> ClipToBox(const Occluder& o, const Position& p,
+                                                   const Position& q) {
   const Vector2 lateral(-o.axis.y(), o.axis.x());
   const Vector2 rp = p - o.a, d = q - p;
   const double s[2] = {rp.dot(o.axis), rp.dot(lateral)};
@@ -68,38 +71,27 @@ double LengthInsideBox(const Occluder& o, const Position& p, const Position& q) 
   double t0 = 0.0, t1 = 1.0;
   for (int i = 0; i < 2; ++i) {
     if (std::abs(v[i]) < 1e-12) {
-      if (std::abs(s[i]) > h[i]) return 0.0;
+      if (std::abs(s[i]) > h[i]) return std::nullopt;
       continue;
     }
     double ta = (-h[i] - s[i]) / v[i], tb = (h[i] - s[i]) / v[i];
     if (ta > tb) std::swap(ta, tb);
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
-    if (t0 > t1) return 0.0;
+    if (t0 > t1) return std::nullopt;
   }
-  return (t1 - t0) * d.norm();
+  return std::pair{t0, t1};
 }
 
-/// Does the segment p -> q cross the box (Liang-Barsky slab clipping in the box frame)?
+/// Does the segment p -> q cross the box?
 bool SegmentHitsBox(const Occluder& o, const Position& p, const Position& q) {
-  const Vector2 lateral(-o.axis.y(), o.axis.x());
-  const Vector2 rp = p - o.a, d = q - p;
-  const double s[2] = {rp.dot(o.axis), rp.dot(lateral)};
-  const double v[2] = {d.dot(o.axis), d.dot(lateral)};
-  const double h[2] = {o.half_length, o.half_width};
-  double t0 = 0.0, t1 = 1.0;
-  for (int i = 0; i < 2; ++i) {
-    if (std::abs(v[i]) < 1e-12) {
-      if (std::abs(s[i]) > h[i]) return false;
-      continue;
-    }
-    double ta = (-h[i] - s[i]) / v[i], tb = (h[i] - s[i]) / v[i];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
-  }
-  return true;
+  return ClipToBox(o, p, q).has_value();
+}
+
+/// Length of the part of the segment p -> q inside the box; 0 if it misses.
+double LengthInsideBox(const Occluder& o, const Position& p, const Position& q) {
+  const auto t = ClipToBox(o, p, q);
+  return t ? (t->second - t->first) * (q - p).norm() : 0.0;
 }
 
 bool SegmentsIntersect(const Position& p, const Position& q, const Position& a, const Position& b) {

@@ -40,14 +40,8 @@ constexpr const char* kMetrics[] = {"D", "D_v", "delta_x", "delta_v", "t_d"};
 // Sets one `tangential.KEY` option of the generator; throws std::invalid_argument.
 void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std::string& value) {
   const auto number = [&](double lo, double hi, bool lo_open) {
-    std::size_t used = 0;
     double v = 0.0;
-    try {
-      v = std::stod(value, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != value.size() || !std::isfinite(v) || (lo_open ? v <= lo : v < lo) || v > hi)
+    if (!ParseNumber(value, &v) || (lo_open ? v <= lo : v < lo) || v > hi)
       throw std::invalid_argument("tangential." + key + ": expected a number in " +
                                   (lo_open ? "(" : "[") + Exact(lo) + ", " + Exact(hi) +
                                   "], got '" + value + "'");
@@ -397,14 +391,8 @@ int RunCollect(const CollectOptions& o) {
   for (std::size_t i = 0; i < axes.size() && xaxis < 0; ++i) {
     bool numeric = axes[i].at("values").size() > 1;
     for (const auto& v : axes[i].at("values")) {
-      try {
-        std::size_t used = 0;
-        const std::string t = v.get<std::string>();
-        std::stod(t, &used);
-        numeric = numeric && used == t.size();
-      } catch (const std::exception&) {
-        numeric = false;
-      }
+      double d;
+      numeric = numeric && ParseNumber(v.get<std::string>(), &d);
     }
     if (numeric) xaxis = static_cast<int>(i);
   }

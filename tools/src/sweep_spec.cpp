@@ -10,6 +10,15 @@ namespace {
 
 constexpr std::size_t kMaxValues = 1000;
 
+// Text of a value already rounded to 12 significant digits: "90", "0.3", "1e-05".
+std::string Text(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+}  // namespace
+
 bool ParseNumber(const std::string& s, double* out) {
   if (s.empty()) return false;
   std::size_t used = 0;
@@ -20,15 +29,6 @@ bool ParseNumber(const std::string& s, double* out) {
   }
   return used == s.size() && std::isfinite(*out);
 }
-
-// Text of a value already rounded to 12 significant digits: "90", "0.3", "1e-05".
-std::string Text(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return buf;
-}
-
-}  // namespace
 
 SweepAxis ParseSweepAxis(const std::string& text) {
   const auto fail = [&](const std::string& why) {

@@ -13,6 +13,9 @@ struct SweepAxis {
   bool numeric = true;              ///< every value parses as a finite number
 };
 
+/// A finite number spelled out in full by `text` (no trailing characters); false otherwise.
+bool ParseNumber(const std::string& text, double* out);
+
 /// Parses "KEY=LIST". Throws std::invalid_argument naming the text and what is wrong: no '=' or
 /// key, an empty item, a range with step <= 0, first > last, more than 1,000 values, a
 /// non-numeric range bound, or a value given twice.
