@@ -1,7 +1,5 @@
 // `dualgrid experiment`: `dualgrid run` over several seeds (separate processes: libsumo holds one
 // simulation per process), then the paper-style tables with 95 % confidence intervals.
-#include <fcntl.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
