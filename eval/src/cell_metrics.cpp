@@ -1,5 +1,7 @@
 #include "dualgrid/eval/cell_metrics.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -34,6 +36,67 @@ void RasterizeTruth(std::span<const Position> cell_centers, std::span<const Orie
     }
     out[i] = static_cast<std::uint8_t>(c);
   }
+}
+
+namespace {
+
+// Marks with `value` every cell of `grid` whose centre lies in `b` (OrientedBox::Contains's test
+// with the rotation hoisted out of the cell loop).
+void StampBox(const RegularGrid& grid, const OrientedBox& b, std::uint8_t value,
+              std::span<std::uint8_t> out) {
+  // A non-finite box contains no centre (the comparisons below would all be false).
+  if (!b.center.allFinite() || !std::isfinite(b.yaw) || !std::isfinite(b.length) ||
+      !std::isfinite(b.width))
+    return;
+  const Matrix2 rt = Rotation(b.yaw).transpose();
+  const double hl = 0.5 * b.length, hw = 0.5 * b.width;
+  double lo_x = b.center.x(), hi_x = lo_x, lo_y = b.center.y(), hi_y = lo_y;
+  for (const Position& c : b.Corners()) {
+    lo_x = std::min(lo_x, c.x());
+    hi_x = std::max(hi_x, c.x());
+    lo_y = std::min(lo_y, c.y());
+    hi_y = std::max(hi_y, c.y());
+  }
+  const double r = grid.resolution;
+  // One cell of margin on each side: the exact test below decides, rounding cannot drop a cell.
+  auto first = [&](double lo, std::int64_t origin) {
+    return std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(lo / r)) - origin - 1);
+  };
+  auto last = [&](double hi, std::int64_t origin, int n) {
+    return std::min<std::int64_t>(n - 1,
+                                  static_cast<std::int64_t>(std::floor(hi / r)) - origin + 1);
+  };
+  const std::int64_t x0 = first(lo_x, grid.origin_ix),
+                     x1 = last(hi_x, grid.origin_ix, grid.cells_x);
+  const std::int64_t y0 = first(lo_y, grid.origin_iy),
+                     y1 = last(hi_y, grid.origin_iy, grid.cells_y);
+  for (std::int64_t y = y0; y <= y1; ++y) {
+    const double cy = (static_cast<double>(grid.origin_iy + y) + 0.5) * r;
+    for (std::int64_t x = x0; x <= x1; ++x) {
+      const Position p((static_cast<double>(grid.origin_ix + x) + 0.5) * r, cy);
+      const Vector2 d = rt * (p - b.center);
+      if (std::abs(d.x()) <= hl && std::abs(d.y()) <= hw)
+        out[static_cast<std::size_t>(y) * static_cast<std::size_t>(grid.cells_x) +
+            static_cast<std::size_t>(x)] = value;
+    }
+  }
+}
+
+}  // namespace
+
+void RasterizeTruth(const RegularGrid& grid, std::span<const OrientedBox> moving,
+                    std::span<const OrientedBox> stationary, std::span<std::uint8_t> out) {
+  const std::size_t n =
+      static_cast<std::size_t>(std::max(grid.cells_x, 0)) * std::max(grid.cells_y, 0);
+  if (out.size() != n)
+    throw std::invalid_argument("RasterizeTruth: " + std::to_string(out.size()) + " outputs for " +
+                                std::to_string(n) + " cells");
+  std::fill(out.begin(), out.end(), static_cast<std::uint8_t>(CellClass::kFree));
+  // Stationary first, moving over it: the span overload's precedence.
+  for (const OrientedBox& b : stationary)
+    StampBox(grid, b, static_cast<std::uint8_t>(CellClass::kStatic), out);
+  for (const OrientedBox& b : moving)
+    StampBox(grid, b, static_cast<std::uint8_t>(CellClass::kDynamic), out);
 }
 
 void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predicted,

@@ -1,5 +1,6 @@
 #include "dualgrid/eval/dbscan.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -43,14 +44,56 @@ Dbscan::Dbscan(const DbscanParams& params) : params_(params) {
   inv_eps_ = 1.0 / params_.eps;
 }
 
+int Dbscan::CellTable::Build(std::span<const std::int64_t> ix, std::span<const std::int64_t> iy,
+                             int pad, std::span<int> id) {
+  const std::size_t n = ix.size();
+  map.clear();
+  std::int64_t lo_x = 0, hi_x = -1, lo_y = 0, hi_y = -1;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo_x = i == 0 ? ix[i] : std::min(lo_x, ix[i]);
+    hi_x = i == 0 ? ix[i] : std::max(hi_x, ix[i]);
+    lo_y = i == 0 ? iy[i] : std::min(lo_y, iy[i]);
+    hi_y = i == 0 ? iy[i] : std::max(hi_y, iy[i]);
+  }
+  // Spans as doubles: far-apart points must not overflow the product.
+  const double area = (static_cast<double>(hi_x) - static_cast<double>(lo_x) + 1.0 + 2.0 * pad) *
+                      (static_cast<double>(hi_y) - static_cast<double>(lo_y) + 1.0 + 2.0 * pad);
+  dense = n > 0 && area <= 8.0 * static_cast<double>(n) + 65536.0;
+  int count = 0;
+  if (dense) {
+    x0 = lo_x - pad;
+    y0 = lo_y - pad;
+    w = hi_x - lo_x + 1 + 2 * pad;
+    cells.assign(static_cast<std::size_t>(area), -1);
+    for (std::size_t i = 0; i < n; ++i) {
+      int& c = cells[static_cast<std::size_t>((iy[i] - y0) * w + (ix[i] - x0))];
+      if (c < 0) c = count++;
+      id[i] = c;
+    }
+    return count;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [it, inserted] = map.try_emplace(PackKey(ix[i], iy[i]), count);
+    if (inserted) ++count;
+    id[i] = it->second;
+  }
+  return count;
+}
+
+int Dbscan::CellTable::Find(std::int64_t x, std::int64_t y) const {
+  if (dense) return cells[static_cast<std::size_t>((y - y0) * w + (x - x0))];
+  const auto it = map.find(PackKey(x, y));
+  return it == map.end() ? -1 : it->second;
+}
+
 template <typename F>
 void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
   const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
   for (std::int64_t dx = -1; dx <= 1; ++dx) {
     for (std::int64_t dy = -1; dy <= 1; ++dy) {
-      const auto it = bucket_of_key_.find(PackKey(ix + dx, iy + dy));
-      if (it != bucket_of_key_.end() && !f(it->second)) return;
+      const int b = buckets_.Find(ix + dx, iy + dy);
+      if (b >= 0 && !f(b)) return;
     }
   }
 }
@@ -68,6 +111,80 @@ void Dbscan::ForEachNeighbour(std::span<const Position> points, int i, F&& f) co
   });
 }
 
+int Dbscan::FindRoot(int c) {
+  while (parent_[c] != c) {
+    parent_[c] = parent_[parent_[c]];  // path halving
+    c = parent_[c];
+  }
+  return c;
+}
+
+int Dbscan::CoreComponents(std::span<const Position> points) {
+  // Side h < eps / sqrt(2) with a relative margin far above rounding: two points of one cell are
+  // closer than eps * (1 - 1e-9), so squaredNorm() <= eps^2 holds for them whatever the rounding.
+  // Cells up to two apart (5 x 5 block) can hold neighbours: 2 h < eps < 3 h.
+  const double inv_h = std::sqrt(2.0) / (params_.eps * (1.0 - 1e-9));
+  const double eps2 = params_.eps * params_.eps;
+  core_ids_.clear();
+  for (int i = 0; i < static_cast<int>(points.size()); ++i)
+    if (core_[i]) core_ids_.push_back(i);
+  const std::size_t m = core_ids_.size();
+  fx_.resize(m);
+  fy_.resize(m);
+  fine_cell_.resize(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    fx_[k] = static_cast<std::int64_t>(std::floor(points[core_ids_[k]].x() * inv_h));
+    fy_[k] = static_cast<std::int64_t>(std::floor(points[core_ids_[k]].y() * inv_h));
+  }
+  const int cells = fine_.Build(fx_, fy_, 2, fine_cell_);
+  fine_start_.assign(cells + 1, 0);
+  for (std::size_t k = 0; k < m; ++k) ++fine_start_[fine_cell_[k] + 1];
+  for (int c = 0; c < cells; ++c) fine_start_[c + 1] += fine_start_[c];
+  fine_sorted_.resize(m);
+  parent_.assign(fine_start_.begin(), fine_start_.end() - 1);  // borrowed as the cursor
+  for (std::size_t k = 0; k < m; ++k) fine_sorted_[parent_[fine_cell_[k]]++] = core_ids_[k];
+  // Cell coordinates per cell id (the first member's).
+  std::vector<int>& first = root_component_;
+  first.assign(cells, -1);
+  for (std::size_t k = 0; k < m; ++k)
+    if (first[fine_cell_[k]] < 0) first[fine_cell_[k]] = static_cast<int>(k);
+  parent_.resize(cells);
+  for (int c = 0; c < cells; ++c) parent_[c] = c;
+  auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
+    for (int s = fine_start_[a]; s < fine_start_[a + 1]; ++s)
+      for (int t = fine_start_[b]; t < fine_start_[b + 1]; ++t)
+        if ((points[fine_sorted_[s]] - points[fine_sorted_[t]]).squaredNorm() <= eps2) return true;
+    return false;
+  };
+  // Adjacent cells first (they almost always link), then the ring two cells away, which is then
+  // mostly joined already and skipped without a pair search.
+  for (const int ring : {1, 2}) {
+    for (int a = 0; a < cells; ++a) {
+      const std::int64_t x = fx_[first[a]], y = fy_[first[a]];
+      for (std::int64_t dx = -ring; dx <= ring; ++dx) {
+        for (std::int64_t dy = -ring; dy <= ring; ++dy) {
+          if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
+          const int b = fine_.Find(x + dx, y + dy);
+          if (b <= a) continue;  // each pair once
+          const int ra = FindRoot(a), rb = FindRoot(b);
+          if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
+        }
+      }
+    }
+  }
+  // Compact component ids in cell order.
+  int num_components = 0;
+  std::vector<int>& id_of_root = first;  // reused: first[] is no longer needed
+  id_of_root.assign(cells, -1);
+  for (int c = 0; c < cells; ++c) {
+    const int r = FindRoot(c);
+    if (id_of_root[r] < 0) id_of_root[r] = num_components++;
+  }
+  for (std::size_t k = 0; k < m; ++k)
+    component_[core_ids_[k]] = id_of_root[FindRoot(fine_cell_[k])];
+  return num_components;
+}
+
 std::span<const int> Dbscan::Run(std::span<const Position> points,
                                  std::span<const double> weights) {
   const int n = static_cast<int>(points.size());
@@ -79,19 +196,15 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
       throw std::invalid_argument("Dbscan::Run: point " + std::to_string(i) + " is not finite");
   }
 
-  // Spatial hash with cell size eps: every neighbour lies in the 3x3 block around a point's cell.
-  bucket_of_key_.clear();
-  key_.resize(n);
+  // Spatial index with cell size eps: every neighbour lies in the 3x3 block around a point's cell.
+  ix_.resize(n);
+  iy_.resize(n);
   bucket_.resize(n);
-  start_.clear();
   for (int i = 0; i < n; ++i) {
-    key_[i] = PackKey(static_cast<std::int64_t>(std::floor(points[i].x() * inv_eps_)),
-                      static_cast<std::int64_t>(std::floor(points[i].y() * inv_eps_)));
-    const auto [it, inserted] =
-        bucket_of_key_.try_emplace(key_[i], static_cast<int>(bucket_of_key_.size()));
-    bucket_[i] = it->second;
+    ix_[i] = static_cast<std::int64_t>(std::floor(points[i].x() * inv_eps_));
+    iy_[i] = static_cast<std::int64_t>(std::floor(points[i].y() * inv_eps_));
   }
-  const int num_buckets = static_cast<int>(bucket_of_key_.size());
+  const int num_buckets = buckets_.Build(ix_, iy_, 1, bucket_);
   start_.assign(num_buckets + 1, 0);
   for (int i = 0; i < n; ++i) ++start_[bucket_[i] + 1];
   for (int b = 0; b < num_buckets; ++b) start_[b + 1] += start_[b];
@@ -119,59 +232,9 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
     });
   }
 
-  // Clusters are the connected components of the core graph (order independent). The search
-  // runs over a second index holding only unvisited core points: a point leaves it when it is
-  // reached, so dense clusters are not rescanned by every member (O(n * k) -> near O(n)).
-  const double eps2 = params_.eps * params_.eps;
-  core_start_.assign(num_buckets + 1, 0);
-  core_live_.assign(num_buckets, 0);
-  for (int i = 0; i < n; ++i) core_start_[bucket_[i] + 1] += core_[i];
-  for (int b = 0; b < num_buckets; ++b) core_start_[b + 1] += core_start_[b];
-  core_sorted_.resize(core_start_[num_buckets]);
-  slot_.assign(n, -1);
-  for (const int i : sorted_) {  // bucket order, input order within a bucket
-    if (!core_[i]) continue;
-    const int b = bucket_[i];
-    slot_[i] = core_start_[b] + core_live_[b]++;
-    core_sorted_[slot_[i]] = i;
-  }
-  auto remove_core = [&](int i) {  // swap-remove i from its bucket's live range
-    const int b = bucket_[i];
-    const int last = core_start_[b] + --core_live_[b];
-    const int moved = core_sorted_[last];
-    core_sorted_[slot_[i]] = moved;
-    slot_[moved] = slot_[i];
-    core_sorted_[last] = i;
-    slot_[i] = last;
-  };
+  // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);
-  int num_components = 0;
-  for (int seed = 0; seed < n; ++seed) {
-    if (!core_[seed] || component_[seed] != kNoise) continue;
-    const int c = num_components++;
-    component_[seed] = c;
-    remove_core(seed);
-    stack_.clear();
-    stack_.push_back(seed);
-    while (!stack_.empty()) {
-      const int i = stack_.back();
-      stack_.pop_back();
-      const Position& p = points[i];
-      ForEachNearBucket(p, [&](int b) {
-        for (int s = core_start_[b]; s < core_start_[b] + core_live_[b];) {
-          const int j = core_sorted_[s];
-          if ((points[j] - p).squaredNorm() <= eps2) {
-            component_[j] = c;
-            stack_.push_back(j);
-            remove_core(j);  // slot s now holds another live point (or the range shrank)
-          } else {
-            ++s;
-          }
-        }
-        return true;
-      });
-    }
-  }
+  const int num_components = CoreComponents(points);
 
   // Border points join their nearest core neighbour's cluster (see class comment for ties).
 #pragma omp parallel for schedule(dynamic, 256)

@@ -106,6 +106,29 @@ CellState DynamicGrid::Cell(CellIndex c) const {
   return out;
 }
 
+void DynamicGrid::ExportMasses(std::span<float> free, std::span<float> static_occ,
+                               std::span<float> dynamic, std::span<std::uint8_t> observed) const {
+  const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  if (free.size() != n || static_occ.size() != n || dynamic.size() != n || observed.size() != n)
+    throw std::invalid_argument(
+        "DynamicGrid::ExportMasses: spans of " + std::to_string(free.size()) + "/" +
+        std::to_string(static_occ.size()) + "/" + std::to_string(dynamic.size()) + "/" +
+        std::to_string(observed.size()) + " entries for " + std::to_string(n) + " cells");
+  for (int y = 0; y < ny_; ++y) {
+    const std::int64_t row = Mod(origin_gy_ + y, ny_) * nx_;
+    std::int64_t sx = Mod(origin_gx_, nx_);  // walks the circular row, wrapping once
+    std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_);
+    for (int x = 0; x < nx_; ++x, ++i) {
+      const std::int64_t s = row + sx;
+      free[i] = static_cast<float>(free_[s]);
+      static_occ[i] = static_cast<float>(static_[s]);
+      dynamic[i] = static_cast<float>(dynamic_[s]);
+      observed[i] = (view_[s] & kObserved) != 0 ? 1 : 0;
+      if (++sx == nx_) sx = 0;
+    }
+  }
+}
+
 void DynamicGrid::Initialize(const EgoInput& ego) {
   const double r = params_.resolution;
   origin_gx_ = static_cast<std::int64_t>(std::floor(ego.pose.position.x() / r)) - nx_ / 2;

@@ -99,3 +99,33 @@ TEST_CASE("RasterizeTruth marks cell centres inside boxes, moving over stationar
   CHECK_THROWS_AS(RasterizeTruth(centers, moving, stationary, std::span(out).first(3)),
                   std::invalid_argument);
 }
+
+TEST_CASE("RasterizeTruth on a regular grid equals the per-centre overload", "[cells]") {
+  // Sampled boxes (any yaw, partly outside, on exact cell boundaries, axis-aligned one-cell-wide
+  // rails whose edges pass through centres) on a grid whose origin index is negative.
+  const dualgrid::eval::RegularGrid grid{-37, 12, 0.5, 60, 24};
+  std::vector<Position> centers;
+  for (int y = 0; y < grid.cells_y; ++y)
+    for (int x = 0; x < grid.cells_x; ++x)
+      centers.emplace_back((static_cast<double>(grid.origin_ix + x) + 0.5) * grid.resolution,
+                           (static_cast<double>(grid.origin_iy + y) + 0.5) * grid.resolution);
+  dualgrid::CounterRng rng(7, dualgrid::RngPurpose::kTest, 0, 0);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<OrientedBox> moving, stationary;
+    for (int k = 0; k < 4; ++k) {
+      OrientedBox b{{-22.0 + 30.0 * rng.Uniform(), 3.0 + 15.0 * rng.Uniform()},
+                    -4.0 + 8.0 * rng.Uniform(),
+                    0.2 + 15.0 * rng.Uniform(),
+                    0.2 + 3.0 * rng.Uniform()};
+      (k % 2 == 0 ? moving : stationary).push_back(b);
+    }
+    // A rail one cell wide centred on a row of cell edges: its long sides pass through centres.
+    stationary.push_back({{-5.0, 9.0}, 0.0, 40.0, grid.resolution});
+    std::vector<std::uint8_t> a(centers.size(), 99), b(centers.size(), 99);
+    RasterizeTruth(centers, moving, stationary, a);
+    RasterizeTruth(grid, moving, stationary, b);
+    REQUIRE(a == b);
+  }
+  std::vector<std::uint8_t> wrong(3);
+  CHECK_THROWS_AS(RasterizeTruth(grid, {}, {}, wrong), std::invalid_argument);
+}

@@ -23,6 +23,17 @@ inline constexpr double kMaxDuration = 3600.0;
 /// The machine's cores (at least 1).
 int Cores();
 
+/// How parallel runs share the cores: `jobs` child processes at a time, each with `threads` OpenMP
+/// threads. Given values (> 0) are kept; by default jobs = min(cores, tasks) and
+/// threads = cores / jobs, so that jobs x threads <= cores (spinning or oversubscribed OpenMP
+/// teams slow every run by an order of magnitude on a shared machine: docs/performance.md).
+struct CoreSplit {
+  int jobs = 1, threads = 1, cores = 1;
+  /// "2 processes at a time x 1 thread on 2 cores", flagged when jobs x threads > cores.
+  std::string Describe() const;
+};
+CoreSplit SplitCores(int jobs, int threads, int tasks);
+
 /// A whole number in [lo, hi] (no sign for lo >= 0, no fraction, no trailing text).
 CLI::Validator WholeNumber(long long lo, long long hi);
 /// A non-empty path (an empty --out would write into the working folder).

@@ -34,7 +34,7 @@ std::filesystem::path LogPath(const std::filesystem::path& seed_dir) {
 }
 
 pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesystem::path& dir,
-               bool figures) {
+               bool figures, int threads) {
   std::filesystem::create_directories(dir.parent_path());
   std::vector<std::string> args = {o.executable,
                                    "run",
@@ -60,7 +60,7 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   args.insert(args.end(), {"--detections", o.run.detections});
   if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.check_invariants) args.push_back("--check-invariants");
-  if (o.run.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.run.threads)});
+  args.insert(args.end(), {"--threads", std::to_string(threads)});
   // Beside the run folder, which the run itself prepares (docs/output.md).
   return StartChild(std::move(args), LogPath(dir));
 }
@@ -82,7 +82,10 @@ int RunExperiment(const ExperimentOptions& o) {
   const auto& out = o.run.run.out;
   PrepareOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
-  const int jobs = o.jobs > 0 ? o.jobs : Cores();
+  const CoreSplit split = SplitCores(o.jobs, o.run.threads, o.seeds);
+  const int jobs = split.jobs;
+  if (!o.run.run.quiet)
+    std::cerr << "experiment: " << o.seeds << " seeds, " << split.Describe() << "\n";
   auto seed_dir = [&](std::uint64_t seed) {
     return out / "seeds" / ("seed_" + std::to_string(seed));
   };
@@ -98,7 +101,8 @@ int RunExperiment(const ExperimentOptions& o) {
   while (done < o.seeds) {
     while (!StopSignal() && next < o.seeds && static_cast<int>(running.size()) < jobs) {
       const std::uint64_t seed = o.first_seed + next++;
-      running[StartRun(o, seed, seed_dir(seed), o.run.figures && seed == o.first_seed)] = seed;
+      running[StartRun(o, seed, seed_dir(seed), o.run.figures && seed == o.first_seed,
+                       split.threads)] = seed;
     }
     if (StopSignal() && !forwarded) {
       // Each run stops at the end of its step and writes its part, marked incomplete.

@@ -161,7 +161,7 @@ int RunRegress(const RegressOptions& o) {
     r.name = c.name;
     if (!o.quiet)
       std::cerr << "regress: case " << i + 1 << "/" << suite.cases.size() << " " << c.name << " ("
-                << c.seeds << " seeds)\n";
+                << c.seeds << " seeds, " << SplitCores(o.jobs, 0, c.seeds).Describe() << ")\n";
     const auto t0 = std::chrono::steady_clock::now();
     ExperimentOptions e;
     e.run.run.scenario = c.scenario;
@@ -176,8 +176,7 @@ int RunRegress(const RegressOptions& o) {
     e.first_seed = c.first_seed;
     e.jobs = o.jobs;
     e.executable = o.executable;
-    // Seeds run `jobs` at a time with one OpenMP thread each: processes x threads <= cores.
-    e.run.threads = (o.jobs > 0 ? o.jobs : Cores()) > 1 ? 1 : 0;
+    // experiment splits the cores (SplitCores: processes x threads <= cores) per case.
     try {
       const int code = RunExperiment(e);
       r.ran = code == kExitOk;

@@ -2,8 +2,10 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <iostream>
 
@@ -76,6 +78,8 @@ std::vector<double> SnapshotTimes(const FilterRunOptions& options,
 
 int RunFilters(const FilterRunOptions& options) {
   if (options.threads > 0) omp_set_num_threads(options.threads);
+  // No nested teams: a filter running inside the modes' team uses one thread.
+  omp_set_max_active_levels(1);
   const std::vector<filter::WeightMode> modes = ParseModes(options.modes);
   std::vector<std::string> mode_names;
   for (auto m : modes) mode_names.emplace_back(filter::ToString(m));
@@ -109,23 +113,61 @@ int RunFilters(const FilterRunOptions& options) {
                     config.sim.StepCount(), !options.run.quiet);
   int steps = 0;
   std::size_t total_detections = 0;
-  while (!StopSignal() && pipeline.Step()) {
+  std::vector<GridSnapshot> snaps(modes.size());  // storage reused every step
+  // The modes run concurrently, one thread each, with three barriers per step instead of the
+  // filters' ~30 parallel regions: robust when another process shares the cores
+  // (docs/performance.md). With one mode (or one thread) the filter's own loops are parallel.
+  const int team = std::min(static_cast<int>(modes.size()), omp_get_max_threads());
+  std::vector<std::exception_ptr> errors(modes.size());
+  while (!StopSignal() && pipeline.Advance()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
     total_detections += pipeline.detections().size();
-    std::vector<GridSnapshot> snaps;
+    // Several requested times may fall into one step: one picture for all of them.
+    bool picture = false;
+    while (next_snapshot < snapshot_times.size() &&
+           f.time + 1e-9 >= snapshot_times[next_snapshot]) {
+      picture = true;
+      ++next_snapshot;
+    }
+    const bool with_velocity = picture && (options.figures || options.write_particles);
     // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
     // and per object is computed once for the first and holds for every mode.
     std::vector<std::uint8_t> truth_classes;
-    const std::vector<eval::TruthObject> objects = pipeline.TruthObjects(pipeline.grid(0));
-    for (std::size_t m = 0; m < modes.size(); ++m) {
-      const auto& grid = pipeline.grid(m);
-      snaps.push_back(TakeSnapshot(grid));
-      if (m == 0) truth_classes = TruthClasses(snaps[0], f, config.sim);
-      scorers[m].AddFrame(f.time, grid, snaps[m], objects, truth_classes, f.ego.box);
-      clusters.Write(f, mode_names[m], scorers[m], objects, pipeline.ids());
+    std::vector<eval::TruthObject> objects;
+    // Exceptions must not leave a parallel region: kept per mode, rethrown after it.
+    auto guarded = [&](std::size_t m, auto&& work) {
+      try {
+        work();
+      } catch (...) {
+        errors[m] = std::current_exception();
+      }
+    };
+#pragma omp parallel num_threads(team) if (team > 1)
+    {
+#pragma omp for schedule(dynamic, 1)
+      for (std::size_t m = 0; m < modes.size(); ++m) guarded(m, [&] { pipeline.UpdateFilter(m); });
+#pragma omp single
+      guarded(0, [&] {
+        objects = pipeline.TruthObjects(pipeline.grid(0));
+        TakeSnapshot(pipeline.grid(0), with_velocity, snaps[0]);
+        truth_classes = TruthClasses(snaps[0], f, config.sim);
+      });
+#pragma omp for schedule(dynamic, 1)
+      for (std::size_t m = 0; m < modes.size(); ++m) {
+        guarded(m, [&] {
+          if (errors[0]) return;
+          if (m > 0) TakeSnapshot(pipeline.grid(m), with_velocity, snaps[m]);
+          scorers[m].AddFrame(f.time, pipeline.grid(m), snaps[m], objects, truth_classes,
+                              f.ego.box);
+        });
+      }
     }
+    for (auto& e : errors)
+      if (e) std::rethrow_exception(e);
+    for (std::size_t m = 0; m < modes.size(); ++m)
+      clusters.Write(f, mode_names[m], scorers[m], objects, pipeline.ids());
     traces.Add(pipeline, trace_mode);
     if (options.check_invariants) {
       for (std::size_t m = 0; m < modes.size(); ++m)
@@ -134,13 +176,6 @@ int RunFilters(const FilterRunOptions& options) {
                                  mode_names[m] + "): " + *broken);
       if (steps % std::max(1, static_cast<int>(std::lround(60.0 / config.sim.step_length))) == 0)
         rss_mb.push_back({f.time, ResidentMegabytes()});
-    }
-    // Several requested times may fall into one step: one picture for all of them.
-    bool picture = false;
-    while (next_snapshot < snapshot_times.size() &&
-           f.time + 1e-9 >= snapshot_times[next_snapshot]) {
-      picture = true;
-      ++next_snapshot;
     }
     const std::string stamp = Fixed(f.time, 2);
     if (options.figures && picture) {

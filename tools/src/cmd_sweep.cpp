@@ -252,10 +252,11 @@ int RunSweep(const SweepOptions& o) {
   }
 
   // Local: `jobs` runs at a time, one OpenMP thread each (processes x threads <= cores).
-  const int jobs = o.jobs > 0 ? o.jobs : Cores();
+  const CoreSplit split = SplitCores(o.jobs, 1, static_cast<int>(runs.size()));
+  const int jobs = split.jobs;
   if (!o.quiet)
     std::cerr << "sweep: " << settings.size() << " settings x " << o.seeds
-              << " seeds = " << runs.size() << " runs, " << jobs << " at a time, 1 thread each\n";
+              << " seeds = " << runs.size() << " runs, " << split.Describe() << "\n";
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < runs.size(); ++i)
     if (!RunComplete(runs[i].second)) todo.push_back(i);

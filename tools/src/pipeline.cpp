@@ -70,11 +70,21 @@ radar::Scene Pipeline::BuildScene() {
 }
 
 bool Pipeline::Step() {
+  if (!Advance()) return false;
+  for (std::size_t i = 0; i < filters_.size(); ++i) UpdateFilter(i);
+  return true;
+}
+
+void Pipeline::UpdateFilter(std::size_t i) {
+  filters_[i]->Update({ego_.pose, ego_.velocity}, measurements_, coverage_, dt_);
+}
+
+bool Pipeline::Advance() {
   if (!simulation_.Step()) return false;
   const sim::Frame& f = frame();
   ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
   // The first filter cycle (the ego may depart late) predicts over one step.
-  const double dt = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
+  dt_ = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
   last_time_ = f.time;
 
   detections_ = radar_.Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
@@ -96,8 +106,6 @@ bool Pipeline::Step() {
     const Pose2 pose = radar_.SensorPose(s, ego_.pose);
     coverage_.push_back({pose.position, pose.yaw, 0.5 * p.fov, p.min_range, p.max_range});
   }
-  const filter::EgoInput ego{ego_.pose, ego_.velocity};
-  for (auto& g : filters_) g->Update(ego, measurements_, coverage_, dt);
   return true;
 }
 

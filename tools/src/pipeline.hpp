@@ -44,6 +44,11 @@ class Pipeline {
 
   /// Advances SUMO one step, scans the due radars and updates every filter. False at the end.
   bool Step();
+  /// The first half of Step(): SUMO and the radars, and the filters' inputs. False at the end.
+  bool Advance();
+  /// The second half for one filter: independent per filter, so callers may run the filters
+  /// concurrently (each with a one-thread team inside; docs/performance.md).
+  void UpdateFilter(std::size_t i);
 
   const scenario::ScenarioConfig& config() const { return config_; }
   const sim::Frame& frame() const { return simulation_.frame(); }
@@ -80,6 +85,7 @@ class Pipeline {
   std::vector<filter::Measurement> measurements_;
   std::vector<filter::SensorCoverage> coverage_;
   double last_time_ = 0.0;
+  double dt_ = 0.0;  // of the last Advance() [s]
 };
 
 }  // namespace dualgrid::tools

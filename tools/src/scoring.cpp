@@ -4,34 +4,32 @@
 
 namespace dualgrid::tools {
 
-GridSnapshot TakeSnapshot(const filter::DynamicGrid& grid) {
-  GridSnapshot s;
+void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s) {
   s.cells_x = grid.cells_x();
   s.cells_y = grid.cells_y();
   s.resolution = grid.resolution();
+  s.origin_ix = grid.origin_index()[0];
+  s.origin_iy = grid.origin_index()[1];
   s.origin = grid.CellCenter({0, 0}) - Position::Constant(0.5 * s.resolution);
   const std::size_t n = static_cast<std::size_t>(s.cells_x) * s.cells_y;
   s.free.resize(n);
   s.static_occ.resize(n);
   s.dynamic.resize(n);
+  s.observed.resize(n);
+  grid.ExportMasses(s.free, s.static_occ, s.dynamic, s.observed);
+  s.mean_vx.clear();
+  s.mean_vy.clear();
+  if (!with_velocity) return;
   s.mean_vx.resize(n);
   s.mean_vy.resize(n);
-  s.observed.resize(n);
-  s.centers.resize(n);
   for (int y = 0; y < s.cells_y; ++y) {
     for (int x = 0; x < s.cells_x; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * s.cells_x + x;
       const filter::CellState c = grid.Cell({x, y});
-      s.free[i] = static_cast<float>(c.free);
-      s.static_occ[i] = static_cast<float>(c.static_occ);
-      s.dynamic[i] = static_cast<float>(c.dynamic);
       s.mean_vx[i] = static_cast<float>(c.mean_velocity.x());
       s.mean_vy[i] = static_cast<float>(c.mean_velocity.y());
-      s.observed[i] = c.observed ? 1 : 0;
-      s.centers[i] = grid.CellCenter({x, y});
     }
   }
-  return s;
 }
 
 namespace {
@@ -75,8 +73,10 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Fram
       if (NearGrid(box, lo, hi)) stationary.push_back(box);
     }
   }
-  std::vector<std::uint8_t> out(grid.centers.size());
-  eval::RasterizeTruth(grid.centers, moving, stationary, out);
+  std::vector<std::uint8_t> out(grid.free.size());
+  eval::RasterizeTruth(
+      {grid.origin_ix, grid.origin_iy, grid.resolution, grid.cells_x, grid.cells_y}, moving,
+      stationary, out);
   return out;
 }
 

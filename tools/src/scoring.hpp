@@ -17,14 +17,17 @@ namespace dualgrid::tools {
 /// Per-cell snapshot of a grid in logical row-major order (index = y * cells_x + x).
 struct GridSnapshot {
   int cells_x = 0, cells_y = 0;
-  double resolution = 0.0;
-  Position origin = Position::Zero();  ///< lower-left corner of cell (0, 0), world
-  std::vector<float> free, static_occ, dynamic, mean_vx, mean_vy;
+  double resolution = 0.0;                    ///< [m]
+  std::int64_t origin_ix = 0, origin_iy = 0;  ///< global index of cell (0, 0)
+  Position origin = Position::Zero();         ///< lower-left corner of cell (0, 0), world [m]
+  std::vector<float> free, static_occ, dynamic;
   std::vector<std::uint8_t> observed;
-  /// Cell centres, world frame.
-  std::vector<Position> centers;
+  /// Mean velocity over ground [m/s] per cell; empty unless taken `with_velocity`.
+  std::vector<float> mean_vx, mean_vy;
 };
-GridSnapshot TakeSnapshot(const filter::DynamicGrid& grid);
+/// Fills `s` (reusing its storage). The velocity moments cost a pass over every particle and are
+/// needed only for figures and particle files, so scoring takes it without them.
+void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s);
 
 /// Ground-truth class per cell: moving vehicles dynamic; parked boxes and guard rails (as boxes
 /// one cell wide) static; the rest free. Boxes are culled to the grid first.
@@ -34,7 +37,7 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Fram
 class ModeScorer {
  public:
   explicit ModeScorer(const scenario::EvaluationConfig& config);
-  /// Scores one cycle. `snapshot` is TakeSnapshot(grid); `truth_classes` from TruthClasses.
+  /// Scores one cycle. `snapshot` is TakeSnapshot(grid, ...); `truth_classes` from TruthClasses.
   /// Particles inside `ego_box` are not clustered: no other object can be there, and particles
   /// there would chain the vehicles on both sides of the ego into one cluster.
   void AddFrame(double time, const filter::DynamicGrid& grid, const GridSnapshot& snapshot,

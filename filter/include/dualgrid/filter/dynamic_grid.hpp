@@ -3,6 +3,7 @@
 // Pipeline and choices: docs/algorithm.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -80,6 +81,16 @@ class DynamicGrid {
   std::optional<CellIndex> CellOf(const Position& p) const;
   /// Throws std::out_of_range for an index outside the grid.
   CellState Cell(CellIndex c) const;
+  /// Global index of logical cell (0, 0): its centre is ((gx + 0.5) r, (gy + 0.5) r) [m], the
+  /// exact arithmetic of CellCenter, so callers rasterising onto the grid agree with it bit for
+  /// bit.
+  std::array<std::int64_t, 2> origin_index() const { return {origin_gx_, origin_gy_}; }
+  /// Masses [probability] and the observed flag of every cell in logical row-major order (index
+  /// y * cells_x() + x), the values Cell() returns, without its velocity moments. Each span must
+  /// hold cells_x() * cells_y() entries (std::invalid_argument otherwise). O(cells), no allocation:
+  /// the scorer reads this every cycle; figures use Cell() for the velocities only when drawn.
+  void ExportMasses(std::span<float> free, std::span<float> static_occ, std::span<float> dynamic,
+                    std::span<std::uint8_t> observed) const;
 
   /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count).
   const ParticleSet& particles() const { return particles_; }
