@@ -28,8 +28,15 @@ struct Target {
 // nearest of the given sensors (long-range front radar + four corner radars).
 class Scene {
  public:
-  Scene(double length, double width, int targets, int per_target, double sensor_range)
-      : length_(length), width_(width), per_target_(per_target), range_(sensor_range) {
+  // `rail_points` > 0 adds two guard rails (static, 1 m inside the grid's long sides) returning
+  // that many detections each per cycle: the bulk of the highway's ~700 detections per step.
+  Scene(double length, double width, int targets, int per_target, double sensor_range,
+        int rail_points = 0)
+      : length_(length),
+        width_(width),
+        per_target_(per_target),
+        range_(sensor_range),
+        rail_points_(rail_points) {
     for (int i = 0; i < targets; ++i) {
       CounterRng rng(42, RngPurpose::kTest, 0, static_cast<std::uint32_t>(i));
       const bool parked = rng.Uniform() < 0.2;
@@ -65,6 +72,17 @@ class Scene {
         z_.push_back({p, t.v.dot(los) * los, s.origin});
       }
     }
+    for (int side = 0; side < 2 && rail_points_ > 0; ++side) {
+      CounterRng rng(43, RngPurpose::kTest, step, static_cast<std::uint32_t>(side));
+      const double y = (side == 0 ? 1.0 : -1.0) * (0.5 * width_ - 1.0);
+      for (int k = 0; k < rail_points_; ++k) {
+        const Position p(ego_.position.x() + rng.Uniform(-0.45, 0.45) * length_,
+                         ego_.position.y() + y);
+        const SensorCoverage& s = p.x() >= ego_.position.x() ? coverage_[side == 0 ? 1 : 2]
+                                                               : coverage_[side == 0 ? 3 : 4];
+        z_.push_back({p, Vector2::Zero(), s.origin});
+      }
+    }
   }
 
   EgoInput ego() const { return {ego_, {25.0, 0.0}}; }
@@ -75,6 +93,7 @@ class Scene {
   double length_, width_;
   int per_target_;
   double range_;
+  int rail_points_;
   Pose2 ego_;
   std::vector<Target> targets_;
   std::vector<Measurement> z_;
@@ -112,6 +131,21 @@ void BM_PaperConfig(benchmark::State& state) {
   RunCycles(state, fp, scene);
 }
 BENCHMARK(BM_PaperConfig)
+    ->Args({10000, 1})
+    ->Args({10000, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+// Paper size with a highway-like load: 20 vehicles x 10 detections plus two guard rails with 250
+// static returns each (700 detections per cycle, the highway scenario's average).
+void BM_PaperHighway(benchmark::State& state) {
+  FilterParams fp;
+  fp.num_particles = static_cast<int>(state.range(0));
+  fp.num_birth = fp.num_particles / 10;
+  Scene scene(fp.length_x, fp.width_y, 20, 10, 200.0, 250);
+  RunCycles(state, fp, scene);
+}
+BENCHMARK(BM_PaperHighway)
     ->Args({10000, 1})
     ->Args({10000, 2})
     ->Unit(benchmark::kMicrosecond)

@@ -90,11 +90,13 @@ template <typename F>
 void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
   const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
-  for (std::int64_t dx = -1; dx <= 1; ++dx) {
-    for (std::int64_t dy = -1; dy <= 1; ++dy) {
-      const int b = buckets_.Find(ix + dx, iy + dy);
-      if (b >= 0 && !f(b)) return;
-    }
+  // The point's own cell first: in a dense cluster the core test then stops after a few
+  // distances instead of scanning the far corners of the neighbouring cells (~10x on vehicles).
+  static constexpr int kOrder[9][2] = {{0, 0},  {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
+                                       {0, 1}, {1, -1},  {1, 0},  {1, 1}};
+  for (const auto& [dx, dy] : kOrder) {
+    const int b = buckets_.Find(ix + dx, iy + dy);
+    if (b >= 0 && !f(b)) return;
   }
 }
 

@@ -114,9 +114,9 @@ int RunFilters(const FilterRunOptions& options) {
   int steps = 0;
   std::size_t total_detections = 0;
   std::vector<GridSnapshot> snaps(modes.size());  // storage reused every step
-  // The modes run concurrently, one thread each, with three barriers per step instead of the
-  // filters' ~30 parallel regions: robust when another process shares the cores
-  // (docs/performance.md). With one mode (or one thread) the filter's own loops are parallel.
+  // The modes run concurrently as tasks, one thread each, in one parallel region per step instead
+  // of the filters' ~30: robust when another process shares the cores (docs/performance.md).
+  // With one mode (or one thread) the filter's own loops are parallel instead.
   const int team = std::min(static_cast<int>(modes.size()), omp_get_max_threads());
   std::vector<std::exception_ptr> errors(modes.size());
   while (!StopSignal() && pipeline.Advance()) {
@@ -144,26 +144,44 @@ int RunFilters(const FilterRunOptions& options) {
         errors[m] = std::current_exception();
       }
     };
+    // Tasks: filter m, then (after filter 0) the shared truth, then scoring m once both are done.
+    // A thread that finished a filter scores while another still filters (3 modes on 2 cores).
+    std::vector<char> filtered(modes.size()), truth_done(1);
+    std::exception_ptr truth_error;
+    char* const f_dep = filtered.data();
+    char* const t_dep = truth_done.data();
 #pragma omp parallel num_threads(team) if (team > 1)
-    {
-#pragma omp for schedule(dynamic, 1)
-      for (std::size_t m = 0; m < modes.size(); ++m) guarded(m, [&] { pipeline.UpdateFilter(m); });
 #pragma omp single
-      guarded(0, [&] {
-        objects = pipeline.TruthObjects(pipeline.grid(0));
-        TakeSnapshot(pipeline.grid(0), with_velocity, snaps[0]);
-        truth_classes = TruthClasses(snaps[0], f, config.sim);
-      });
-#pragma omp for schedule(dynamic, 1)
+    {
       for (std::size_t m = 0; m < modes.size(); ++m) {
+#pragma omp task depend(out : f_dep[m]) shared(pipeline, errors)
+        guarded(m, [&] { pipeline.UpdateFilter(m); });
+        if (m == 0) {
+          // clang-format off
+#pragma omp task depend(in: f_dep[0]) depend(out: t_dep[0]) \
+    shared(pipeline, truth_error, objects, truth_classes, snaps, f)
+          // clang-format on
+          try {
+            objects = pipeline.TruthObjects(pipeline.grid(0));
+            TakeSnapshot(pipeline.grid(0), with_velocity, snaps[0]);
+            truth_classes = TruthClasses(snaps[0], f, config.sim);
+          } catch (...) {
+            truth_error = std::current_exception();
+          }
+        }
+        // clang-format off
+#pragma omp task depend(in: f_dep[m], t_dep[0]) \
+    shared(pipeline, errors, truth_error, objects, truth_classes, snaps, scorers, f)
+        // clang-format on
         guarded(m, [&] {
-          if (errors[0]) return;
+          if (truth_error || errors[m]) return;
           if (m > 0) TakeSnapshot(pipeline.grid(m), with_velocity, snaps[m]);
           scorers[m].AddFrame(f.time, pipeline.grid(m), snaps[m], objects, truth_classes,
                               f.ego.box);
         });
       }
     }
+    if (truth_error) std::rethrow_exception(truth_error);
     for (auto& e : errors)
       if (e) std::rethrow_exception(e);
     for (std::size_t m = 0; m < modes.size(); ++m)
