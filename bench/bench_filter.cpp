@@ -79,7 +79,7 @@ class Scene {
         const Position p(ego_.position.x() + rng.Uniform(-0.45, 0.45) * length_,
                          ego_.position.y() + y);
         const SensorCoverage& s = p.x() >= ego_.position.x() ? coverage_[side == 0 ? 1 : 2]
-                                                               : coverage_[side == 0 ? 3 : 4];
+                                                             : coverage_[side == 0 ? 3 : 4];
         z_.push_back({p, Vector2::Zero(), s.origin});
       }
     }

@@ -40,16 +40,15 @@ void RasterizeTruth(std::span<const Position> cell_centers, std::span<const Orie
 
 namespace {
 
-// Marks with `value` every cell of `grid` whose centre lies in `b` (OrientedBox::Contains's test
-// with the rotation hoisted out of the cell loop).
+// Marks with `value` every cell of `grid` whose centre lies in `b` (BoxTest: Contains's test with
+// the rotation hoisted out of the cell loop).
 void StampBox(const RegularGrid& grid, const OrientedBox& b, std::uint8_t value,
               std::span<std::uint8_t> out) {
   // A non-finite box contains no centre (the comparisons below would all be false).
   if (!b.center.allFinite() || !std::isfinite(b.yaw) || !std::isfinite(b.length) ||
       !std::isfinite(b.width))
     return;
-  const Matrix2 rt = Rotation(b.yaw).transpose();
-  const double hl = 0.5 * b.length, hw = 0.5 * b.width;
+  const BoxTest box(b);
   double lo_x = b.center.x(), hi_x = lo_x, lo_y = b.center.y(), hi_y = lo_y;
   for (const Position& c : b.Corners()) {
     lo_x = std::min(lo_x, c.x());
@@ -73,9 +72,7 @@ void StampBox(const RegularGrid& grid, const OrientedBox& b, std::uint8_t value,
   for (std::int64_t y = y0; y <= y1; ++y) {
     const double cy = (static_cast<double>(grid.origin_iy + y) + 0.5) * r;
     for (std::int64_t x = x0; x <= x1; ++x) {
-      const Position p((static_cast<double>(grid.origin_ix + x) + 0.5) * r, cy);
-      const Vector2 d = rt * (p - b.center);
-      if (std::abs(d.x()) <= hl && std::abs(d.y()) <= hw)
+      if (box.Contains({(static_cast<double>(grid.origin_ix + x) + 0.5) * r, cy}))
         out[static_cast<std::size_t>(y) * static_cast<std::size_t>(grid.cells_x) +
             static_cast<std::size_t>(x)] = value;
     }

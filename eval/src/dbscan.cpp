@@ -92,7 +92,7 @@ void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
   // The point's own cell first: in a dense cluster the core test then stops after a few
   // distances instead of scanning the far corners of the neighbouring cells (~10x on vehicles).
-  static constexpr int kOrder[9][2] = {{0, 0},  {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
+  static constexpr int kOrder[9][2] = {{0, 0}, {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
                                        {0, 1}, {1, -1},  {1, 0},  {1, 1}};
   for (const auto& [dx, dy] : kOrder) {
     const int b = buckets_.Find(ix + dx, iy + dy);

@@ -1,4 +1,5 @@
-// Step 7 of the cycle (docs/algorithm.md): new-born particles from the birth mass.
+// Step 7 of the cycle (docs/algorithm.md): new-born particles from the birth mass (Nuss et al.'s
+// birth; the paper gives it no equation), velocities from the Doppler of eq. (1).
 #include "dualgrid/filter/dynamic_grid.hpp"
 
 #include <algorithm>

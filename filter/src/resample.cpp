@@ -1,5 +1,5 @@
 // Step 8 of the cycle (docs/algorithm.md): systematic resampling of persistent and new-born
-// particles.
+// particles on the mode's weight (in dual mode w_resample = max(w_position, w_velocity), eq. 14).
 #include "dualgrid/filter/dynamic_grid.hpp"
 
 #include <algorithm>

@@ -150,6 +150,8 @@ int RunFilters(const FilterRunOptions& options) {
     std::exception_ptr truth_error;
     char* const f_dep = filtered.data();
     char* const t_dep = truth_done.data();
+    (void)f_dep;  // used only in depend clauses, which GCC 12's -Wunused-variable misses
+    (void)t_dep;
 #pragma omp parallel num_threads(team) if (team > 1)
 #pragma omp single
     {

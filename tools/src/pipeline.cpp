@@ -95,7 +95,7 @@ bool Pipeline::Advance() {
   measurements_.clear();
   // Nothing but the ego can be inside the ego's own footprint: returns there (clutter drawn down
   // to the sensors' minimum range) would feed particles that ride along with the ego.
-  const OrientedBox ego_box = f.ego.box;
+  const BoxTest ego_box(f.ego.box);
   for (const radar::Detection& d : detections_) {
     if (ego_box.Contains(d.position_world)) continue;
     measurements_.push_back({d.position_world, d.radial_velocity_world, d.sensor_position_world});

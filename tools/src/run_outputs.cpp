@@ -41,7 +41,7 @@ void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
     in_grid.insert(v.id);
     if (dropped.count(v.id)) continue;
     double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
-    const OrientedBox grown{v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0};
+    const BoxTest grown({v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0});
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
       wp += p.w_position[i];

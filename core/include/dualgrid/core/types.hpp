@@ -86,6 +86,26 @@ struct OrientedBox {
   }
 };
 
+/// OrientedBox::Contains for many points: the rotation is computed once (a sincos per call showed
+/// in profiles). Same arithmetic as Contains, so the same answer bit for bit.
+class BoxTest {
+ public:
+  explicit BoxTest(const OrientedBox& b)
+      : center_(b.center),
+        rt_(Rotation(b.yaw).transpose()),
+        hl_(0.5 * b.length),
+        hw_(0.5 * b.width) {}
+  bool Contains(const Position& p) const {
+    const Vector2 d = rt_ * (p - center_);
+    return std::abs(d.x()) <= hl_ && std::abs(d.y()) <= hw_;
+  }
+
+ private:
+  Position center_;
+  Matrix2 rt_;
+  double hl_, hw_;
+};
+
 /// Velocity [m/s] of a point `p` of a rigid body moving with centre velocity `v` and yaw rate
 /// `omega` [rad/s] about `center`: v + omega x (p - center).
 inline Velocity RigidPointVelocity(const Velocity& v, double omega, const Position& center,

@@ -1,0 +1,139 @@
+#!/usr/bin/env bash
+# The performance table of docs/performance.md (issue 14), measured side by side on this machine.
+#
+#   bench/perf_table.sh [BUILD_DIR [OLD_BUILD_DIR]]      (defaults: build, none)
+#
+# BUILD_DIR (and OLD_BUILD_DIR, e.g. a build of an earlier commit, for a before/after column) must
+# hold Release builds of `dualgrid` and `bench_filter`. Runs, alternating the builds within each
+# repetition so that drifting machine load hits both alike, REPS times (default 3; medians shown):
+#   - the highway run (60 s simulated, 3 modes, 2 threads) without figures, quiet and with one
+#     competing CPU-bound process (a shell busy loop), and with figures, quiet;
+#   - bench_filter at paper size (50 and 700 detections per cycle), quiet and under the same
+#     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet.
+# bench_filter runs with OMP_WAIT_POLICY=PASSIVE, the policy `dualgrid` sets for itself.
+# Prints a Markdown table: values, targets and the loaded / quiet slowdown. Takes ~5 min (new
+# build only) to ~12 min (both). Nothing else should run meanwhile: timings of a busy machine are
+# noise (check `uptime` before).
+set -euo pipefail
+
+NEW=${1:-build}
+OLD=${2:-}
+REPS=${REPS:-3}
+SCENARIO=${SCENARIO:-scenarios/highway.yaml}
+SIMULATED=60
+for b in "$NEW" $OLD; do
+  for exe in tools/dualgrid bench/bench_filter; do
+    [[ -x "$b/$exe" ]] || { echo "perf_table.sh: $b/$exe missing: build it first (Release)" >&2; exit 2; }
+  done
+done
+BUILDS=("$NEW")
+[[ -n "$OLD" ]] && BUILDS+=("$OLD")
+WORK=$(mktemp -d)
+BUSY=""
+cleanup() {
+  [[ -n "$BUSY" ]] && kill "$BUSY" 2>/dev/null || true
+  rm -rf "$WORK"
+}
+trap cleanup EXIT
+
+busy_start() {
+  sh -c 'while :; do :; done' &
+  BUSY=$!
+  sleep 0.5
+}
+busy_stop() {
+  kill "$BUSY" 2>/dev/null || true
+  wait "$BUSY" 2>/dev/null || true
+  BUSY=""
+}
+
+# Wall seconds of one highway run: e2e BUILD [extra args].
+e2e() {
+  local build=$1
+  shift
+  rm -rf "$WORK/run"
+  local t0 t1
+  t0=$(date +%s.%N)
+  if ! "$build/tools/dualgrid" run "$SCENARIO" --out "$WORK/run" -q --threads 2 "$@" \
+    >/dev/null 2>"$WORK/err"; then
+    echo "perf_table.sh: $build/tools/dualgrid run failed:" >&2
+    cat "$WORK/err" >&2
+    exit 1
+  fi
+  t1=$(date +%s.%N)
+  awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f\n", b - a }'
+}
+
+# Median real time [ms] per cycle of one bench_filter case: bench BUILD FILTER.
+bench() {
+  OMP_WAIT_POLICY=PASSIVE "$1/bench/bench_filter" --benchmark_filter="^$2\$" \
+    --benchmark_format=csv --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+    2>/dev/null | awk -F, '/_median"?,/ {
+      t = $3; u = $5; gsub(/"/, "", u)
+      if (u == "us") t /= 1000; else if (u == "ns") t /= 1e6; else if (u == "s") t *= 1000
+      printf "%.4f\n", t }'
+}
+
+median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
+
+declare -A SAMPLES
+add() { SAMPLES["$1"]+="$2 "; }
+
+echo "perf_table.sh: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg), $REPS repetitions" >&2
+for ((r = 1; r <= REPS; ++r)); do
+  for b in "${BUILDS[@]}"; do
+    echo "  repetition $r/$REPS, $b: highway run quiet, loaded, with figures" >&2
+    add "e2e_quiet|$b" "$(e2e "$b" --no-figures)"
+    busy_start
+    add "e2e_loaded|$b" "$(e2e "$b" --no-figures)"
+    busy_stop
+    add "e2e_figures|$b" "$(e2e "$b")"
+  done
+done
+for b in "${BUILDS[@]}"; do
+  echo "  $b: bench_filter quiet and loaded" >&2
+  add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/real_time)"
+  add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/real_time)"
+  add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/real_time)"
+  busy_start
+  add "paper50_loaded|$b" "$(bench "$b" BM_PaperConfig/10000/2/real_time)"
+  add "paper700_loaded|$b" "$(bench "$b" BM_PaperHighway/10000/2/real_time)"
+  busy_stop
+done
+
+med() { tr ' ' '\n' <<<"${SAMPLES[$1|$2]:-}" | grep -v '^$' | median; }
+fmt() { awk -v v="$1" -v k="$2" 'BEGIN {
+  if (v == "") { print "-"; exit }
+  if (k == "xrt") printf "%.1fx (%.2f s)", 60 / v, v
+  else if (k == "cps") printf "%.0f/s (%.3f ms)", 1000 / v, v
+  else printf "%.1f ms", v }'; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { if (a == "" || b == "") print "-"; else printf "%.2fx", b / a }'; }
+
+header="| quantity | target |"
+rule="|---|---|"
+for b in "${BUILDS[@]}"; do
+  header+=" $b quiet | $b loaded | slowdown |"
+  rule+="---:|---:|---:|"
+done
+echo "$header"
+echo "$rule"
+row() {  # key kind label target
+  local line="| $3 | $4 |"
+  for b in "${BUILDS[@]}"; do
+    local q l
+    q=$(med "$1_quiet" "$b")
+    l=$(med "$1_loaded" "$b")
+    line+=" $(fmt "$q" "$2") | $(fmt "$l" "$2") | $(ratio "$q" "$l") |"
+  done
+  echo "$line"
+}
+row e2e xrt "highway run, 3 modes, no figures: x real time" ">= 50x; loaded <= 2x slower"
+line="| highway run with figures: x real time | >= 30x |"
+for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med e2e_figures "$b")" xrt) | - | - |"; done
+echo "$line"
+row paper50 cps "filter, paper size, 50 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
+row paper700 cps "filter, paper size, 700 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
+line="| filter, Nuss scale (1.44e6 cells, 2e6 + 2e5 particles): ms/cycle | <= 50 ms |"
+for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med nuss_quiet "$b")" ms) | - | - |"; done
+echo "$line"
+echo "(medians of $REPS runs for the highway rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"
