@@ -10,7 +10,7 @@
 #     competing CPU-bound process (a shell busy loop), and with figures, quiet;
 #   - bench_filter at paper size (50 and 700 detections per cycle), quiet and under the same
 #     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet.
-# bench_filter runs with OMP_WAIT_POLICY=PASSIVE, the policy `dualgrid` sets for itself.
+# bench_filter runs with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for itself.
 # Prints a Markdown table: values, targets and the loaded / quiet slowdown. Takes ~5 min (new
 # build only) to ~12 min (both). Nothing else should run meanwhile: timings of a busy machine are
 # noise (check `uptime` before).
@@ -64,9 +64,9 @@ e2e() {
   awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f\n", b - a }'
 }
 
-# Median real time [ms] per cycle of one bench_filter case: bench BUILD FILTER.
+# Median real time [ms] per cycle of one bench_filter case: bench BUILD NAME_PREFIX.
 bench() {
-  OMP_WAIT_POLICY=PASSIVE "$1/bench/bench_filter" --benchmark_filter="^$2\$" \
+  OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 "$1/bench/bench_filter" --benchmark_filter="^$2" \
     --benchmark_format=csv --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     2>/dev/null | awk -F, '/_median"?,/ {
       t = $3; u = $5; gsub(/"/, "", u)
@@ -92,12 +92,12 @@ for ((r = 1; r <= REPS; ++r)); do
 done
 for b in "${BUILDS[@]}"; do
   echo "  $b: bench_filter quiet and loaded" >&2
-  add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/real_time)"
-  add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/real_time)"
-  add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/real_time)"
+  add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
+  add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
+  add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/)"
   busy_start
-  add "paper50_loaded|$b" "$(bench "$b" BM_PaperConfig/10000/2/real_time)"
-  add "paper700_loaded|$b" "$(bench "$b" BM_PaperHighway/10000/2/real_time)"
+  add "paper50_loaded|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
+  add "paper700_loaded|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
   busy_stop
 done
 
