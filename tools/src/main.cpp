@@ -115,8 +115,7 @@ std::string HelpHint(const CLI::App& app) {
 // itself once with them set, unless the user chose a policy or spin count. Returns only if no
 // re-exec happened.
 static void UseShortOpenMpSpinning(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr)
-    return;
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
   if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) != 0 || setenv("GOMP_SPINCOUNT", "300", 1) != 0)
     return;
   execv("/proc/self/exe", argv);
