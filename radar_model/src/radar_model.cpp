@@ -22,6 +22,11 @@ constexpr int kAzimuthBins = 128;          // occluder lookup by azimuth
 // [m] a line of sight must run this far inside the ego's body to be blocked: the sensors sit on
 // its surface, and a ray leaving the surface (or grazing it) is not hidden.
 constexpr double kEgoBodyMargin = 0.05;
+// [m] the body is tested shrunk by this skin: a line of sight exactly along its surface (a corner
+// radar on the flank looking at a car as wide as the ego, straight ahead in its lane) grazes it.
+// On the exact boundary, rounding decided: the same scene turned by 45 deg was seen, at 0 deg
+// not (docs/radar.md, tests "the radar model is rotation invariant").
+constexpr double kEgoBodySkin = 1e-3;
 // A face is visible only if the line of sight meets it at more than this grazing angle (sine):
 // a face seen exactly edge-on (a flank collinear with the sensor) returns nothing, and with it
 // its far corner, hidden behind the near one (docs/radar.md step 2).
@@ -297,11 +302,12 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   // The ego's own body: checked for every scatterer (the sensors sit on it, so its angular
   // interval spans up to a half turn and does not fit the azimuth bins).
   Occluder body;
-  const bool has_body = options_.occlusion && ego.length > 0.0 && ego.width > 0.0;
+  const bool has_body =
+      options_.occlusion && ego.length > 2.0 * kEgoBodySkin && ego.width > 2.0 * kEgoBodySkin;
   body.a = ego.pose.position;
   body.axis = UnitVector(ego.pose.yaw);
-  body.half_length = 0.5 * ego.length;
-  body.half_width = 0.5 * ego.width;
+  body.half_length = 0.5 * ego.length - kEgoBodySkin;
+  body.half_width = 0.5 * ego.width - kEgoBodySkin;
   const auto occluded = [&](const Position& q, int owner, const Polar& truth) {
     if (!options_.occlusion) return false;
     if (has_body && LengthInsideBox(body, s, q) > kEgoBodyMargin) return true;

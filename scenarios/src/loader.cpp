@@ -1,6 +1,8 @@
 #include "dualgrid/scenario/loader.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <functional>
 #include <type_traits>
 
@@ -342,6 +344,31 @@ void ReadSwitch(MapReader& r, const std::string& key, std::optional<E> (*parse)(
   *out = *v;
 }
 
+void ReadGridPlacement(MapReader& r, const filter::FilterParams& f, GridPlacement* g) {
+  if (r.Has("frame")) {
+    std::string frame;
+    r.Read("frame", &frame);
+    if (frame == "world")
+      g->frame = GridPlacement::Frame::kWorld;
+    else if (frame == "heading")
+      g->frame = GridPlacement::Frame::kHeading;
+    else
+      r.Fail("frame", "expected 'heading' or 'world', got '" + frame + "'");
+  }
+  auto read_edge = [&](const char* key, double extent, const char* extent_key, double* out) {
+    if (!r.Has(key)) return;
+    r.Read(key, out);
+    if (!(std::isfinite(*out) && *out >= 0.0 && *out <= extent)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "expected a distance in [0, %s = %g] m, got %g", extent_key,
+                    extent, *out);
+      r.Fail(key, buf);
+    }
+  };
+  read_edge("ahead", f.length_x, "length_x", &g->ahead);
+  read_edge("left", f.width_y, "width_y", &g->left);
+}
+
 void ReadFilter(MapReader& root, ScenarioConfig* config) {
   filter::FilterParams* f = &config->filter;
   auto r = root.Map("filter");
@@ -384,6 +411,7 @@ void ReadFilter(MapReader& root, ScenarioConfig* config) {
   } else {
     ReadSwitch(*r, "birth_velocity", filter::ParseBirthVelocity, kBirthNames, &f->birth_velocity);
   }
+  ReadGridPlacement(*r, *f, &config->grid);  // after length_x / width_y: it checks against them
   r->Finish();
   std::string error;
   if (!f->IsValid(&error)) Invalid(root.file(), "filter", error);
@@ -433,6 +461,17 @@ bool EvaluationConfig::IsValid(std::string* error) const {
     return false;
   }
   return true;
+}
+
+Vector2 GridPlacement::CentreOffset(double length_x, double width_y) const {
+  const double a = std::isnan(ahead) ? 0.5 * length_x : ahead;
+  const double l = std::isnan(left) ? 0.5 * width_y : left;
+  // Centre = ego + (ahead - L/2, left - W/2); exactly zero for a centred ego.
+  return {a - 0.5 * length_x, l - 0.5 * width_y};
+}
+
+std::string_view ToString(GridPlacement::Frame f) {
+  return f == GridPlacement::Frame::kWorld ? "world" : "heading";
 }
 
 filter::FilterParams ScenarioConfig::FilterFor(filter::WeightMode mode) const {
@@ -581,6 +620,10 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   j["filter"]["zero_likelihood"] = filter::ToString(c.filter.zero_likelihood);
   j["filter"]["velocity_likelihood"] = filter::ToString(c.filter.velocity_likelihood);
   j["filter"]["normalisation"] = filter::ToString(c.filter.normalisation);
+  j["filter"]["frame"] = ToString(c.grid.frame);
+  const Vector2 off = c.grid.CentreOffset(c.filter.length_x, c.filter.width_y);
+  j["filter"]["ahead"] = 0.5 * c.filter.length_x + off.x();
+  j["filter"]["left"] = 0.5 * c.filter.width_y + off.y();
   // Per mode always (the resolved value each filter runs with), so runs compare key by key.
   for (filter::WeightMode m :
        {filter::WeightMode::kPosition, filter::WeightMode::kVelocity, filter::WeightMode::kDual})

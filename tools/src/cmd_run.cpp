@@ -166,7 +166,7 @@ int RunFilters(const FilterRunOptions& options) {
           try {
             objects = pipeline.TruthObjects(pipeline.grid(0));
             TakeSnapshot(pipeline.grid(0), with_velocity, snaps[0]);
-            truth_classes = TruthClasses(snaps[0], f, config.sim);
+            truth_classes = TruthClasses(snaps[0], pipeline.grid_frame(), f, config.sim);
           } catch (...) {
             truth_error = std::current_exception();
           }
@@ -179,7 +179,7 @@ int RunFilters(const FilterRunOptions& options) {
           if (truth_error || errors[m]) return;
           if (m > 0) TakeSnapshot(pipeline.grid(m), with_velocity, snaps[m]);
           scorers[m].AddFrame(f.time, pipeline.grid(m), snaps[m], objects, truth_classes,
-                              f.ego.box);
+                              pipeline.grid_frame().ToGrid(f.ego.box));
         });
       }
     }
@@ -187,7 +187,7 @@ int RunFilters(const FilterRunOptions& options) {
     for (auto& e : errors)
       if (e) std::rethrow_exception(e);
     for (std::size_t m = 0; m < modes.size(); ++m)
-      clusters.Write(f, mode_names[m], scorers[m], objects, pipeline.ids());
+      clusters.Write(f, pipeline.grid_frame(), mode_names[m], scorers[m], objects, pipeline.ids());
     traces.Add(pipeline, trace_mode);
     if (options.check_invariants) {
       for (std::size_t m = 0; m < modes.size(); ++m)
@@ -201,7 +201,7 @@ int RunFilters(const FilterRunOptions& options) {
     if (options.figures && picture) {
       const auto grid_png = out / "figures" / ("grid_t" + stamp + ".png");
       TryFigure(
-          grid_png, [&] { RenderGridFigure(mode_names, snaps, f, f.time, grid_png); }, &warnings);
+          grid_png, [&] { RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, grid_png); }, &warnings);
       const auto scene_png = out / "figures" / ("scene_t" + stamp + ".png");
       TryFigure(
           scene_png, [&] { RenderScene(pipeline, scene_png, 60, 140, 22); }, &warnings);

@@ -28,44 +28,61 @@ bool TryFigure(const std::filesystem::path& path, const std::function<void()>& d
   }
 }
 
+namespace {
+
+// " (grid frame: x along 152 deg)" when the picture is turned from the world, else "".
+std::string FrameNote(const GridFrame& g) {
+  if (g.identity()) return "";
+  return "  (grid frame: x axis at " + Fixed(RadToDeg(g.yaw()), 0) + " deg from world east)";
+}
+
+}  // namespace
+
 void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width) {
   const sim::Frame& f = pipeline.frame();
-  const Position c = f.ego.box.center;
+  const GridFrame& g = pipeline.grid_frame();
+  const Position c = g.ToGrid(f.ego.box.center);
   viz::BirdsEyeOptions options;
   options.title = pipeline.config().sim.name + "  t = " + Fixed(f.time, 2) + " s  (" +
-                  std::to_string(pipeline.detections().size()) + " detections)";
+                  std::to_string(pipeline.detections().size()) + " detections)" + FrameNote(g);
   viz::BirdsEyeView view({c + Position(-behind, -half_width), c + Position(ahead, half_width)},
                          options);
+  auto to_grid = [&](std::vector<Position> points) {
+    for (Position& p : points) p = g.ToGrid(p);
+    return points;
+  };
   for (const auto& lane : pipeline.simulation().LaneShapes())
-    view.DrawLane(lane.points, lane.width);
-  for (const auto& g : pipeline.config().sim.guard_rails) view.DrawGuardRail(g.points);
+    view.DrawLane(to_grid(lane.points), lane.width);
+  for (const auto& rail : pipeline.config().sim.guard_rails) view.DrawGuardRail(to_grid(rail.points));
   for (const auto& p : pipeline.config().sim.parked) {
     viz::VehicleStyle style;
     style.fill = viz::colors::kGuardRail;
     style.label = p.id;
-    view.DrawVehicle(p.box, style);
+    view.DrawVehicle(g.ToGrid(p.box), style);
   }
   const auto& radar = pipeline.radar();
   const auto poses = radar.SensorPoses(pipeline.ego_motion().pose);
   for (std::size_t s = 0; s < poses.size(); ++s) {
     const auto& p = radar.sensors()[s];
-    view.DrawSensorFov(
-        {poses[s].position, poses[s].yaw, 0.5 * p.fov, p.max_range, static_cast<int>(s), p.name});
+    view.DrawSensorFov({g.ToGrid(poses[s].position), g.YawToGrid(poses[s].yaw), 0.5 * p.fov,
+                        p.max_range, static_cast<int>(s), p.name});
   }
   for (const auto& v : f.vehicles) {
     viz::VehicleStyle style;
     style.label = v.id;
-    style.velocity = v.velocity - f.ego.velocity;  // relative motion reads better at speed
-    view.DrawVehicle(v.box, style);
+    // Relative motion reads better at speed.
+    style.velocity = g.VectorToGrid(v.velocity - f.ego.velocity);
+    view.DrawVehicle(g.ToGrid(v.box), style);
   }
   viz::VehicleStyle ego_style;
   ego_style.ego = true;
   ego_style.label = "ego";
-  view.DrawVehicle(f.ego.box, ego_style);
+  view.DrawVehicle(g.ToGrid(f.ego.box), ego_style);
   std::vector<viz::DetectionMark> marks;
   for (const auto& d : pipeline.detections())
-    marks.push_back({d.position_world, d.radial_velocity_world, d.sensor, d.is_clutter});
+    marks.push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world), d.sensor,
+                     d.is_clutter});
   viz::DetectionStyle style;
   style.coloring = viz::DetectionColoring::kBySpeed;
   view.DrawDetections(marks, style);
@@ -82,20 +99,21 @@ viz::GridRaster ToRaster(const GridSnapshot& s) {
 }  // namespace
 
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots, const sim::Frame& frame,
-                      double time, const std::filesystem::path& path) {
+                      const std::vector<GridSnapshot>& snapshots, const GridFrame& g,
+                      const sim::Frame& frame, double time, const std::filesystem::path& path) {
   std::vector<viz::GridPanel> panels;
   for (std::size_t i = 0; i < modes.size(); ++i) {
     viz::GridPanel panel;
     panel.title = modes[i];
     panel.raster = ToRaster(snapshots[i]);
-    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(v.box);
-    panel.ego_boxes.push_back(frame.ego.box);
+    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(g.ToGrid(v.box));
+    panel.ego_boxes.push_back(g.ToGrid(frame.ego.box));
     panels.push_back(std::move(panel));
   }
   viz::GridFigureOptions options;
   options.title = "Dynamic grid at t = " + Fixed(time, 2) +
-                  " s: hue = direction of motion, white free, black static, grey unknown";
+                  " s: hue = direction of motion, white free, black static, grey unknown" +
+                  FrameNote(g);
   viz::RenderGridPanels(panels, path.string(), options);
 }
 

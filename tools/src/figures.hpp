@@ -20,15 +20,17 @@ bool TryFigure(const std::filesystem::path& path, const std::function<void()>& d
                std::vector<std::string>* warnings);
 
 /// Bird's-eye picture of the current step: lanes, guard rails, parked boxes, vehicles, radar
-/// fields of view and the step's detections with their radial-velocity arrows. The view spans
-/// [ego.x - behind, ego.x + ahead] x [ego.y - half_width, ego.y + half_width].
+/// fields of view and the step's detections with their radial-velocity arrows, drawn in the grid
+/// frame (pipeline.grid_frame(): the world turned so that the grid's axes are the picture's). The
+/// view spans [ego.x - behind, ego.x + ahead] x [ego.y - half_width, ego.y + half_width] there.
 void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width);
 
-/// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined.
+/// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined; in the
+/// grid frame, whose axes are the grid's.
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots, const sim::Frame& frame,
-                      double time, const std::filesystem::path& path);
+                      const std::vector<GridSnapshot>& snapshots, const GridFrame& grid_frame,
+                      const sim::Frame& frame, double time, const std::filesystem::path& path);
 
 /// D per object (name) and mode; NaN where a mode did not score the object.
 using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;

@@ -76,7 +76,12 @@ bool Pipeline::Step() {
 }
 
 void Pipeline::UpdateFilter(std::size_t i) {
-  filters_[i]->Update({ego_.pose, ego_.velocity}, measurements_, coverage_, dt_);
+  // The grid is centred on ego + offset (filter.ahead / filter.left); the filter reads only the
+  // position of EgoInput's pose, to place the grid.
+  const Pose2 pose = grid_frame_.ToGrid(ego_.pose);
+  filters_[i]->Update({{pose.position + centre_offset_, pose.yaw},
+                       grid_frame_.VectorToGrid(ego_.velocity)},
+                      measurements_, coverage_, dt_);
 }
 
 bool Pipeline::Advance() {
@@ -85,6 +90,16 @@ bool Pipeline::Advance() {
   ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
   // The first filter cycle (the ego may depart late) predicts over one step.
   dt_ = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
+  if (!frame_fixed_) {
+    // Whole degrees: a road along a world axis keeps an exactly world-aligned grid (SUMO's
+    // headings carry ~1e-6 deg of rounding), and 0.5 deg is 0.9 m across at 100 m.
+    const double yaw = config_.grid.frame == scenario::GridPlacement::Frame::kHeading
+                           ? DegToRad(std::round(RadToDeg(ego_.pose.yaw)))
+                           : 0.0;
+    grid_frame_ = GridFrame(WrapAngle(yaw) == 0.0 ? 0.0 : yaw);
+    centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
+    frame_fixed_ = true;
+  }
   last_time_ = f.time;
 
   detections_ = radar_.Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
@@ -96,15 +111,19 @@ bool Pipeline::Advance() {
   // Nothing but the ego can be inside the ego's own footprint: returns there (clutter drawn down
   // to the sensors' minimum range) would feed particles that ride along with the ego.
   const BoxTest ego_box(f.ego.box);
+  // The filter works in the grid frame.
+  const GridFrame& g = grid_frame_;
   for (const radar::Detection& d : detections_) {
     if (ego_box.Contains(d.position_world)) continue;
-    measurements_.push_back({d.position_world, d.radial_velocity_world, d.sensor_position_world});
+    measurements_.push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world),
+                             g.ToGrid(d.sensor_position_world)});
   }
   coverage_.clear();
   for (int s : scanned_) {
     const radar::SensorParams& p = radar_.sensors()[s];
     const Pose2 pose = radar_.SensorPose(s, ego_.pose);
-    coverage_.push_back({pose.position, pose.yaw, 0.5 * p.fov, p.min_range, p.max_range});
+    coverage_.push_back(
+        {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
   return true;
 }
@@ -114,16 +133,17 @@ std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid&
   const auto poses = radar_.SensorPoses(ego_.pose);
   // Sources of this step's detections inside the grid: the t_d clock starts at a vehicle's first.
   std::vector<int> detected;
+  const GridFrame& g = grid_frame_;
   for (const radar::Detection& d : detections_)
-    if (grid.CellOf(d.position_world)) detected.push_back(d.source_id);
+    if (grid.CellOf(g.ToGrid(d.position_world))) detected.push_back(d.source_id);
   std::sort(detected.begin(), detected.end());
   for (const sim::VehicleState& v : frame().vehicles) {
     eval::TruthObject o;
     o.id = ids_.Id(v.id);
     o.detected_in_grid = std::binary_search(detected.begin(), detected.end(), o.id);
-    o.box = v.box;
-    o.velocity = v.velocity;
-    o.in_grid = grid.CellOf(v.box.center).has_value();
+    o.box = g.ToGrid(v.box);
+    o.velocity = g.VectorToGrid(v.velocity);
+    o.in_grid = grid.CellOf(o.box.center).has_value();
     for (std::size_t s = 0; s < poses.size() && !o.in_coverage; ++s) {
       const radar::SensorParams& p = radar_.sensors()[s];
       const Position local = poses[s].ToLocal(v.box.center);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "dualgrid/eval/association.hpp"
+#include "dualgrid/core/grid_frame.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/radar_model/radar_model.hpp"
 #include "dualgrid/scenario/loader.hpp"
@@ -65,8 +66,13 @@ class Pipeline {
   IdRegistry& ids() { return ids_; }
   const IdRegistry& ids() const { return ids_; }
 
-  /// Ground-truth vehicles (ego excluded) as evaluation objects for a grid: in_grid when the
-  /// centre lies in the grid, in_coverage when the centre lies in some radar's field of view.
+  /// The grid frame (docs/algorithm.md, "Grid frame"): fixed at the first Advance() from the
+  /// scenario's `filter.frame` and the ego's heading then; identity before.
+  const GridFrame& grid_frame() const { return grid_frame_; }
+
+  /// Ground-truth vehicles (ego excluded) as evaluation objects for a grid, in the grid frame
+  /// (boxes and velocities: the clusters' frame): in_grid when the centre lies in the grid,
+  /// in_coverage when the centre lies in some radar's field of view.
   std::vector<eval::TruthObject> TruthObjects(const filter::DynamicGrid& grid);
 
  private:
@@ -86,6 +92,9 @@ class Pipeline {
   std::vector<filter::SensorCoverage> coverage_;
   double last_time_ = 0.0;
   double dt_ = 0.0;  // of the last Advance() [s]
+  GridFrame grid_frame_;
+  bool frame_fixed_ = false;
+  Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
 };
 
 }  // namespace dualgrid::tools

@@ -9,7 +9,8 @@ ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
   out_.buffer() += "step,time,mode,x,y,vx,vy,weight,particles,role,object,x_ego,y_ego\n";
 }
 
-void ClusterWriter::Write(const sim::Frame& f, const std::string& mode, const ModeScorer& scorer,
+void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::string& mode,
+                          const ModeScorer& scorer,
                           const std::vector<eval::TruthObject>& objects, const IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
@@ -17,10 +18,11 @@ void ClusterWriter::Write(const sim::Frame& f, const std::string& mode, const Mo
   os.precision(10);
   for (std::size_t c = 0; c < scorer.clusters().size(); ++c) {
     const eval::Cluster& cl = scorer.clusters()[c];
-    const Position local = f.EgoPose().ToLocal(cl.position);
-    os << f.step << ',' << Fixed(f.time, 3) << ',' << mode << ',' << Fixed(cl.position.x(), 3)
-       << ',' << Fixed(cl.position.y(), 3) << ',' << Fixed(cl.velocity.x(), 3) << ','
-       << Fixed(cl.velocity.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
+    const Position pos = g.ToWorld(cl.position);
+    const Velocity vel = g.VectorToWorld(cl.velocity);
+    const Position local = f.EgoPose().ToLocal(pos);
+    os << f.step << ',' << Fixed(f.time, 3) << ',' << mode << ',' << Fixed(pos.x(), 3) << ','
+       << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ',' << Fixed(vel.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
        << kRole[static_cast<int>(a.role[c])] << ','
        << (a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id)
                                        : std::string())
@@ -34,20 +36,23 @@ void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
   const sim::Frame& f = pipeline.frame();
   const auto& grid = pipeline.grid(mode);
   const auto& p = grid.particles();
+  const GridFrame& g = pipeline.grid_frame();
   std::set<std::string> in_grid;
   for (const auto& v : f.vehicles) {
-    if (!grid.CellOf(v.box.center)) continue;
+    const OrientedBox box = g.ToGrid(v.box);  // particles live in the grid frame
+    const Velocity velocity = g.VectorToGrid(v.velocity);
+    if (!grid.CellOf(box.center)) continue;
     ++frames_in_grid[v.id];
     in_grid.insert(v.id);
     if (dropped.count(v.id)) continue;
     double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
-    const BoxTest grown({v.box.center, v.box.yaw, v.box.length + 1.0, v.box.width + 1.0});
+    const BoxTest grown({box.center, box.yaw, box.length + 1.0, box.width + 1.0});
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
       wp += p.w_position[i];
       wv += p.w_velocity[i];
       w += p.weight[i];
-      if ((Velocity(p.vx[i], p.vy[i]) - v.velocity).norm() < WeightTrace::kGoodVelocity) {
+      if ((Velocity(p.vx[i], p.vy[i]) - velocity).norm() < WeightTrace::kGoodVelocity) {
         wp_good += p.w_position[i];
         wv_good += p.w_velocity[i];
       }
@@ -94,6 +99,7 @@ void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot&
   pc.buffer() += "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
   const auto& grid = pipeline.grid(m);
   const auto& ps = grid.particles();
+  const GridFrame& g = pipeline.grid_frame();
   std::ostringstream os;
   os.precision(10);
   for (std::size_t i = 0; i < ps.size(); ++i) {
@@ -101,8 +107,11 @@ void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot&
     const double pd =
         cell ? snapshot.dynamic[static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x]
              : 0.0;
-    os << Fixed(ps.x[i], 3) << ',' << Fixed(ps.y[i], 3) << ',' << Fixed(ps.vx[i], 3) << ','
-       << Fixed(ps.vy[i], 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
+    // Written in the world frame, like every other file of the run.
+    const Position pos = g.ToWorld(Position(ps.x[i], ps.y[i]));
+    const Velocity vel = g.VectorToWorld(Velocity(ps.vx[i], ps.vy[i]));
+    os << Fixed(pos.x(), 3) << ',' << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ','
+       << Fixed(vel.y(), 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
        << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
   }
   pc.buffer() += os.str();

@@ -23,7 +23,9 @@ class ClusterWriter {
  public:
   explicit ClusterWriter(const std::filesystem::path& path);
   /// The clusters of `scorer`'s last frame, for mode `mode`; `objects` as given to the scorer.
-  void Write(const sim::Frame& frame, const std::string& mode, const ModeScorer& scorer,
+  /// Clusters are scored in the grid frame and written in the world frame.
+  void Write(const sim::Frame& frame, const GridFrame& grid_frame, const std::string& mode,
+             const ModeScorer& scorer,
              const std::vector<eval::TruthObject>& objects, const IdRegistry& ids);
   void Close() { out_.Close(); }
 

@@ -43,21 +43,25 @@ bool NearGrid(const OrientedBox& b, const Position& lo, const Position& hi) {
 
 }  // namespace
 
-std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Frame& frame,
-                                       const sim::ScenarioSpec& spec) {
+std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame& g,
+                                       const sim::Frame& frame, const sim::ScenarioSpec& spec) {
   const Position lo = grid.origin;
   const Position hi = lo + Position(grid.cells_x, grid.cells_y) * grid.resolution;
   std::vector<OrientedBox> moving, stationary;
   // A vehicle slower than 0.5 m/s is stationary (the filter cannot call it dynamic either).
-  for (const auto& v : frame.vehicles)
-    if (NearGrid(v.box, lo, hi)) (v.velocity.norm() > 0.5 ? moving : stationary).push_back(v.box);
-  for (const auto& p : spec.parked)
-    if (NearGrid(p.box, lo, hi)) stationary.push_back(p.box);
+  for (const auto& v : frame.vehicles) {
+    const OrientedBox b = g.ToGrid(v.box);
+    if (NearGrid(b, lo, hi)) (v.velocity.norm() > 0.5 ? moving : stationary).push_back(b);
+  }
+  for (const auto& p : spec.parked) {
+    const OrientedBox b = g.ToGrid(p.box);
+    if (NearGrid(b, lo, hi)) stationary.push_back(b);
+  }
   for (const auto& rail : spec.guard_rails) {
     for (std::size_t k = 0; k + 1 < rail.points.size(); ++k) {
       // Clip the segment to the grid's x range so the box stays small, then make it one cell
       // wide so that the rail marks one row of cells.
-      Position a = rail.points[k], b = rail.points[k + 1];
+      Position a = g.ToGrid(rail.points[k]), b = g.ToGrid(rail.points[k + 1]);
       const Vector2 d = b - a;
       if (std::abs(d.x()) > 1e-9) {
         const double t0 = std::clamp((lo.x() - a.x()) / d.x(), 0.0, 1.0);

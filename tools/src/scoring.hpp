@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dualgrid/core/grid_frame.hpp"
 #include "dualgrid/eval/cell_metrics.hpp"
 #include "dualgrid/eval/clustering.hpp"
 #include "dualgrid/eval/metrics.hpp"
@@ -30,15 +31,16 @@ struct GridSnapshot {
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s);
 
 /// Ground-truth class per cell: moving vehicles dynamic; parked boxes and guard rails (as boxes
-/// one cell wide) static; the rest free. Boxes are culled to the grid first.
-std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const sim::Frame& frame,
-                                       const sim::ScenarioSpec& spec);
+/// one cell wide) static; the rest free. The world's boxes are mapped into the grid frame and
+/// culled to the grid first.
+std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame& grid_frame,
+                                       const sim::Frame& frame, const sim::ScenarioSpec& spec);
 
 class ModeScorer {
  public:
   explicit ModeScorer(const scenario::EvaluationConfig& config);
   /// Scores one cycle. `snapshot` is TakeSnapshot(grid, ...); `truth_classes` from TruthClasses.
-  /// Particles inside `ego_box` are not clustered: no other object can be there, and particles
+  /// All positions in the grid frame. Particles inside `ego_box` are not clustered: no other object can be there, and particles
   /// there would chain the vehicles on both sides of the ego into one cluster.
   void AddFrame(double time, const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
                 const std::vector<eval::TruthObject>& objects,

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -46,11 +48,30 @@ struct EvaluationConfig {
   bool IsValid(std::string* error) const;
 };
 
+/// Where the grid lies (keys `filter.frame`, `filter.ahead`, `filter.left`; docs/algorithm.md,
+/// "Grid frame"). The filter runs in the grid frame; the co-simulation maps SUMO's world into it.
+struct GridPlacement {
+  enum class Frame {
+    kWorld,    ///< grid axes along the world's x and y
+    kHeading,  ///< turned to the ego's heading when it enters, rounded to whole degrees; fixed
+  };
+  Frame frame = Frame::kHeading;
+  /// Distance [m] from the ego to the grid's front edge (+x of the grid frame) and to its left
+  /// edge (+y); NaN: half the extent (the ego centred). 0 <= ahead <= length_x,
+  /// 0 <= left <= width_y.
+  double ahead = std::numeric_limits<double>::quiet_NaN();
+  double left = std::numeric_limits<double>::quiet_NaN();
+  /// Offset [m] from the ego to the grid centre in the grid frame, for a grid of that extent.
+  Vector2 CentreOffset(double length_x, double width_y) const;
+};
+std::string_view ToString(GridPlacement::Frame f);
+
 struct ScenarioConfig {
   std::filesystem::path file;
   sim::ScenarioSpec sim;
   RadarConfig radar;
   filter::FilterParams filter;
+  GridPlacement grid;
   /// `filter.birth_velocity` given per mode ({position: uniform, ...}); modes not listed use
   /// filter.birth_velocity.
   std::map<filter::WeightMode, filter::BirthVelocity> birth_velocity_by_mode;
