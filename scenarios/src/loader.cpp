@@ -6,6 +6,7 @@
 #include <functional>
 #include <type_traits>
 
+#include "dualgrid/sim/sumo_files.hpp"
 #include "yaml_reader.hpp"
 
 namespace dualgrid::scenario {
@@ -23,18 +24,51 @@ void ReadVehicle(MapReader& r, sim::VehicleSpec* v) {
   r.Read("lane_change", &v->lane_change);
 }
 
+std::string Shown(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   root.Read("name", &s->name);
   root.Read("description", &s->description);
-  root.Require("network", &s->network);
+  const std::filesystem::path here = std::filesystem::path(root.file()).parent_path();
+  const auto relative_to_file = [&](const std::string& p) {
+    return std::filesystem::absolute(here / p).lexically_normal().string();
+  };
+  // SUMO's own configuration: its network and route files (docs/scenarios.md).
+  std::optional<double> cfg_step;
+  if (root.Has("sumo_config")) {
+    if (root.Has("network"))
+      root.Fail("network", "must not be given with sumo_config (whose net-file is the network)");
+    std::string cfg;
+    root.Read("sumo_config", &cfg);
+    try {
+      const sim::SumoConfigInputs in = sim::ReadSumoConfig(relative_to_file(cfg));
+      s->network = in.net_file.string();
+      for (const auto& f : in.route_files) s->route_files.push_back(f.string());
+      for (const auto& f : in.additional_files)
+        s->warnings.push_back(root.file() + ": key 'sumo_config': additional file " + f.string() +
+                              " is not loaded (stops, detectors, polygons are not simulated "
+                              "here; the radar sees vehicles, guard rails and parked boxes)");
+      cfg_step = in.step_length;
+    } catch (const std::invalid_argument& e) {
+      root.Fail("sumo_config", e.what());
+    }
+  } else {
+    root.Require("network", &s->network);
+  }
   // A network given as a file (ending in .xml) is read relative to the scenario file, so a
   // scenario and its network can move together; a bare name is one of the built networks.
   if (const std::filesystem::path net(s->network); net.extension() == ".xml" && net.is_relative())
-    s->network = std::filesystem::absolute(std::filesystem::path(root.file()).parent_path() / net)
-                     .lexically_normal()
-                     .string();
+    s->network = relative_to_file(s->network);
   root.Read("duration", &s->duration);
   root.Read("step_length", &s->step_length);
+  if (cfg_step && *cfg_step != s->step_length)
+    s->warnings.push_back(root.file() + ": key 'sumo_config': its step-length " + Shown(*cfg_step) +
+                          " s is replaced by step_length " + Shown(s->step_length) +
+                          " s (the radar cycle)");
   root.Read("seed", &s->seed);
   root.Read("lane_change_duration", &s->lane_change_duration);
 
@@ -63,10 +97,20 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   if (!ego) root.Fail("ego", "is required");
   s->ego.id = "ego";
   s->ego.lane_change = false;  // the ego keeps its lane unless the scenario says otherwise
+  if (ego->Has("from_routes")) {
+    // A vehicle of the route files is the ego: SUMO places and drives it.
+    for (const char* key : {"id", "type", "route", "depart", "lane", "position", "speed"})
+      if (ego->Has(key))
+        ego->Fail(key, "must not be given with from_routes (the route file defines the ego)");
+    ego->Read("from_routes", &s->ego.id);
+    s->ego_from_routes = true;
+    s->ego_speed.mode = sim::SpeedPolicy::Mode::kSumo;
+  }
   ReadVehicle(*ego, &s->ego);
   if (s->ego.desired_speed)
     ego->Fail("desired_speed", "is not used for the ego: set ego.speed_policy.speed");
   if (auto sp = ego->Map("speed_policy")) {
+    s->ego_speed.mode = sim::SpeedPolicy::Mode::kCruise;
     std::string mode = "cruise";
     sp->Read("mode", &mode);
     if (mode == "cruise")
@@ -83,6 +127,17 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   ego->Finish();
 
   if (auto traffic = root.Map("traffic")) {
+    std::vector<std::string> files;
+    traffic->Read("route_files", &files);
+    for (const std::string& f : files) s->route_files.push_back(relative_to_file(f));
+    if (auto rcs = traffic->Map("rcs_dbsm")) {
+      for (const std::string& type : rcs->Keys()) {
+        double v = 0.0;
+        rcs->Read(type, &v);
+        s->type_rcs[type] = v;
+      }
+      rcs->Finish();
+    }
     for (auto& r : traffic->MapList("vehicles")) {
       sim::VehicleSpec v;
       ReadVehicle(r, &v);
@@ -647,6 +702,19 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
   if (config.sim.name.empty()) config.sim.name = std::filesystem::path(name).stem().string();
   std::string error;
   if (!config.sim.IsValid(&error)) Invalid(name, "", error);
+  if (!config.sim.route_files.empty()) {
+    const char* key = root.Has("sumo_config") ? "sumo_config" : "traffic.route_files";
+    try {
+      for (std::string& w : sim::RouteFileWarnings(config.sim.route_files))
+        config.sim.warnings.push_back(std::move(w));
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(name + ": key '" + key + "': " + e.what());
+    }
+    if (config.sim.ego_from_routes &&
+        !sim::RouteFilesDefine(config.sim.route_files, config.sim.ego.id))
+      throw ConfigError(name + ": key 'ego.from_routes' names '" + config.sim.ego.id +
+                        "', which no vehicle of the route files has as its id");
+  }
   ReadRadar(root, config.sim, &config.radar);
   ReadFilter(root, &config);
   ReadEvaluation(root, &config.evaluation);
@@ -661,6 +729,11 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
       found =
           found || (focus.rfind(f.id + ".", 0) == 0 && focus.size() > f.id.size() + 1 &&
                     focus.find_first_not_of("0123456789", f.id.size() + 1) == std::string::npos);
+    // A vehicle of the user's route files (or of one of their flows).
+    if (!found && !config.sim.route_files.empty())
+      found = sim::RouteFilesDefine(config.sim.route_files, focus) ||
+              (focus.rfind('.') != std::string::npos &&
+               sim::RouteFilesDefine(config.sim.route_files, focus.substr(0, focus.rfind('.'))));
     if (!found || focus == config.sim.ego.id)
       throw ConfigError(name + ": key 'evaluation.focus_object' names '" + focus +
                         "', which is no vehicle of the scenario (expected an id of "

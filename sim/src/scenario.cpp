@@ -42,6 +42,16 @@ int ScenarioSpec::StepCount() const {
   return static_cast<int>(std::floor(duration / step_length + 1e-9));
 }
 
+double VClassRcs(const std::string& vclass) {
+  static const std::map<std::string, double> kRcs = {
+      {"passenger", 10.0}, {"private", 10.0},  {"taxi", 10.0},      {"evehicle", 10.0},
+      {"emergency", 10.0}, {"delivery", 14.0}, {"truck", 25.0},     {"trailer", 25.0},
+      {"bus", 25.0},       {"coach", 25.0},    {"motorcycle", 5.0}, {"moped", 3.0},
+      {"bicycle", 0.0}};
+  const auto it = kRcs.find(vclass);
+  return it == kRcs.end() ? 10.0 : it->second;
+}
+
 bool ScenarioSpec::IsValid(std::string* error) const {
   if (network.empty()) return Fail(error, "network", "must name a network");
   if (!(duration > 0.0 && duration <= 3600.0))
@@ -70,7 +80,13 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   }
   if (!(duration >= step_length))
     return Fail(error, "duration", "must be at least one step_length");
-  if (!CheckVehicle(ego, "ego", *this, error)) return false;
+  if (ego_from_routes) {
+    if (route_files.empty())
+      return Fail(error, "ego.from_routes",
+                  "needs SUMO route files (traffic.route_files or sumo_config)");
+  } else if (!CheckVehicle(ego, "ego", *this, error)) {
+    return false;
+  }
   if (!(ego.depart < duration))
     return Fail(error, "ego.depart", "must be before the end (duration)");
   if (!(ego_speed.speed >= 0.0 && ego_speed.speed <= kMaxTrafficSpeed))

@@ -124,7 +124,14 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
       << name << "' -->\n<routes>\n";
   // Desired speeds are set per vehicle through maxSpeed (see ApplyDepartures); a speed factor of
   // 1.5 keeps the lane limits from capping them below 130 km/h.
+  // Only the types the scenario's own vehicles use: a route file of the user may define a type of
+  // the same name (SUMO refuses a second definition).
+  std::set<std::string> used;
+  if (!spec.ego_from_routes) used.insert(spec.ego.type);
+  for (const VehicleSpec& v : spec.vehicles) used.insert(v.type);
+  for (const FlowSpec& f : spec.flows) used.insert(f.type);
   for (const auto& [name, t] : spec.vehicle_types) {
+    if (!used.count(name)) continue;
     out << "  <vType id=\"" << Xml(name) << "\" length=\"" << Num(t.length) << "\" width=\""
         << Num(t.width) << "\" maxSpeed=\"" << Num(t.max_speed) << "\" accel=\"" << Num(t.accel)
         << "\" decel=\"" << Num(t.decel) << "\" speedFactor=\"1.5\" speedDev=\"0\" sigma=\"0\""
@@ -148,7 +155,7 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
            std::to_string(v.lane) + "\" departPos=\"" + Num(v.position) + "\" departSpeed=\"" +
            Num(v.speed) + "\"/>\n";
   };
-  entries.push_back({spec.ego.depart, vehicle_xml(spec.ego)});
+  if (!spec.ego_from_routes) entries.push_back({spec.ego.depart, vehicle_xml(spec.ego)});
   for (const VehicleSpec& v : spec.vehicles) entries.push_back({v.depart, vehicle_xml(v)});
   for (const FlowSpec& f : spec.flows) {
     entries.push_back({f.begin, "  <flow id=\"" + Xml(f.id) + "\" type=\"" + Xml(f.type) +
@@ -183,13 +190,16 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
     std::filesystem::create_directories(work_dir);
     const auto routes = work_dir / "routes.rou.xml";
     WriteRouteFile(spec_, routes);
+    // The scenario's own vehicles first, then the user's SUMO route files as they are.
+    std::string route_files = routes.string();
+    for (const std::string& f : spec_.route_files) route_files += "," + f;
     std::sort(spec_.actions.begin(), spec_.actions.end(),
               [](const ActionSpec& a, const ActionSpec& b) { return a.time < b.time; });
     const std::vector<std::string> args = {"sumo",
                                            "--net-file",
                                            network_file.string(),
                                            "--route-files",
-                                           routes.string(),
+                                           route_files,
                                            "--step-length",
                                            Num(spec_.step_length),
                                            "--seed",
@@ -263,7 +273,7 @@ void SumoSimulation::CheckAgainstNetwork() const {
                                   " m long); positions are along the "
                                   "route's first edge");
   };
-  check_vehicle(spec_.ego, "ego");
+  if (!spec_.ego_from_routes) check_vehicle(spec_.ego, "ego");
   for (std::size_t i = 0; i < spec_.vehicles.size(); ++i)
     check_vehicle(spec_.vehicles[i], "traffic.vehicles[" + std::to_string(i) + "]");
 }
@@ -297,11 +307,7 @@ VehicleState SumoSimulation::ReadVehicle(const std::string& id) {
   // parameter (its max speed) is changed.
   v.type = V::getTypeID(id);
   v.type = v.type.substr(0, v.type.find('@'));
-  const auto type_it = spec_.vehicle_types.find(v.type);
-  if (type_it == spec_.vehicle_types.end())
-    throw std::runtime_error("vehicle '" + id + "' has type '" + v.type +
-                             "', which the scenario does not define");
-  const VehicleTypeSpec& t = type_it->second;
+  const VehicleTypeSpec& t = TypeOf(id, v.type);
   const auto pos = V::getPosition(id);
   const double yaw = SumoAngleToYaw(V::getAngle(id));
   v.box = {FrontBumperToCenter(Position(pos.x, pos.y), yaw, t.length), yaw, t.length, t.width};
@@ -327,10 +333,30 @@ VehicleState SumoSimulation::ReadVehicle(const std::string& id) {
   return v;
 }
 
+const VehicleTypeSpec& SumoSimulation::TypeOf(const std::string& vehicle, const std::string& type) {
+  if (const auto it = spec_.vehicle_types.find(type); it != spec_.vehicle_types.end())
+    return it->second;
+  if (const auto it = sumo_types_.find(type); it != sumo_types_.end()) return it->second;
+  if (spec_.route_files.empty())
+    throw std::runtime_error("vehicle '" + vehicle + "' has type '" + type +
+                             "', which the scenario does not define");
+  // A type of the user's route files: its box as SUMO simulates it, its RCS from the scenario
+  // (traffic.rcs_dbsm) or its vClass.
+  using V = libsumo::Vehicle;
+  VehicleTypeSpec t;
+  t.length = V::getLength(vehicle);
+  t.width = V::getWidth(vehicle);
+  t.vclass = V::getVehicleClass(vehicle);
+  const auto rcs = spec_.type_rcs.find(type);
+  t.rcs_dbsm = rcs != spec_.type_rcs.end() ? rcs->second : VClassRcs(t.vclass);
+  return sumo_types_.emplace(type, t).first->second;
+}
+
 void SumoSimulation::ApplyDepartures() {
   for (const std::string& id : libsumo::Simulation::getDepartedIDList()) {
     const std::uint64_t index = departures_++;
     if (id == spec_.ego.id) {
+      if (spec_.ego_speed.mode == SpeedPolicy::Mode::kSumo) continue;  // as its route file says
       // SUMO needs a positive maximum speed; a parked ego is held by setSpeed(0) each step.
       libsumo::Vehicle::setMaxSpeed(id, std::max(spec_.ego_speed.speed, 0.1));
       if (!spec_.ego.lane_change)
@@ -376,6 +402,14 @@ bool SumoSimulation::Step() {
     // Until the ego has departed, steps only advance SUMO: frames start with the ego.
     for (;;) {
       if (step_ >= spec_.StepCount()) {
+        if (frame_.step == 0 && spec_.ego_from_routes)
+          throw std::runtime_error("ego '" + spec_.ego.id +
+                                   "' (ego.from_routes) never entered "
+                                   "the network before t=" +
+                                   Num(spec_.duration) +
+                                   " s: is it a vehicle of the route files, departing before "
+                                   "the end (duration counts from SUMO's start)? See " +
+                                   log_path_.string());
         if (frame_.step == 0)
           throw std::runtime_error("ego '" + spec_.ego.id +
                                    "' never entered the network before t=" + Num(spec_.duration) +

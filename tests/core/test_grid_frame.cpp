@@ -32,8 +32,7 @@ TEST_CASE("GridFrame round-trips, preserves distances and turns headings", "[gri
     const Position a(rng.Uniform(-5e4, 5e4), rng.Uniform(-5e4, 5e4));
     const Position b(rng.Uniform(-5e4, 5e4), rng.Uniform(-5e4, 5e4));
     CHECK((g.ToWorld(g.ToGrid(a)) - a).norm() <= 1e-9 * (1.0 + a.norm()));
-    CHECK((g.ToGrid(a) - g.ToGrid(b)).norm() ==
-          Approx((a - b).norm()).epsilon(1e-12).margin(1e-9));
+    CHECK((g.ToGrid(a) - g.ToGrid(b)).norm() == Approx((a - b).norm()).epsilon(1e-12).margin(1e-9));
     // The grid's +x axis is the world direction `yaw`.
     const Vector2 x_axis = g.VectorToWorld(Vector2(1.0, 0.0));
     CHECK(x_axis.x() == Approx(std::cos(yaw)).margin(1e-12));

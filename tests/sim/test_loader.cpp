@@ -250,3 +250,24 @@ TEST_CASE("sensors.accuracy and sensors.overrides.all", "[loader][sensors]") {
   CHECK(ErrorOf(std::string(kValid) + "sensors: {overrides: {all: {off_boresight_deg: [0, 10]}}}\n")
             .find("off_boresight") != std::string::npos);
 }
+
+TEST_CASE("grid frame and placement keys", "[loader][frame]") {
+  const auto d = LoadScenario(Write("frame0.yaml", kValid));
+  CHECK(d.grid.frame == scenario::GridPlacement::Frame::kHeading);  // the default
+  CHECK(d.grid.CentreOffset(200.0, 25.0) == Vector2::Zero());       // the ego centred, exactly
+  const auto w = LoadScenario(
+      Write("frame1.yaml", std::string(kValid) + "filter: {frame: world, ahead: 150, left: 10}\n"));
+  CHECK(w.grid.frame == scenario::GridPlacement::Frame::kWorld);
+  // 150 m ahead of a 200 m grid: its centre 50 m ahead of the ego; 10 m to the left edge of 25.
+  CHECK(w.grid.CentreOffset(w.filter.length_x, w.filter.width_y).x() == Approx(50.0));
+  CHECK(w.grid.CentreOffset(w.filter.length_x, w.filter.width_y).y() == Approx(-2.5));
+  CHECK(ErrorOf(std::string(kValid) + "filter: {frame: diagonal}\n")
+            .find("'filter.frame' expected 'heading' or 'world', got 'diagonal'") !=
+        std::string::npos);
+  CHECK(ErrorOf(std::string(kValid) + "filter: {ahead: 250}\n")
+            .find("'filter.ahead' expected a distance in [0, length_x = 200] m, got 250") !=
+        std::string::npos);
+  // Checked against the extent given in the same section, whatever the key order.
+  CHECK_NOTHROW(LoadScenario(
+      Write("frame2.yaml", std::string(kValid) + "filter: {ahead: 250, length_x: 300}\n")));
+}

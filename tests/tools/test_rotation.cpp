@@ -45,21 +45,21 @@ fs::path WriteScene(const fs::path& dir, double deg) {
   // A straight two-lane-each-way road 1.4 km long (no junction inside the scene). netconvert
   // would shift a network with negative coordinates to the origin (and the rail and parked car
   // of the YAML with it out of place): --offset.disable-normalization keeps the coordinates.
-  std::ofstream(dir / "road.nod.xml") << "<nodes>\n"
-                                      << "  <node id=\"a\" x=\"" << t.X(0, 0) << "\" y=\""
-                                      << t.Y(0, 0) << "\"/>\n"
-                                      << "  <node id=\"b\" x=\"" << t.X(1400, 0) << "\" y=\""
-                                      << t.Y(1400, 0) << "\"/>\n"
-                                      << "</nodes>\n";
+  std::ofstream(dir / "road.nod.xml")
+      << "<nodes>\n"
+      << "  <node id=\"a\" x=\"" << t.X(0, 0) << "\" y=\"" << t.Y(0, 0) << "\"/>\n"
+      << "  <node id=\"b\" x=\"" << t.X(1400, 0) << "\" y=\"" << t.Y(1400, 0) << "\"/>\n"
+      << "</nodes>\n";
   std::ofstream(dir / "road.edg.xml")
       << "<edges>\n"
       << "  <edge id=\"ab\" from=\"a\" to=\"b\" numLanes=\"2\" speed=\"33.3\"/>\n"
       << "  <edge id=\"ba\" from=\"b\" to=\"a\" numLanes=\"2\" speed=\"33.3\"/>\n"
       << "</edges>\n";
-  const auto nc = Shell(std::string(DUALGRID_NETCONVERT) + " --node-files " +
-                        (dir / "road.nod.xml").string() + " --edge-files " +
-                        (dir / "road.edg.xml").string() + " --no-turnarounds true --offset.disable-normalization true -o " +
-                        (dir / "road.net.xml").string());
+  const auto nc =
+      Shell(std::string(DUALGRID_NETCONVERT) + " --node-files " + (dir / "road.nod.xml").string() +
+            " --edge-files " + (dir / "road.edg.xml").string() +
+            " --no-turnarounds true --offset.disable-normalization true -o " +
+            (dir / "road.net.xml").string());
   INFO(nc.output);
   REQUIRE(nc.code == 0);
   std::ofstream(dir / "scene.yaml")
@@ -79,11 +79,11 @@ fs::path WriteScene(const fs::path& dir, double deg) {
          " desired_speed: 22.0, lane_change: false}\n"
       << "obstacles:\n"
       << "  guard_rails:\n"
-      << "    - {id: rail, points: [" << t.Point(50, -8.5) << ", " << t.Point(1350, -8.5)
-      << "]}\n"
+      << "    - {id: rail, points: [" << t.Point(50, -8.5) << ", " << t.Point(1350, -8.5) << "]}\n"
       << "  parked:\n"
-      << "    - {id: parked, center: " << t.Point(420, -11.0) << ", yaw: "
-      << Turned::Num(deg * kPi / 180.0) << ", length: 4.5, width: 1.8, rcs_dbsm: 10.0}\n";
+      << "    - {id: parked, center: " << t.Point(420, -11.0)
+      << ", yaw: " << Turned::Num(deg * kPi / 180.0)
+      << ", length: 4.5, width: 1.8, rcs_dbsm: 10.0}\n";
   return dir / "scene.yaml";
 }
 
@@ -100,7 +100,8 @@ Table RunScene(const fs::path& scenario, const fs::path& out, const std::string&
   for (const auto& m : j.at("metrics")) {
     for (const auto& [mode, v] : m.at("values").items()) {
       if (v.at("mean").is_null()) continue;
-      const double hw = v.at("ci95_half_width").is_null() ? 0.0 : v.at("ci95_half_width").get<double>();
+      const double hw =
+          v.at("ci95_half_width").is_null() ? 0.0 : v.at("ci95_half_width").get<double>();
       t[m.at("key").get<std::string>()][mode] = {v.at("mean").get<double>(), hw};
     }
   }

@@ -201,7 +201,9 @@ int RunFilters(const FilterRunOptions& options) {
     if (options.figures && picture) {
       const auto grid_png = out / "figures" / ("grid_t" + stamp + ".png");
       TryFigure(
-          grid_png, [&] { RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, grid_png); }, &warnings);
+          grid_png,
+          [&] { RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, grid_png); },
+          &warnings);
       const auto scene_png = out / "figures" / ("scene_t" + stamp + ".png");
       TryFigure(
           scene_png, [&] { RenderScene(pipeline, scene_png, 60, 140, 22); }, &warnings);
@@ -300,6 +302,9 @@ int RunFilters(const FilterRunOptions& options) {
     summary["invariants_checked_steps"] = steps;
     summary["rss_mb"] = rss_mb;
   }
+  // The grid frame as resolved at the ego's departure (docs/algorithm.md, "Grid frame").
+  summary["grid_frame"] = {{"frame", scenario::ToString(config.grid.frame)},
+                           {"yaw_deg", RadToDeg(pipeline.grid_frame().yaw())}};
   summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!status.empty())

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -28,6 +29,7 @@ scenario::ScenarioConfig LoadConfig(const RunOptions& options) {
   for (const std::string& text : options.sets) overrides.push_back(scenario::ParseOverride(text));
   scenario::ScenarioConfig config = scenario::LoadScenario(options.scenario, overrides);
   config.overrides = options.sets;
+  for (const std::string& w : config.sim.warnings) std::cerr << "dualgrid: warning: " << w << "\n";
   if (options.seed) config.sim.seed = *options.seed;
   if (options.duration) config.sim.duration = *options.duration;
   // The overrides go through the same validation as the file.
@@ -198,7 +200,7 @@ std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& 
 GroundTruthWriter::GroundTruthWriter(const std::filesystem::path& path) : out_(path) {
   out_.buffer() +=
       "step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,"
-      "x_ego,y_ego,vx_ego,vy_ego\n";
+      "x_ego,y_ego,vx_ego,vy_ego,rcs_dbsm\n";
 }
 
 void GroundTruthWriter::Write(const sim::Frame& f) {
@@ -214,7 +216,7 @@ void GroundTruthWriter::Write(const sim::Frame& f) {
        << Fixed(v.velocity.y(), 4) << ',' << Fixed(v.speed, 4) << ',' << Fixed(v.lateral_speed, 4)
        << ',' << Fixed(v.yaw_rate, 6) << ',' << Fixed(v.box.length, 3) << ','
        << Fixed(v.box.width, 3) << ',' << v.lane << ',' << Fixed(p.x(), 4) << ',' << Fixed(p.y(), 4)
-       << ',' << Fixed(vr.x(), 4) << ',' << Fixed(vr.y(), 4) << '\n';
+       << ',' << Fixed(vr.x(), 4) << ',' << Fixed(vr.y(), 4) << ',' << Fixed(v.rcs_dbsm, 1) << '\n';
   };
   row(f.ego, true);
   for (const auto& v : f.vehicles) row(v, false);

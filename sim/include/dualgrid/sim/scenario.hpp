@@ -24,9 +24,10 @@ struct VehicleTypeSpec {
 
 /// How the ego's speed is chosen.
 struct SpeedPolicy {
-  enum class Mode { kCruise, kFixed };
+  enum class Mode { kCruise, kFixed, kSumo };
   /// kCruise: SUMO drives with `speed` as desired speed (car following applies);
-  /// kFixed: the speed is imposed every step (traffic is ignored).
+  /// kFixed: the speed is imposed every step (traffic is ignored);
+  /// kSumo: as the SUMO route file says (an ego taken from route files without speed_policy).
   Mode mode = Mode::kCruise;
   double speed = 27.78;  ///< [m/s]
 };
@@ -102,12 +103,30 @@ struct ScenarioSpec {
   std::vector<ActionSpec> actions;
   std::vector<GuardRail> guard_rails;
   std::vector<ParkedBox> parked;
+  /// SUMO route files (absolute paths) simulated besides the scenario's own vehicles
+  /// (`traffic.route_files`, or the route-files of `sumo_config`). Their vehicles are scored like
+  /// the others: box from their vType's length and width, RCS from `type_rcs` or VClassRcs.
+  std::vector<std::string> route_files;
+  /// True: the ego is the vehicle `ego.id` of route_files (`ego: {from_routes: ID}`), not one
+  /// the scenario places.
+  bool ego_from_routes = false;
+  /// Radar cross-section [dBsm] per vType id of route_files (`traffic.rcs_dbsm`).
+  std::map<std::string, double> type_rcs;
+  /// Parts of the input that are not honoured, one line each naming the file and the element
+  /// (filled by the loader; the tools print them as warnings).
+  std::vector<std::string> warnings;
 
   /// Checks ranges and cross references; `error` names the offending field.
   bool IsValid(std::string* error) const;
   /// Number of simulation steps.
   int StepCount() const;
 };
+
+/// Default radar cross-section [dBsm] of a SUMO vClass for vehicles of route files whose type
+/// the scenario does not give one (docs/scenarios.md, "Bring your own SUMO scenario"): passenger
+/// car 10, van (delivery) 14, truck / trailer / bus / coach 25, motorcycle 5, moped 3, bicycle 0
+/// (typical 77 GHz values of the literature, rounded); any other class 10.
+double VClassRcs(const std::string& vclass);
 
 /// Speed band of the paper's scenarios (70-130 km/h), used to validate traffic speeds.
 inline constexpr double kMinTrafficSpeed = 0.0;

@@ -61,6 +61,8 @@ class SumoSimulation {
   };
   const LaneGeometry& Lane(const std::string& lane_id);
   VehicleState ReadVehicle(const std::string& id);
+  // The scenario's type, or (for vehicles of the user's route files) SUMO's, cached by type id.
+  const VehicleTypeSpec& TypeOf(const std::string& vehicle, const std::string& type);
   void ApplyDepartures();
   void ApplyActions();
   // Checks the scenario against the loaded network: every route edge exists and consecutive
@@ -75,6 +77,7 @@ class SumoSimulation {
   std::size_t next_action_ = 0;
   std::map<std::string, LaneGeometry> lanes_;
   std::map<std::string, double> previous_yaw_;
+  std::map<std::string, VehicleTypeSpec> sumo_types_;
   std::uint64_t departures_ = 0;
 };
 

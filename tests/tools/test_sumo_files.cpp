@@ -1,0 +1,172 @@
+// SUMO's own files as input (issue 16, docs/scenarios.md "Bring your own SUMO scenario"): a
+// .sumocfg with route files, the ego taken from them by id, SUMO vehicle types mapped to boxes and
+// radar cross-sections, and one-line messages for what cannot be honoured.
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_harness.hpp"
+
+using namespace dualgrid::testing;
+
+namespace {
+
+// A SUMO user's folder: a straight two-lane road, a route file written as duarouter would (own
+// vTypes, vehicles with inline routes, a flow, a person), and a .sumocfg naming them.
+fs::path WriteSumoFolder(const fs::path& dir) {
+  std::ofstream(dir / "road.nod.xml")
+      << "<nodes>\n  <node id=\"w\" x=\"0\" y=\"0\"/>\n  <node id=\"e\" x=\"1500\" y=\"0\"/>\n"
+      << "</nodes>\n";
+  std::ofstream(dir / "road.edg.xml")
+      << "<edges>\n  <edge id=\"we\" from=\"w\" to=\"e\" numLanes=\"2\" speed=\"33.3\"/>\n"
+      << "  <edge id=\"ew\" from=\"e\" to=\"w\" numLanes=\"2\" speed=\"33.3\"/>\n</edges>\n";
+  const auto nc = Shell(std::string(DUALGRID_NETCONVERT) + " --node-files " +
+                        (dir / "road.nod.xml").string() + " --edge-files " +
+                        (dir / "road.edg.xml").string() + " -o " + (dir / "road.net.xml").string());
+  INFO(nc.output);
+  REQUIRE(nc.code == 0);
+  std::ofstream(dir / "traffic.rou.xml")
+      << "<routes>\n"
+      << "  <vType id=\"pkw\" vClass=\"passenger\" length=\"4.6\" width=\"1.9\"/>\n"
+      << "  <vType id=\"lkw\" vClass=\"truck\" length=\"16.5\" width=\"2.55\" maxSpeed=\"25\"/>\n"
+      << "  <vehicle id=\"veh_ego\" type=\"pkw\" depart=\"0\" departPos=\"200\" departLane=\"0\""
+         " departSpeed=\"20\">\n    <route edges=\"we\"/>\n  </vehicle>\n"
+      << "  <vehicle id=\"lead\" type=\"pkw\" depart=\"0\" departPos=\"240\" departLane=\"0\""
+         " departSpeed=\"18\">\n    <route edges=\"we\"/>\n  </vehicle>\n"
+      << "  <vehicle id=\"truck_1\" type=\"lkw\" depart=\"0\" departPos=\"260\" departLane=\"1\""
+         " departSpeed=\"22\">\n    <route edges=\"we\"/>\n  </vehicle>\n"
+      << "  <flow id=\"oncoming\" type=\"pkw\" begin=\"0\" end=\"20\" period=\"4\" from=\"ew\""
+         " to=\"ew\" departSpeed=\"max\"/>\n"
+      << "  <person id=\"walker\" depart=\"0\">\n    <walk edges=\"we\"/>\n  </person>\n"
+      << "</routes>\n";
+  std::ofstream(dir / "case.sumocfg")
+      << "<configuration>\n  <input>\n    <net-file value=\"road.net.xml\"/>\n"
+      << "    <route-files value=\"traffic.rou.xml\"/>\n"
+      << "    <additional-files value=\"stops.add.xml\"/>\n  </input>\n"
+      << "  <time>\n    <step-length value=\"0.5\"/>\n  </time>\n</configuration>\n";
+  return dir / "case.sumocfg";
+}
+
+std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream hs(line);
+  for (std::string h; std::getline(hs, h, ',');) header.push_back(h);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::map<std::string, std::string> row;
+    std::stringstream ls(line);
+    std::string v;
+    for (std::size_t i = 0; std::getline(ls, v, ',') && i < header.size(); ++i) row[header[i]] = v;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+TEST_CASE("a run from a .sumocfg with its route files and the ego chosen by id", "[cli][sumo]") {
+  const fs::path dir = TempDir("sumo_files", "run");
+  WriteSumoFolder(dir);
+  std::ofstream(dir / "scenario.yaml") << "name: own_sumo\nsumo_config: case.sumocfg\n"
+                                       << "duration: 12.0\nego: {from_routes: veh_ego}\n"
+                                       << "traffic: {rcs_dbsm: {lkw: 23.0}}\n"
+                                       << "evaluation: {focus_object: lead}\n";
+  const auto r = Run("run " + (dir / "scenario.yaml").string() + " --out " +
+                     (dir / "out").string() + " --no-figures -q");
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  // What cannot be honoured is named, one line each, with the file and the element.
+  CHECK(r.output.find("dualgrid: warning: " + (dir / "traffic.rou.xml").string() +
+                      ": 1 <person> element(s)") != std::string::npos);
+  CHECK(r.output.find("additional file " + (dir / "stops.add.xml").string() + " is not loaded") !=
+        std::string::npos);
+  CHECK(r.output.find("its step-length 0.5 s is replaced by step_length 0.05 s") !=
+        std::string::npos);
+  // The route file's vehicles are the ground truth, with their vType's box and RCS by vClass
+  // (passenger 10 dBsm) or the scenario's per-type value (lkw 23 dBsm).
+  std::set<std::string> ids;
+  bool ego_seen = false;
+  for (const auto& row : ReadCsv(dir / "out" / "ground_truth.csv")) {
+    ids.insert(row.at("id"));
+    if (row.at("id") == "veh_ego") {
+      ego_seen = true;
+      CHECK(row.at("is_ego") == "1");
+    }
+    if (row.at("id") == "truck_1") {
+      CHECK(row.at("length") == "16.500");
+      CHECK(row.at("width") == "2.550");
+      CHECK(row.at("rcs_dbsm") == "23.0");
+    }
+    if (row.at("id") == "lead") {
+      CHECK(row.at("length") == "4.600");
+      CHECK(row.at("rcs_dbsm") == "10.0");
+    }
+  }
+  CHECK(ego_seen);
+  CHECK(ids.count("lead"));
+  CHECK(ids.count("truck_1"));
+  CHECK(ids.count("oncoming.0"));
+  CHECK_FALSE(ids.count("walker"));
+  // And they are scored: the lead vehicle in the ego's lane is tracked.
+  bool lead_scored = false;
+  for (const auto& row : ReadCsv(dir / "out" / "objects.csv"))
+    lead_scored = lead_scored || (row.at("name") == "lead" && row.at("scored") == "1");
+  CHECK(lead_scored);
+}
+
+TEST_CASE("SUMO file inputs that cannot be used are refused naming the key", "[cli][sumo]") {
+  const fs::path dir = TempDir("sumo_files", "errors");
+  WriteSumoFolder(dir);
+  struct Case {
+    std::string yaml, expected;
+  };
+  const std::vector<Case> cases = {
+      {"sumo_config: case.sumocfg\nego: {from_routes: nobody}\n",
+       "key 'ego.from_routes' names 'nobody', which no vehicle of the route files has as its id"},
+      {"sumo_config: missing.sumocfg\nego: {from_routes: veh_ego}\n",
+       "missing.sumocfg: cannot read this SUMO configuration"},
+      {"network: road.net.xml\nsumo_config: case.sumocfg\nego: {from_routes: veh_ego}\n",
+       "key 'network' must not be given with sumo_config"},
+      {"sumo_config: case.sumocfg\nego: {from_routes: veh_ego, lane: 1}\n",
+       "key 'ego.lane' must not be given with from_routes"},
+      {"network: road.net.xml\ntraffic: {route_files: [nope.rou.xml]}\n"
+       "ego: {from_routes: veh_ego}\n",
+       "key 'traffic.route_files': " + (dir / "nope.rou.xml").string() + ": cannot read"},
+  };
+  for (const Case& c : cases) {
+    std::ofstream(dir / "bad.yaml") << "name: bad\n" << c.yaml;
+    const auto r = Run("sim " + (dir / "bad.yaml").string() + " --out " + (dir / "out").string() +
+                       " -q --duration 1");
+    INFO(c.yaml);
+    INFO(r.output);
+    CHECK(r.code == 2);
+    CHECK(r.output.find(c.expected) != std::string::npos);
+    CHECK(CountLines(r.output) <= 2);
+  }
+}
+
+TEST_CASE("the OpenStreetMap example of docs/scenarios.md runs as written", "[cli][sumo]") {
+  // sumo-tools (a required package) ships the network and route files it names.
+  const fs::path example = fs::path(DUALGRID_SOURCE_DIR) / "docs/examples/osm_motorway/a10.yaml";
+  const fs::path out = TempDir("sumo_files", "osm");
+  const auto r = Run("run " + example.string() + " --out " + (out / "run").string() +
+                     " --duration 5 --no-figures -q");
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const auto summary = nlohmann::json::parse(Slurp(out / "run" / "summary.json"));
+  // The grid lies along the ego's start heading (155 deg), not along world x.
+  CHECK(summary.at("grid_frame").at("frame") == "heading");
+  CHECK(summary.at("grid_frame").at("yaw_deg").get<double>() == Approx(155.0));
+  // Vehicles of the route files are in the grid and scored.
+  int scored = 0;
+  for (const auto& row : ReadCsv(out / "run" / "objects.csv")) scored += row.at("scored") == "1";
+  CHECK(scored > 0);
+}
