@@ -19,4 +19,17 @@ cd /
 "$dualgrid" run "$work/village.yaml" --duration 6 --no-figures -q --out "$work/run"
 grep -q '^village,D,%,dual,1,' "$work/run/table.csv"
 grep -q '^dual,[0-9]*,lead,' "$work/run/objects.csv"
-echo "custom network guide: 1 passed, 0 failed"
+# The ego and its lead turn left into the side street (docs/scenarios.md, "An ego that turns"):
+# the grid keeps its start heading and re-centres on the ego; the lead leaves it through its side
+# after turning and comes back when the ego has turned too. Scoring goes on throughout.
+"$dualgrid" run "$work/village.yaml" --no-figures -q --out "$work/turn" \
+  --set 'routes.left=[main_in, side_out]' --set ego.route=left --set traffic.vehicles.0.route=left
+awk -F, '$5 == 1 { yaw = $8 } END { if (yaw < 1.4 || yaw > 1.75) { print "ego did not turn: yaw " yaw; exit 1 } }' \
+  "$work/turn/ground_truth.csv"
+steps=$(awk -F, 'NR > 1 && $5 == 1' "$work/turn/ground_truth.csv" | wc -l)
+awk -F, -v steps="$steps" '$1 == "dual" && $3 == "lead" {
+  found = 1
+  if (!($4 > 100 && $4 < steps)) { print "lead in the grid for " $4 " of " steps " frames"; exit 1 }
+  if ($7 != 1 || $8 < 0.9) { print "lead not tracked while in the grid: " $0; exit 1 } }
+  END { if (!found) { print "lead not scored"; exit 1 } }' "$work/turn/objects.csv"
+echo "custom network guide: 2 passed, 0 failed"
