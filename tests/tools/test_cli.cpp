@@ -68,6 +68,22 @@ TEST_CASE("Errors are one line with a non-zero exit", "[cli]") {
   }
 }
 
+TEST_CASE("snapshot writes the format its --out names", "[cli]") {
+  const auto dir = TempDir("snapshot_vector");
+  for (const char* name : {"hw.svg", "hw.pdf"}) {
+    const Result r = Run("snapshot scenarios/highway.yaml --time 3 -q --out " +
+                         (dir / name).string());
+    INFO(r.output);
+    REQUIRE(r.code == 0);
+    const std::string text = Slurp(dir / name);
+    CHECK(text.rfind(std::string(name) == "hw.svg" ? "<?xml" : "%PDF-", 0) == 0);
+  }
+  const Result bad =
+      Run("snapshot scenarios/highway.yaml --time 3 -q --out " + (dir / "hw.jpg").string());
+  CHECK(bad.code != 0);
+  CHECK(bad.output.find("expected a file name ending in .png, .svg or .pdf") != std::string::npos);
+}
+
 TEST_CASE("snapshot writes a bird's-eye PNG", "[cli]") {
   const auto dir = TempDir("snapshot");
   const auto png = dir / "hw.png";
@@ -189,6 +205,16 @@ TEST_CASE("experiment forwards the picture options to its runs", "[cli][run]") {
   REQUIRE(Run(common + "--snapshots 1 --out " + with.string()).code == 0);
   CHECK(fs::exists(with / "seeds" / "seed_1" / "figures" / "grid_t1.00.png"));
   CHECK(fs::exists(with / "figures" / "grid_t1.00.png"));
+  // Every figure in every format by default, vectors included, in the runs and the experiment.
+  for (const char* f : {"grid_t1.00.svg", "grid_t1.00.pdf", "scene_t1.00.pdf"})
+    CHECK(fs::exists(with / "seeds" / "seed_1" / "figures" / f));
+  CHECK(fs::exists(with / "figures" / "tracked_share_v.svg"));
+  // --figure-formats chooses, and is forwarded to the seed that draws.
+  const auto png_only = TempDir("exp_png_only");
+  REQUIRE(Run(common + "--snapshots 1 --figure-formats png --out " + png_only.string()).code == 0);
+  CHECK(fs::exists(png_only / "seeds" / "seed_1" / "figures" / "grid_t1.00.png"));
+  CHECK_FALSE(fs::exists(png_only / "seeds" / "seed_1" / "figures" / "grid_t1.00.svg"));
+  CHECK_FALSE(fs::exists(png_only / "figures" / "tracked_share.pdf"));
   REQUIRE(Run(common + "--no-figures --out " + without.string()).code == 0);
   CHECK_FALSE(fs::exists(without / "figures" / "tracked_share.png"));
   CHECK(fs::is_empty(without / "seeds" / "seed_1" / "figures"));

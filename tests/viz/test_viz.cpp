@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <functional>
 #include <limits>
 #include <random>
@@ -329,7 +331,7 @@ TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]")
   view.DrawDetections(dets);
   const fs::path path = TempDir() / "birds_eye.png";
   fs::remove(path);
-  view.SavePng(path.string());
+  view.Save(path.string());
   REQUIRE(fs::exists(path));
   const Png png(path);
   CHECK(png.width() == 1600);
@@ -375,7 +377,7 @@ TEST_CASE("BirdsEyeView rejects bad input and unwritable paths", "[viz]") {
   DetectionStyle style;
   style.max_speed = 0.0;
   CheckInvalidArgument([&] { view.DrawDetections({}, style); }, "style.max_speed");
-  CHECK_THROWS_AS(view.SavePng("/nonexistent_dir_dualgrid/x.png"), std::runtime_error);
+  CHECK_THROWS_AS(view.Save("/nonexistent_dir_dualgrid/x.png"), std::runtime_error);
 }
 
 TEST_CASE("RenderBarChart draws grouped bars in mode colours", "[viz]") {
@@ -543,4 +545,74 @@ TEST_CASE("A one-sample span and a single point are drawn, not dropped", "[viz]"
   const Rgb8 band = png.At(Vector2(a.left + 0.2 * a.width, a.top + 0.8 * a.height));
   CHECK(band.r < 250);
   CHECK(Near(png.At(Vector2(a.left + 0.3 * a.width, a.top + 0.8 * a.height)), colors::kWhite));
+}
+
+namespace {
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+int Count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+  return n;
+}
+
+// cairo's SVG spelling of a fill colour: "fill:rgb(12.2%,46.7%,70.6%)".
+std::string SvgFill(const Rgba& c) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "fill:rgb(%.3g%%,%.3g%%,%.3g%%)", 100.0 * c.r, 100.0 * c.g,
+                100.0 * c.b);
+  return buf;
+}
+
+}  // namespace
+
+TEST_CASE("figures are written as SVG and PDF vectors by extension", "[viz][vector]") {
+  BarChart chart;
+  chart.title = "Tracked share";
+  chart.categories = {"obj 1", "obj 2"};
+  chart.series = {{"position", {0.7, 0.5}, {}}, {"dual", {0.9, 0.8}, {}}};
+  const fs::path dir = TempDir();
+  RenderBarChart(chart, (dir / "bars.svg").string());
+  RenderBarChart(chart, (dir / "bars.pdf").string());
+  const std::string svg = ReadText(dir / "bars.svg");
+  // A vector drawing of the chart's size in points: bars as filled paths in the mode colours,
+  // text as glyph outlines; no embedded raster.
+  CHECK(svg.rfind("<?xml", 0) == 0);
+  CHECK(svg.find("width=\"" + std::to_string(chart.width) + "pt\" height=\"" +
+                 std::to_string(chart.height) + "pt\"") != std::string::npos);
+  CHECK(svg.find(SvgFill(ModeColor(Mode::kPosition))) != std::string::npos);
+  CHECK(svg.find(SvgFill(ModeColor(Mode::kDual))) != std::string::npos);
+  CHECK(Count(svg, "<path") > 20);
+  CHECK(Count(svg, "<image") == 0);
+  const std::string pdf = ReadText(dir / "bars.pdf");
+  CHECK(pdf.rfind("%PDF-", 0) == 0);
+  CHECK(pdf.find("/MediaBox [ 0 0 " + std::to_string(chart.width) + " " +
+                 std::to_string(chart.height) + " ]") != std::string::npos);
+
+  // Grid panels: the cells stay a raster (one embedded image per panel), the rest is vectors.
+  std::vector<GridPanel> panels(2);
+  for (auto& p : panels) p.raster = UnknownRaster(40, 10, 0.5, Position(0.0, 0.0));
+  RenderGridPanels(panels, (dir / "grid.svg").string());
+  const std::string grid_svg = ReadText(dir / "grid.svg");
+  CHECK(Count(grid_svg, "<image") >= 2);
+  CHECK(Count(grid_svg, "<path") > 20);
+
+  // The bird's-eye view too; an unknown extension is refused naming the path.
+  BirdsEyeView view({Position(0, 0), Position(40, 20)});
+  view.DrawVehicle(OrientedBox{Position(20, 10), 0.3, 4.5, 1.8}, {});
+  view.Save((dir / "scene.pdf").string());
+  CHECK(ReadText(dir / "scene.pdf").rfind("%PDF-", 0) == 0);
+  try {
+    view.Save((dir / "scene.bmp").string());
+    FAIL("no exception");
+  } catch (const std::invalid_argument& e) {
+    CHECK(std::string(e.what()).find("scene.bmp': expected a file name ending in .png, .svg or "
+                                     ".pdf") != std::string::npos);
+  }
 }

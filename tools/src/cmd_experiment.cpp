@@ -58,6 +58,9 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
     args.insert(args.end(), {"--snapshots", times});
   }
   args.insert(args.end(), {"--detections", o.run.detections});
+  std::string formats;
+  for (const auto& f : o.run.figure_formats) formats += (formats.empty() ? "" : ",") + f;
+  if (figures) args.insert(args.end(), {"--figure-formats", formats});
   if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.check_invariants) args.push_back("--check-invariants");
   args.insert(args.end(), {"--threads", std::to_string(threads)});
@@ -196,14 +199,14 @@ int RunExperiment(const ExperimentOptions& o) {
       for (const auto& [id, r] : rows[v]) shares.emplace_back(names.Name(id), r);
       const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
       const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
-      TryFigure(
-          png,
-          [&] {
+      TryFigures(
+          png, o.run.figure_formats,
+          [&](const auto& p) {
             RenderTrackedShares(o.run.modes, shares,
                                 config.sim.name + ": tracked share " + what +
                                     " per object, mean over " + std::to_string(finished.size()) +
                                     " seeds",
-                                "tracked share " + what, png);
+                                "tracked share " + what, p);
           },
           &warnings);
     }

@@ -200,13 +200,16 @@ int RunFilters(const FilterRunOptions& options) {
     const std::string stamp = Fixed(f.time, 2);
     if (options.figures && picture) {
       const auto grid_png = out / "figures" / ("grid_t" + stamp + ".png");
-      TryFigure(
-          grid_png,
-          [&] { RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, grid_png); },
+      TryFigures(
+          grid_png, options.figure_formats,
+          [&](const auto& p) {
+            RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, p);
+          },
           &warnings);
       const auto scene_png = out / "figures" / ("scene_t" + stamp + ".png");
-      TryFigure(
-          scene_png, [&] { RenderScene(pipeline, scene_png, 60, 140, 22); }, &warnings);
+      TryFigures(
+          scene_png, options.figure_formats,
+          [&](const auto& p) { RenderScene(pipeline, p, 60, 140, 22); }, &warnings);
     }
     if (options.write_particles && picture)
       for (std::size_t m = 0; m < modes.size(); ++m)
@@ -265,23 +268,23 @@ int RunFilters(const FilterRunOptions& options) {
   if (options.figures && !stop) {
     if (!focus.empty()) {
       const auto png = out / "figures" / "weights.png";
-      TryFigure(
-          png,
-          [&] {
-            RenderWeightTrace(traces.by_vehicle.at(focus), focus, mode_names[trace_mode], png);
+      TryFigures(
+          png, options.figure_formats,
+          [&](const auto& p) {
+            RenderWeightTrace(traces.by_vehicle.at(focus), focus, mode_names[trace_mode], p);
           },
           &warnings);
     }
     for (const bool v : {false, true}) {
       const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
       const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
-      TryFigure(
-          png,
-          [&] {
+      TryFigures(
+          png, options.figure_formats,
+          [&](const auto& p) {
             RenderTrackedShares(mode_names, RunTrackedShares(metrics, pipeline.ids(), v),
                                 config.sim.name + ": tracked share " + what + " per object (seed " +
                                     std::to_string(config.sim.seed) + ")",
-                                "tracked share " + what, png);
+                                "tracked share " + what, p);
           },
           &warnings);
     }

@@ -11,11 +11,13 @@ namespace dualgrid::tools {
 int RunSnapshot(const SnapshotOptions& options) {
   RunOptions run = options.run;
   const std::filesystem::path png = run.out;
-  if (png.extension() != ".png")
-    throw std::invalid_argument(
-        "--out: the picture is a PNG; give a file name ending in .png, got '" + png.string() + "'");
+  // The extension picks the format: a raster, or vectors for papers.
+  if (png.extension() != ".png" && png.extension() != ".svg" && png.extension() != ".pdf")
+    throw std::invalid_argument("--out: expected a file name ending in .png, .svg or .pdf, got '" +
+                                png.string() + "'");
   if (std::filesystem::is_directory(png))
-    throw std::invalid_argument("--out: '" + png.string() + "' is a folder; give a .png file name");
+    throw std::invalid_argument("--out: '" + png.string() +
+                                "' is a folder; give a .png, .svg or .pdf file name");
   scenario::ScenarioConfig config = LoadConfig(run);
   if (!(options.time >= config.sim.step_length && options.time <= config.sim.duration))
     throw std::invalid_argument("--time must be in [" + Fixed(config.sim.step_length, 2) + ", " +

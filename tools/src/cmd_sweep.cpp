@@ -449,8 +449,9 @@ int RunCollect(const CollectOptions& o) {
         for (char& ch : name)
           if (ch == '/' || ch == ' ' || ch == ',' || ch == '=') ch = ch == '=' ? '-' : '_';
         const fs::path png = out / "figures" / (name + ".png");
-        TryFigure(
-            png, [&] { viz::RenderLineChart(chart, png.string()); }, &warnings);
+        TryFigures(
+            png, kFigureFormats, [&](const auto& p) { viz::RenderLineChart(chart, p.string()); },
+            &warnings);
       }
     }
   }

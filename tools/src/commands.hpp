@@ -36,6 +36,8 @@ struct FilterRunOptions {
   std::vector<std::string> modes = {"position", "velocity", "dual"};
   std::vector<double> snapshots;  ///< grid picture times [s]; empty: from the scenario
   bool figures = true;
+  /// Formats every figure is written in: "png", "svg", "pdf" (`--figure-formats`).
+  std::vector<std::string> figure_formats = {"png", "svg", "pdf"};
   /// detections.csv: "none", "csv" or "csv.gz" (gzip-compressed, about 3.5x smaller).
   std::string detections = "none";
   /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).

@@ -38,6 +38,18 @@ std::string FrameNote(const GridFrame& g) {
 
 }  // namespace
 
+bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::string>& formats,
+                const std::function<void(const std::filesystem::path&)>& draw,
+                std::vector<std::string>* warnings) {
+  bool all = true;
+  for (const std::string& format : formats) {
+    std::filesystem::path path = png_path;
+    path.replace_extension("." + format);
+    all = TryFigure(path, [&] { draw(path); }, warnings) && all;
+  }
+  return all;
+}
+
 void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width) {
   const sim::Frame& f = pipeline.frame();
@@ -86,7 +98,7 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
   viz::DetectionStyle style;
   style.coloring = viz::DetectionColoring::kBySpeed;
   view.DrawDetections(marks, style);
-  view.SavePng(path.string());
+  view.Save(path.string());
 }
 
 namespace {

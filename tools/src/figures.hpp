@@ -19,6 +19,15 @@ namespace dualgrid::tools {
 bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
                std::vector<std::string>* warnings);
 
+/// Figure file formats: "png" (raster), "svg" and "pdf" (vectors, for papers).
+inline const std::vector<std::string> kFigureFormats = {"png", "svg", "pdf"};
+
+/// TryFigure once per format: `draw(path)` writes `path`, which is `png_path` with the format's
+/// extension. Returns whether every format was written.
+bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::string>& formats,
+                const std::function<void(const std::filesystem::path&)>& draw,
+                std::vector<std::string>* warnings);
+
 /// Bird's-eye picture of the current step: lanes, guard rails, parked boxes, vehicles, radar
 /// fields of view and the step's detections with their radial-velocity arrows, drawn in the grid
 /// frame (pipeline.grid_frame(): the world turned so that the grid's axes are the picture's). The

@@ -66,6 +66,11 @@ void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
       ->delimiter(',')
       ->check(Number(0.0, kMaxDuration, true));
   cmd->add_flag("--no-figures", *no_figures, "Skip the pictures (metrics and tables only)");
+  cmd->add_option("--figure-formats", o->figure_formats,
+                  "Formats of every figure, comma-separated: png (raster), svg, pdf (vectors) "
+                  "(default: all three)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"png", "svg", "pdf"}));
   cmd->add_flag_callback(
       "--write-detections", [o] { o->detections = "csv"; }, "Same as --detections csv");
   Opt(cmd, "--detections", &o->detections,

@@ -293,7 +293,7 @@ void BirdsEyeView::DrawLabel(const Position& at, const std::string& text) {
            {.size = impl_->options.font_size, .v = VAlign::kMiddle, .halo = true});
 }
 
-void BirdsEyeView::SavePng(const std::string& path) const {
+void BirdsEyeView::Save(const std::string& path) const {
   const Impl& im = *impl_;
   const double fs = im.options.font_size;
   const double title_h = im.TitleHeight();
@@ -335,7 +335,7 @@ void BirdsEyeView::SavePng(const std::string& path) const {
     DrawText(cr, "|v_r| [m/s]", right_x + kColorBarWidth + 8.0, y + 0.5 * h,
              {.size = fs, .v = VAlign::kMiddle});
   }
-  out.WritePng(path);
+  out.Save(path);
 }
 
 }  // namespace dualgrid::viz

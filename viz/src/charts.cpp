@@ -187,7 +187,7 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
     DrawNoData(cr, a, "no data");
     DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
     DrawHeader(cr, chart.title, {}, a, chart.width);
-    canvas.WritePng(path);
+    canvas.Save(path);
     return;
   }
   const double slot = a.width / nc;
@@ -233,7 +233,7 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
              {.size = kFont * 0.9, .h = HAlign::kCenter, .v = VAlign::kTop});
   DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
   DrawHeader(cr, chart.title, legend, a, chart.width);
-  canvas.WritePng(path);
+  canvas.Save(path);
 }
 
 namespace {
@@ -416,7 +416,7 @@ void RenderLineChart(const LineChart& chart, const std::string& path) {
   DrawFrame(cr, a);
   DrawAxisLabels(cr, a, chart.x_label, chart.y_label);
   DrawHeader(cr, chart.title, legend, a, chart.width);
-  canvas.WritePng(path);
+  canvas.Save(path);
 }
 
 }  // namespace dualgrid::viz

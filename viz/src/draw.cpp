@@ -1,6 +1,7 @@
 #include "draw.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -9,24 +10,69 @@
 
 namespace dualgrid::viz::detail {
 
+namespace {
+
+cairo_surface_t* RecordingSurface(int width, int height) {
+  const cairo_rectangle_t extents{0.0, 0.0, static_cast<double>(width),
+                                  static_cast<double>(height)};
+  return cairo_recording_surface_create(CAIRO_CONTENT_COLOR_ALPHA, &extents);
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
 Canvas::Canvas(int width, int height)
     : width_(width),
       height_(height),
-      surface_(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width, height)),
+      surface_(RecordingSurface(width, height)),
       cr_(cairo_create(surface_.get())) {
-  if (cairo_surface_status(surface_.get()) != CAIRO_STATUS_SUCCESS)
+  if (width <= 0 || height <= 0 || cairo_surface_status(surface_.get()) != CAIRO_STATUS_SUCCESS)
     throw std::runtime_error("viz: cannot create a " + std::to_string(width) + "x" +
-                             std::to_string(height) + " image surface");
+                             std::to_string(height) + " drawing");
   cairo_set_source_rgb(cr(), 1.0, 1.0, 1.0);
   cairo_paint(cr());
 }
 
-void Canvas::WritePng(const std::string& path) const {
+void Canvas::Save(const std::string& path) const {
   cairo_surface_flush(surface_.get());
-  const cairo_status_t status = cairo_surface_write_to_png(surface_.get(), path.c_str());
-  if (status != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("viz: cannot write PNG '" + path +
-                             "': " + cairo_status_to_string(status));
+  const auto dot = path.rfind('.');
+  const std::string ext = dot == std::string::npos ? "" : Lower(path.substr(dot));
+  SurfacePtr target;
+  if (ext == ".png") {
+    target.reset(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_, height_));
+  } else if (ext == ".svg") {
+    target.reset(cairo_svg_surface_create(path.c_str(), width_, height_));
+  } else if (ext == ".pdf") {
+    target.reset(cairo_pdf_surface_create(path.c_str(), width_, height_));
+  } else {
+    throw std::invalid_argument("viz: cannot write '" + path +
+                                "': expected a file name ending in .png, .svg or .pdf");
+  }
+  const auto fail = [&](cairo_status_t status) {
+    throw std::runtime_error("viz: cannot write '" + path + "': " + cairo_status_to_string(status));
+  };
+  if (cairo_surface_status(target.get()) != CAIRO_STATUS_SUCCESS)
+    fail(cairo_surface_status(target.get()));
+  {
+    ContextPtr cr(cairo_create(target.get()));
+    cairo_set_source_surface(cr.get(), surface_.get(), 0.0, 0.0);
+    cairo_paint(cr.get());
+    if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) fail(cairo_status(cr.get()));
+  }
+  if (ext == ".png") {
+    cairo_surface_flush(target.get());
+    const cairo_status_t status = cairo_surface_write_to_png(target.get(), path.c_str());
+    if (status != CAIRO_STATUS_SUCCESS) fail(status);
+    return;
+  }
+  // SVG and PDF surfaces write their file when finished; errors show in the surface status.
+  cairo_surface_finish(target.get());
+  if (cairo_surface_status(target.get()) != CAIRO_STATUS_SUCCESS)
+    fail(cairo_surface_status(target.get()));
 }
 
 void SetColor(cairo_t* cr, const Rgba& c) { cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a); }

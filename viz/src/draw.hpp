@@ -1,6 +1,8 @@
 // Private cairo helpers shared by the figure kinds: surfaces, text, ticks, legends, scale bars.
 #pragma once
 
+#include <cairo-pdf.h>
+#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <memory>
@@ -20,7 +22,9 @@ struct ContextDeleter {
 using SurfacePtr = std::unique_ptr<cairo_surface_t, SurfaceDeleter>;
 using ContextPtr = std::unique_ptr<cairo_t, ContextDeleter>;
 
-/// An ARGB32 image with a drawing context, cleared to white.
+/// A drawing of width x height units (pixels in PNG, points in SVG and PDF) with a context,
+/// cleared to white. Drawn into a cairo recording surface, so one drawing is written as a raster
+/// or as vectors (text as text, lines as paths; embedded images such as grid cells stay rasters).
 class Canvas {
  public:
   Canvas(int width, int height);
@@ -28,8 +32,10 @@ class Canvas {
   cairo_surface_t* surface() const { return surface_.get(); }
   int width() const { return width_; }
   int height() const { return height_; }
-  /// Throws std::runtime_error naming the path and cairo's reason.
-  void WritePng(const std::string& path) const;
+  /// Writes the drawing; the format follows the extension: .png (raster), .svg or .pdf (vector,
+  /// through cairo's own surfaces). Throws std::invalid_argument for another extension and
+  /// std::runtime_error naming the path and cairo's reason when writing fails.
+  void Save(const std::string& path) const;
 
  private:
   int width_, height_;

@@ -371,7 +371,7 @@ void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& p
   const MapTransform& first = layout.panels.front();
   DrawLegendColumn(cr, first.pixel_offset().x() + first.pixel_width() + fs * 1.5,
                    first.pixel_offset().y(), options, LegendItems(panels), first.scale());
-  canvas.WritePng(path);
+  canvas.Save(path);
 }
 
 }  // namespace dualgrid::viz

@@ -73,7 +73,7 @@ struct DetectionStyle {
 
 /// Immediate-mode map canvas: each Draw call paints onto the map at once (later calls on top);
 /// the title band, legend band (with entries collected from the calls) and scale bar are added by
-/// SavePng. Image layout, top to bottom: title band (if any), map, legend band.
+/// Save. Image layout, top to bottom: title band (if any), map, legend band.
 class BirdsEyeView {
  public:
   /// Throws std::invalid_argument (naming the field) for a bad rectangle or options.
@@ -87,7 +87,7 @@ class BirdsEyeView {
   /// World point to pixel coordinates of the saved image (the map is shifted by the title band).
   Vector2 ToImagePixel(const Position& world) const;
   int image_width() const;
-  /// Height of the image SavePng would write now (depends on the legend entries so far).
+  /// Height of the image Save would write now (depends on the legend entries so far).
   int image_height() const;
 
   /// A lane centre line with its width [m]: light grey band with a darker edge.
@@ -101,8 +101,10 @@ class BirdsEyeView {
   /// Free text at a world position (e.g. a time stamp), left-aligned, with a white halo.
   void DrawLabel(const Position& at, const std::string& text);
 
-  /// Writes the PNG (cairo_surface_write_to_png); throws std::runtime_error on failure.
-  void SavePng(const std::string& path) const;
+  /// Writes the picture as PNG, SVG or PDF by the path's extension (.png, .svg, .pdf; vectors
+  /// through cairo's own surfaces). Throws std::invalid_argument for another extension and
+  /// std::runtime_error on a failed write.
+  void Save(const std::string& path) const;
 
  private:
   struct Impl;

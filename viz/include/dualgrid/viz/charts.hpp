@@ -68,6 +68,7 @@ struct LineChart {
 
 /// Throw std::invalid_argument (naming the field) for bad input, std::runtime_error if the PNG
 /// cannot be written.
+/// `path` ends in .png, .svg or .pdf (raster or vector; see BirdsEyeView::Save).
 void RenderBarChart(const BarChart& chart, const std::string& path);
 void RenderLineChart(const LineChart& chart, const std::string& path);
 

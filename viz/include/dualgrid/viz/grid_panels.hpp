@@ -76,6 +76,7 @@ GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
 /// Renders the panels stacked vertically, each with its title and axes in metres, plus a legend
 /// column (hue wheel for the direction of motion, free/static/unknown swatches, scale bar).
 /// Throws std::invalid_argument for bad input, std::runtime_error if the PNG cannot be written.
+/// `path` ends in .png, .svg or .pdf (the cells are an embedded raster in SVG and PDF).
 void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& path,
                       const GridFigureOptions& options = {});
 
