@@ -71,8 +71,8 @@ TEST_CASE("Errors are one line with a non-zero exit", "[cli]") {
 TEST_CASE("snapshot writes the format its --out names", "[cli]") {
   const auto dir = TempDir("snapshot_vector");
   for (const char* name : {"hw.svg", "hw.pdf"}) {
-    const Result r = Run("snapshot scenarios/highway.yaml --time 3 -q --out " +
-                         (dir / name).string());
+    const Result r =
+        Run("snapshot scenarios/highway.yaml --time 3 -q --out " + (dir / name).string());
     INFO(r.output);
     REQUIRE(r.code == 0);
     const std::string text = Slurp(dir / name);

@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <functional>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -594,6 +594,8 @@ TEST_CASE("figures are written as SVG and PDF vectors by extension", "[viz][vect
   CHECK(pdf.rfind("%PDF-", 0) == 0);
   CHECK(pdf.find("/MediaBox [ 0 0 " + std::to_string(chart.width) + " " +
                  std::to_string(chart.height) + " ]") != std::string::npos);
+  // No creation date: the same figure is the same bytes at any time (runs compare digests).
+  CHECK(pdf.find("/CreationDate") == std::string::npos);
 
   // Grid panels: the cells stay a raster (one embedded image per panel), the rest is vectors.
   std::vector<GridPanel> panels(2);

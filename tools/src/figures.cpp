@@ -45,7 +45,9 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
   for (const std::string& format : formats) {
     std::filesystem::path path = png_path;
     path.replace_extension("." + format);
-    all = TryFigure(path, [&] { draw(path); }, warnings) && all;
+    all = TryFigure(
+              path, [&] { draw(path); }, warnings) &&
+          all;
   }
   return all;
 }
@@ -66,7 +68,8 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
   };
   for (const auto& lane : pipeline.simulation().LaneShapes())
     view.DrawLane(to_grid(lane.points), lane.width);
-  for (const auto& rail : pipeline.config().sim.guard_rails) view.DrawGuardRail(to_grid(rail.points));
+  for (const auto& rail : pipeline.config().sim.guard_rails)
+    view.DrawGuardRail(to_grid(rail.points));
   for (const auto& p : pipeline.config().sim.parked) {
     viz::VehicleStyle style;
     style.fill = viz::colors::kGuardRail;

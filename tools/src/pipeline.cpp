@@ -79,9 +79,9 @@ void Pipeline::UpdateFilter(std::size_t i) {
   // The grid is centred on ego + offset (filter.ahead / filter.left); the filter reads only the
   // position of EgoInput's pose, to place the grid.
   const Pose2 pose = grid_frame_.ToGrid(ego_.pose);
-  filters_[i]->Update({{pose.position + centre_offset_, pose.yaw},
-                       grid_frame_.VectorToGrid(ego_.velocity)},
-                      measurements_, coverage_, dt_);
+  filters_[i]->Update(
+      {{pose.position + centre_offset_, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)},
+      measurements_, coverage_, dt_);
 }
 
 bool Pipeline::Advance() {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "dualgrid/eval/association.hpp"
 #include "dualgrid/core/grid_frame.hpp"
+#include "dualgrid/eval/association.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/radar_model/radar_model.hpp"
 #include "dualgrid/scenario/loader.hpp"

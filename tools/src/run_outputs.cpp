@@ -10,8 +10,8 @@ ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
 }
 
 void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::string& mode,
-                          const ModeScorer& scorer,
-                          const std::vector<eval::TruthObject>& objects, const IdRegistry& ids) {
+                          const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+                          const IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
   std::ostringstream os;
@@ -22,8 +22,8 @@ void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::st
     const Velocity vel = g.VectorToWorld(cl.velocity);
     const Position local = f.EgoPose().ToLocal(pos);
     os << f.step << ',' << Fixed(f.time, 3) << ',' << mode << ',' << Fixed(pos.x(), 3) << ','
-       << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ',' << Fixed(vel.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
-       << kRole[static_cast<int>(a.role[c])] << ','
+       << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ',' << Fixed(vel.y(), 3) << ','
+       << cl.weight << ',' << cl.size << ',' << kRole[static_cast<int>(a.role[c])] << ','
        << (a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id)
                                        : std::string())
        << ',' << Fixed(local.x(), 2) << ',' << Fixed(local.y(), 2) << '\n';

@@ -25,8 +25,8 @@ class ClusterWriter {
   /// The clusters of `scorer`'s last frame, for mode `mode`; `objects` as given to the scorer.
   /// Clusters are scored in the grid frame and written in the world frame.
   void Write(const sim::Frame& frame, const GridFrame& grid_frame, const std::string& mode,
-             const ModeScorer& scorer,
-             const std::vector<eval::TruthObject>& objects, const IdRegistry& ids);
+             const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+             const IdRegistry& ids);
   void Close() { out_.Close(); }
 
  private:

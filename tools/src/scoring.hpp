@@ -40,8 +40,9 @@ class ModeScorer {
  public:
   explicit ModeScorer(const scenario::EvaluationConfig& config);
   /// Scores one cycle. `snapshot` is TakeSnapshot(grid, ...); `truth_classes` from TruthClasses.
-  /// All positions in the grid frame. Particles inside `ego_box` are not clustered: no other object can be there, and particles
-  /// there would chain the vehicles on both sides of the ego into one cluster.
+  /// All positions in the grid frame. Particles inside `ego_box` are not clustered: no other object
+  /// can be there, and particles there would chain the vehicles on both sides of the ego into one
+  /// cluster.
   void AddFrame(double time, const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
                 const std::vector<eval::TruthObject>& objects,
                 const std::vector<std::uint8_t>& truth_classes, const OrientedBox& ego_box);

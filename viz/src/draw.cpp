@@ -48,6 +48,9 @@ void Canvas::Save(const std::string& path) const {
     target.reset(cairo_svg_surface_create(path.c_str(), width_, height_));
   } else if (ext == ".pdf") {
     target.reset(cairo_pdf_surface_create(path.c_str(), width_, height_));
+    // No creation date: the same figure gives the same bytes (runs are compared by digests).
+    if (cairo_surface_status(target.get()) == CAIRO_STATUS_SUCCESS)
+      cairo_pdf_surface_set_metadata(target.get(), CAIRO_PDF_METADATA_CREATE_DATE, "");
   } else {
     throw std::invalid_argument("viz: cannot write '" + path +
                                 "': expected a file name ending in .png, .svg or .pdf");
