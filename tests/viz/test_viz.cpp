@@ -618,3 +618,25 @@ TEST_CASE("figures are written as SVG and PDF vectors by extension", "[viz][vect
                                      ".pdf") != std::string::npos);
   }
 }
+
+TEST_CASE("grid panels go side by side when they are square enough", "[viz][layout]") {
+  std::vector<GridPanel> panels(3);
+  for (auto& p : panels) p.raster = UnknownRaster(40, 40, 0.5, Position(-10.0, -10.0));
+  GridFigureOptions opt;
+  const GridFigureLayout row = LayoutGridPanels(panels, opt);
+  REQUIRE(row.panels.size() == 3);
+  for (int k = 0; k + 1 < 3; ++k) {
+    CHECK(row.panels[k + 1].pixel_offset().y() == row.panels[k].pixel_offset().y());
+    CHECK(row.panels[k + 1].pixel_offset().x() >=
+          row.panels[k].pixel_offset().x() + row.panels[k].pixel_width());
+  }
+  CHECK(row.panels[2].pixel_offset().x() + row.panels[2].pixel_width() <= row.width);
+  // Asked for one column, they stack; a wide (8:1) grid stacks by default (the layout test above).
+  opt.columns = 1;
+  const GridFigureLayout stacked = LayoutGridPanels(panels, opt);
+  CHECK(stacked.panels[1].pixel_offset().y() >
+        stacked.panels[0].pixel_offset().y() + stacked.panels[0].pixel_height());
+  CHECK(stacked.height > row.height);
+  opt.columns = -1;
+  CHECK_THROWS_AS(LayoutGridPanels(panels, opt), std::invalid_argument);
+}

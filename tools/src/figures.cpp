@@ -116,16 +116,26 @@ viz::GridRaster ToRaster(const GridSnapshot& s) {
 void RenderGridFigure(const std::vector<std::string>& modes,
                       const std::vector<GridSnapshot>& snapshots, const GridFrame& g,
                       const sim::Frame& frame, double time, const std::filesystem::path& path) {
+  // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
+  // not with the network's (often UTM-sized) coordinates.
+  const Position ego = g.ToGrid(frame.ego.box.center);
+  const auto from_ego = [&](OrientedBox b) {
+    b.center -= ego;
+    return b;
+  };
   std::vector<viz::GridPanel> panels;
   for (std::size_t i = 0; i < modes.size(); ++i) {
     viz::GridPanel panel;
     panel.title = modes[i];
     panel.raster = ToRaster(snapshots[i]);
-    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(g.ToGrid(v.box));
-    panel.ego_boxes.push_back(g.ToGrid(frame.ego.box));
+    panel.raster.origin -= ego;
+    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(from_ego(g.ToGrid(v.box)));
+    panel.ego_boxes.push_back(from_ego(g.ToGrid(frame.ego.box)));
     panels.push_back(std::move(panel));
   }
   viz::GridFigureOptions options;
+  options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the title)
+  options.y_label = "y [m]";
   options.title = "Dynamic grid at t = " + Fixed(time, 2) +
                   " s: hue = direction of motion, white free, black static, grey unknown" +
                   FrameNote(g);

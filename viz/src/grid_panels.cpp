@@ -58,6 +58,7 @@ bool GridFigureOptions::IsValid(std::string* error) const {
   };
   if (image_width < 500 || image_width > 20000) return fail("image_width must be in [500, 20000]");
   if (!(font_size >= 6.0 && font_size <= 40.0)) return fail("font_size must be in [6, 40]");
+  if (columns < 0) return fail("columns must be >= 0 (0: automatic)");
   std::string sub;
   if (!cell.IsValid(&sub)) return fail("cell." + sub);
   return true;
@@ -248,7 +249,7 @@ void DrawPanel(cairo_t* cr, const GridPanel& panel, const MapTransform& t,
     DrawText(cr, detail::FormatTick(v, yt.size() > 1 ? yt[1] - yt[0] : 1.0), x0 - 7.0, py, tick_y);
   }
   cairo_restore(cr);
-  DrawText(cr, "y [m]", fs * 0.9, y0 + 0.5 * h,
+  DrawText(cr, options.y_label, x0 - m.left + fs * 0.9, y0 + 0.5 * h,
            {.size = fs * 0.9, .h = HAlign::kCenter, .v = VAlign::kMiddle, .angle = -0.5 * kPi});
 }
 
@@ -336,12 +337,25 @@ GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
   const Metrics m = MetricsFor(options);
   GridFigureLayout layout;
   layout.width = options.image_width;
-  const int map_w = static_cast<int>(options.image_width - m.left - m.right_col);
+  const int n = static_cast<int>(panels.size());
+  int columns = std::min(options.columns, n);
+  if (columns == 0) {
+    const WorldRect e = panels.front().raster.Extent();
+    const double aspect = (e.max.x() - e.min.x()) / std::max(1e-9, e.max.y() - e.min.y());
+    columns = aspect <= 2.5 ? n : 1;
+  }
+  // Side by side, each panel keeps a left margin for its y ticks.
+  const double all_w = options.image_width - m.left - m.right_col;
+  const int map_w = static_cast<int>((all_w - (columns - 1) * m.left) / columns);
   double y = m.pad + m.fig_title;
-  for (const GridPanel& p : panels) {
-    y += m.panel_title;
-    layout.panels.emplace_back(p.raster.Extent(), map_w, Vector2(m.left, y));
-    y += layout.panels.back().pixel_height() + m.tick_band;
+  for (int i = 0; i < n; ++i) {
+    const int col = i % columns;
+    if (col == 0) y += m.panel_title;
+    layout.panels.emplace_back(panels[i].raster.Extent(), map_w,
+                               Vector2(m.left + col * (map_w + m.left), y));
+    if (col == columns - 1 || i == n - 1)
+      y += layout.panels.back().pixel_height() + m.tick_band +
+           (i == n - 1 ? 0.0 : m.x_label * (columns > 1 ? 1.0 : 0.0));
   }
   y += m.x_label + m.pad;
   const double fs = options.font_size;
@@ -364,11 +378,19 @@ void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& p
              {.size = fs * 1.3, .bold = true, .h = HAlign::kCenter, .v = VAlign::kMiddle});
   for (std::size_t i = 0; i < panels.size(); ++i)
     DrawPanel(cr, panels[i], layout.panels[i], options, m);
-  const MapTransform& last = layout.panels.back();
-  DrawText(cr, "x [m]", last.pixel_offset().x() + 0.5 * last.pixel_width(),
-           last.pixel_offset().y() + last.pixel_height() + m.tick_band + 0.5 * m.x_label,
-           {.size = fs * 0.9, .h = HAlign::kCenter, .v = VAlign::kMiddle});
-  const MapTransform& first = layout.panels.front();
+  // The x label under each panel of the last row (the bottom panel when stacked).
+  const double last_y = layout.panels.back().pixel_offset().y();
+  for (const MapTransform& t : layout.panels) {
+    if (t.pixel_offset().y() != last_y) continue;
+    DrawText(cr, options.x_label, t.pixel_offset().x() + 0.5 * t.pixel_width(),
+             t.pixel_offset().y() + t.pixel_height() + m.tick_band + 0.5 * m.x_label,
+             {.size = fs * 0.9, .h = HAlign::kCenter, .v = VAlign::kMiddle});
+  }
+  // The legend column right of the rightmost panel.
+  const MapTransform* right = &layout.panels.front();
+  for (const MapTransform& t : layout.panels)
+    if (t.pixel_offset().x() > right->pixel_offset().x()) right = &t;
+  const MapTransform& first = *right;
   DrawLegendColumn(cr, first.pixel_offset().x() + first.pixel_width() + fs * 1.5,
                    first.pixel_offset().y(), options, LegendItems(panels), first.scale());
   canvas.Save(path);

@@ -59,6 +59,11 @@ struct GridFigureOptions {
   std::string title;  ///< figure title above all panels when not empty
   CellColorOptions cell;
   double font_size = 14.0;
+  /// Axis labels (the frame and origin of the rasters' coordinates, e.g. relative to the ego).
+  std::string x_label = "x [m]", y_label = "y [m]";
+  /// Panels per row: 0 = automatic (side by side when a panel is at most 2.5 times as wide as
+  /// high, e.g. a square grid; stacked for the paper's 8:1 road grid), else 1..panels.
+  int columns = 0;
   bool IsValid(std::string* error) const;
 };
 
@@ -73,7 +78,8 @@ struct GridFigureLayout {
 GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
                                   const GridFigureOptions& options = {});
 
-/// Renders the panels stacked vertically, each with its title and axes in metres, plus a legend
+/// Renders the panels stacked or side by side (options.columns), each with its title and axes in
+/// metres, plus a legend
 /// column (hue wheel for the direction of motion, free/static/unknown swatches, scale bar).
 /// Throws std::invalid_argument for bad input, std::runtime_error if the PNG cannot be written.
 /// `path` ends in .png, .svg or .pdf (the cells are an embedded raster in SVG and PDF).
