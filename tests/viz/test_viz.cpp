@@ -640,3 +640,31 @@ TEST_CASE("grid panels go side by side when they are square enough", "[viz][layo
   opt.columns = -1;
   CHECK_THROWS_AS(LayoutGridPanels(panels, opt), std::invalid_argument);
 }
+
+TEST_CASE("bar charts draw confidence whiskers and validate them", "[viz]") {
+  BarChart chart;
+  chart.categories = {"obj"};
+  chart.series = {{"dual", {0.5}, {}, {0.2}}};
+  chart.percent = true;
+  chart.value_labels = false;
+  const fs::path path = TempDir() / "whiskers.png";
+  RenderBarChart(chart, path.string());
+  const Png png(path);
+  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const double bar_w = 0.8 * a.width;
+  const int xc = static_cast<int>(a.left + 0.1 * a.width + 0.5 * bar_w);
+  const auto py = [&](double v) {
+    return static_cast<int>(std::lround(a.top + a.height * (1 - v)));
+  };
+  // The cap at 0.5 + 0.2 is black; above it, the background; beside the bar top, the bar colour.
+  CHECK(Near(png.At(xc, py(0.7)), colors::kBlack, 90));
+  CHECK(Near(png.At(xc, py(0.85)), colors::kWhite, 2));  // off the 0.8 grid line
+  CHECK(Near(png.At(static_cast<int>(a.left + 0.1 * a.width + 0.1 * bar_w), py(0.4)),
+             ModeColor(Mode::kDual), 3));
+  chart.series[0].errors = {0.1, 0.2};
+  CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
+                       "series[0].errors has 2 values, expected 0 or 1");
+  chart.series[0].errors = {-0.1};
+  CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
+                       "series[0].errors must be finite and >= 0");
+}

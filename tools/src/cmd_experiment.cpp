@@ -182,11 +182,14 @@ int RunExperiment(const ExperimentOptions& o) {
 
   // Per-object tracked share over seeds (paper Fig. 6), D and D_v.
   std::map<int, std::vector<double>> rows[2];  // [velocity_aware][object] -> per mode
+  std::map<int, std::vector<double>> half[2];  // the same for the 95 % CI half-widths
   nlohmann::json per_object;
   for (const bool v : {false, true})
     for (std::size_t m = 0; m < runs.size(); ++m)
       for (const auto& [id, s] : eval::PerObjectTrackedFraction(runs[m].seeds, v)) {
         rows[v].try_emplace(id, runs.size(), std::nan("")).first->second[m] = s.mean;
+        half[v].try_emplace(id, runs.size(), std::nan("")).first->second[m] =
+            s.half_width.value_or(std::nan(""));
         per_object[names.Name(id)][runs[m].mode][v ? "D_v" : "D"] = s;
       }
   WriteTextFile(out / "per_object.json", per_object.dump(2) + "\n");
@@ -195,18 +198,19 @@ int RunExperiment(const ExperimentOptions& o) {
   std::vector<std::string> warnings;
   if (o.run.figures && !StopSignal()) {
     for (const bool v : {false, true}) {
-      TrackedShares shares;
+      TrackedShares shares, errors;
       for (const auto& [id, r] : rows[v]) shares.emplace_back(names.Name(id), r);
+      for (const auto& [id, r] : half[v]) errors.emplace_back(names.Name(id), r);
       const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
       const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
       TryFigures(
           png, o.run.figure_formats,
           [&](const auto& p) {
             RenderTrackedShares(o.run.modes, shares,
-                                config.sim.name + ": tracked share " + what +
-                                    " per object, mean over " + std::to_string(finished.size()) +
-                                    " seeds",
-                                "tracked share " + what, p);
+                                config.sim.name + ": " + (v ? "D_v" : "D") +
+                                    " per object, mean and 95 % CI over " +
+                                    std::to_string(finished.size()) + " seeds",
+                                "tracked share " + what, p, errors);
           },
           &warnings);
     }

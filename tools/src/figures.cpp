@@ -159,7 +159,7 @@ TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics
 
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
-                         const std::filesystem::path& path) {
+                         const std::filesystem::path& path, const TrackedShares& errors) {
   viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
   chart.x_label = "object";
@@ -174,6 +174,7 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
     viz::BarSeries s;
     s.name = modes[m];
     for (const auto& [name, row] : shares) s.values.push_back(row[m]);
+    for (const auto& [name, row] : errors) s.errors.push_back(row[m]);
     chart.series.push_back(std::move(s));
   }
   viz::RenderBarChart(chart, path.string());

@@ -45,10 +45,11 @@ void RenderGridFigure(const std::vector<std::string>& modes,
 using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
 
 /// The paper's Fig. 6: tracked share (D or D_v, named by `y_label`) per object and mode; says
-/// "no data" without objects.
+/// "no data" without objects. `errors`, when not empty, holds per object (same order as
+/// `shares`) and mode the 95 % CI half-width over seeds, drawn as whiskers.
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
-                         const std::filesystem::path& path);
+                         const std::filesystem::path& path, const TrackedShares& errors = {});
 
 /// The scored objects' D (or D_v, `velocity_aware`) of one run, per mode (object ids named
 /// through `ids`).

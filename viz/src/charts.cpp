@@ -128,6 +128,13 @@ bool BarChart::IsValid(std::string* error) const {
                              std::to_string(categories.size()) + " (one per category)");
     for (double v : series[i].values)
       if (std::isinf(v)) return Fail(error, "series[" + std::to_string(i) + "].values has inf");
+    if (!series[i].errors.empty() && series[i].errors.size() != categories.size())
+      return Fail(error, "series[" + std::to_string(i) + "].errors has " +
+                             std::to_string(series[i].errors.size()) + " values, expected 0 or " +
+                             std::to_string(categories.size()));
+    for (double e : series[i].errors)
+      if (!std::isnan(e) && !(e >= 0.0 && std::isfinite(e)))
+        return Fail(error, "series[" + std::to_string(i) + "].errors must be finite and >= 0");
   }
   if (!std::isfinite(y_min)) return Fail(error, "y_min must be finite");
   if (!std::isnan(y_max) && !(y_max > y_min)) return Fail(error, "y_max must exceed y_min");
@@ -162,8 +169,10 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
 
   double data_max = chart.y_min;
   for (const BarSeries& s : chart.series)
-    for (double v : s.values)
-      if (std::isfinite(v)) data_max = std::max(data_max, v);
+    for (std::size_t c = 0; c < s.values.size(); ++c) {
+      const double e = c < s.errors.size() && std::isfinite(s.errors[c]) ? s.errors[c] : 0.0;
+      if (std::isfinite(s.values[c])) data_max = std::max(data_max, s.values[c] + e);
+    }
   double y_hi = chart.y_max;
   if (std::isnan(y_hi)) y_hi = chart.percent ? std::max(1.0, data_max) : data_max * 1.08;
   const LinearAxis axis = NiceAxis(chart.y_min, y_hi, true, !std::isnan(chart.y_max), 5);
@@ -211,13 +220,29 @@ void RenderBarChart(const BarChart& chart, const std::string& path) {
       SetColor(cr, Mix(color, colors::kBlack, 0.4));
       cairo_set_line_width(cr, 1.0);
       cairo_stroke(cr);
+      double label_y = std::min(top, base) - 3.0;
+      if (c < static_cast<int>(series.errors.size()) && std::isfinite(series.errors[c])) {
+        // Whisker value +- error, capped, black over the bar; the value label goes above it.
+        const double e = series.errors[c], xc = x + 0.5 * bar_w, cap = 0.25 * bar_w;
+        const double y_lo = to_py(v - e), y_hi = to_py(v + e);
+        label_y = std::min(label_y, y_hi - 3.0);
+        SetColor(cr, colors::kBlack);
+        cairo_set_line_width(cr, 1.5);
+        cairo_move_to(cr, xc, y_lo);
+        cairo_line_to(cr, xc, y_hi);
+        cairo_move_to(cr, xc - cap, y_lo);
+        cairo_line_to(cr, xc + cap, y_lo);
+        cairo_move_to(cr, xc - cap, y_hi);
+        cairo_line_to(cr, xc + cap, y_hi);
+        cairo_stroke(cr);
+      }
       if (chart.value_labels && bar_w >= 22.0) {
         char buf[32];
         if (chart.percent)
           std::snprintf(buf, sizeof buf, "%.0f%%", 100.0 * v);
         else
           std::snprintf(buf, sizeof buf, "%.3g", v);
-        DrawText(cr, buf, x + 0.5 * bar_w, std::min(top, base) - 3.0,
+        DrawText(cr, buf, x + 0.5 * bar_w, label_y,
                  {.size = kFont * 0.72, .h = HAlign::kCenter, .v = VAlign::kBottom});
       }
     }

@@ -14,6 +14,9 @@ struct BarSeries {
   std::string name;  ///< legend label; a mode name ("dual", ...) picks ModeColor by default
   std::vector<double> values;  ///< one per category; NaN = no bar
   std::optional<Rgba> color;
+  /// Empty, or one half-width per category drawn as a whisker value +- error with caps (e.g. the
+  /// 95 % confidence interval over seeds); NaN = no whisker. Must be >= 0.
+  std::vector<double> errors;
 };
 
 struct BarChart {
