@@ -91,7 +91,7 @@ void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
   const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
   const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
   // The point's own cell first: in a dense cluster the core test then stops after a few
-  // distances instead of scanning the far corners of the neighbouring cells (~10x on vehicles).
+  // distances instead of scanning the far corners of the neighbouring cells.
   static constexpr int kOrder[9][2] = {{0, 0}, {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
                                        {0, 1}, {1, -1},  {1, 0},  {1, 1}};
   for (const auto& [dx, dy] : kOrder) {

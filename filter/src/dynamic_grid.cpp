@@ -65,15 +65,6 @@ Position DynamicGrid::CellCenter(CellIndex c) const {
           (static_cast<double>(origin_gy_ + c.y) + 0.5) * r};
 }
 
-std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
-  if (!initialized_ || !p.allFinite()) return std::nullopt;
-  const double r = params_.resolution;
-  const double fx = std::floor(p.x() / r) - static_cast<double>(origin_gx_);
-  const double fy = std::floor(p.y() / r) - static_cast<double>(origin_gy_);
-  if (fx < 0.0 || fy < 0.0 || fx >= nx_ || fy >= ny_) return std::nullopt;
-  return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
-}
-
 void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measurements,
                          std::span<const SensorCoverage> coverage, double dt) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) {

@@ -284,8 +284,9 @@ void WriteFields(const Field<S, T> (&fields)[N], const S& in, nlohmann::json* j)
   }
 }
 
-void ReadSensorFields(MapReader& r, radar::SensorParams* p) {
+void ReadSensorFields(MapReader& r, radar::SensorParams* p, RadarConfig* radar) {
   if (auto m = r.Map("mount")) {
+    radar->mounts_given.insert(p->name);
     m->Read("x", &p->mount.position.x());
     m->Read("y", &p->mount.position.y());
     m->ReadDegrees("yaw_deg", &p->mount.yaw);
@@ -334,6 +335,8 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
   radar->sensors = radar::DefaultRig(
       ego_type.length, ego_type.width,
       accuracy == "clean" ? radar::Accuracy::kClean : radar::Accuracy::kDataSheet);
+  radar->rig_length = ego_type.length;
+  radar->rig_width = ego_type.width;
   if (!section) return;
   std::string rig = "default";
   section->Read("rig", &rig);
@@ -351,7 +354,7 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
   // a YAML::Node assigns the node it refers to.)
   for (auto& [name, r] : overrides) {
     if (name != "all") continue;
-    for (auto& sensor : radar->sensors) ReadSensorFields(r, &sensor);
+    for (auto& sensor : radar->sensors) ReadSensorFields(r, &sensor, radar);
     r.Finish();
   }
   for (auto& [name, r] : overrides) {
@@ -362,7 +365,7 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
     if (it == radar->sensors.end())
       throw ConfigError(r.file() + ": key '" + r.path() + "' names unknown sensor '" + name +
                         "' (expected one of: " + names() + ")");
-    ReadSensorFields(r, &*it);
+    ReadSensorFields(r, &*it, radar);
     r.Finish();
   }
   if (section->Has("use")) {
@@ -386,6 +389,27 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
     if (!s.IsValid(&error)) Invalid(root.file(), "sensors.overrides." + s.name, error);
   }
 }
+
+}  // namespace
+
+bool PlaceRigOn(RadarConfig* radar, double length, double width) {
+  if (length == radar->rig_length && width == radar->rig_width) return false;
+  const std::vector<radar::SensorParams> rig = radar::DefaultRig(length, width);
+  bool moved = false;
+  for (radar::SensorParams& s : radar->sensors) {
+    if (radar->mounts_given.count(s.name)) continue;
+    for (const radar::SensorParams& d : rig) {
+      if (d.name != s.name) continue;
+      moved = moved || d.mount.position != s.mount.position || d.mount.yaw != s.mount.yaw;
+      s.mount = d.mount;
+    }
+  }
+  radar->rig_length = length;
+  radar->rig_width = width;
+  return moved;
+}
+
+namespace {
 
 // Reads a switch given by name into *out, naming the accepted values on error.
 template <typename E>

@@ -75,10 +75,11 @@ SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
   const std::filesystem::path base = std::filesystem::absolute(cfg).parent_path();
   SumoConfigInputs in;
   const auto net = ValueOf(xml, "net-file");
-  if (!net || net->empty())
+  const auto nets = net ? PathList(*net, base) : std::vector<std::filesystem::path>{};
+  if (nets.empty())
     throw std::invalid_argument(cfg.string() +
                                 ": element <net-file value=\"...\"/> expected in <input>");
-  in.net_file = PathList(*net, base).front();
+  in.net_file = nets.front();
   if (const auto r = ValueOf(xml, "route-files")) in.route_files = PathList(*r, base);
   if (const auto a = ValueOf(xml, "additional-files")) in.additional_files = PathList(*a, base);
   if (const auto s = ValueOf(xml, "step-length")) {

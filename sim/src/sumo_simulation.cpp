@@ -112,6 +112,21 @@ std::filesystem::path ResolveNetwork(const std::string& network,
       "; or give a path to a .net.xml file, relative to the scenario file)");
 }
 
+namespace {
+
+// The types the scenario's own vehicles use, the only ones written to its route file: a route
+// file of the user may define a type of the same name (SUMO refuses a second definition, and
+// that name then means the user's type).
+std::set<std::string> OwnTypes(const ScenarioSpec& spec) {
+  std::set<std::string> used;
+  if (!spec.ego_from_routes) used.insert(spec.ego.type);
+  for (const VehicleSpec& v : spec.vehicles) used.insert(v.type);
+  for (const FlowSpec& f : spec.flows) used.insert(f.type);
+  return used;
+}
+
+}  // namespace
+
 void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write route file " + path.string());
@@ -124,12 +139,7 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
       << name << "' -->\n<routes>\n";
   // Desired speeds are set per vehicle through maxSpeed (see ApplyDepartures); a speed factor of
   // 1.5 keeps the lane limits from capping them below 130 km/h.
-  // Only the types the scenario's own vehicles use: a route file of the user may define a type of
-  // the same name (SUMO refuses a second definition).
-  std::set<std::string> used;
-  if (!spec.ego_from_routes) used.insert(spec.ego.type);
-  for (const VehicleSpec& v : spec.vehicles) used.insert(v.type);
-  for (const FlowSpec& f : spec.flows) used.insert(f.type);
+  const std::set<std::string> used = OwnTypes(spec);
   for (const auto& [name, t] : spec.vehicle_types) {
     if (!used.count(name)) continue;
     out << "  <vType id=\"" << Xml(name) << "\" length=\"" << Num(t.length) << "\" width=\""
@@ -174,7 +184,7 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
 
 SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                                const std::filesystem::path& work_dir)
-    : spec_(spec), log_path_(work_dir / "sumo.log") {
+    : spec_(spec), log_path_(work_dir / "sumo.log"), own_types_(OwnTypes(spec)) {
   std::string error;
   if (!spec_.IsValid(&error))
     throw std::invalid_argument("scenario '" + spec_.name + "': " + error);
@@ -334,8 +344,7 @@ VehicleState SumoSimulation::ReadVehicle(const std::string& id) {
 }
 
 const VehicleTypeSpec& SumoSimulation::TypeOf(const std::string& vehicle, const std::string& type) {
-  if (const auto it = spec_.vehicle_types.find(type); it != spec_.vehicle_types.end())
-    return it->second;
+  if (own_types_.count(type)) return spec_.vehicle_types.at(type);
   if (const auto it = sumo_types_.find(type); it != sumo_types_.end()) return it->second;
   if (spec_.route_files.empty())
     throw std::runtime_error("vehicle '" + vehicle + "' has type '" + type +

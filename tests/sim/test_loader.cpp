@@ -270,4 +270,6 @@ TEST_CASE("grid frame and placement keys", "[loader][frame]") {
   // Checked against the extent given in the same section, whatever the key order.
   CHECK_NOTHROW(LoadScenario(
       Write("frame2.yaml", std::string(kValid) + "filter: {ahead: 250, length_x: 300}\n")));
+  CHECK_NOTHROW(LoadScenario(
+      Write("frame3.yaml", std::string(kValid) + "filter: {length_x: 300, ahead: 250}\n")));
 }

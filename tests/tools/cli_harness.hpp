@@ -9,8 +9,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace dualgrid::testing {
 
@@ -52,6 +54,28 @@ inline fs::path TempDir(const std::string& group, const std::string& name) {
 
 inline int CountLines(const std::string& s) {
   return static_cast<int>(std::count(s.begin(), s.end(), '\n'));
+}
+
+/// Rows of a CSV file (no quoted commas) as column -> text maps.
+inline std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& path) {
+  std::istringstream in(Slurp(path));
+  std::string line;
+  std::vector<std::string> header;
+  std::getline(in, line);
+  {
+    std::istringstream h(line);
+    for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
+  }
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::istringstream r(line);
+    std::map<std::string, std::string> row;
+    std::size_t i = 0;
+    for (std::string cell; std::getline(r, cell, ',') && i < header.size(); ++i)
+      row[header[i]] = cell;
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 }  // namespace dualgrid::testing

@@ -15,28 +15,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Rows of a CSV file as column -> text maps.
-std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& path) {
-  std::istringstream in(Slurp(path));
-  std::string line;
-  std::vector<std::string> header;
-  std::getline(in, line);
-  {
-    std::istringstream h(line);
-    for (std::string cell; std::getline(h, cell, ',');) header.push_back(cell);
-  }
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    std::istringstream r(line);
-    std::map<std::string, std::string> row;
-    std::size_t i = 0;
-    for (std::string cell; std::getline(r, cell, ',') && i < header.size(); ++i)
-      row[header[i]] = cell;
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 struct Case {
   std::string sensor;
   double angle, ego_speed, grid_width;

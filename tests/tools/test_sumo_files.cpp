@@ -34,7 +34,9 @@ fs::path WriteSumoFolder(const fs::path& dir) {
       << "<routes>\n"
       << "  <vType id=\"pkw\" vClass=\"passenger\" length=\"4.6\" width=\"1.9\"/>\n"
       << "  <vType id=\"lkw\" vClass=\"truck\" length=\"16.5\" width=\"2.55\" maxSpeed=\"25\"/>\n"
-      << "  <vehicle id=\"veh_ego\" type=\"pkw\" depart=\"0\" departPos=\"200\" departLane=\"0\""
+      // The ego's type: longer and wider than the scenario's default car (4.5 m x 1.8 m).
+      << "  <vType id=\"suv\" vClass=\"passenger\" length=\"5.2\" width=\"2.0\"/>\n"
+      << "  <vehicle id=\"veh_ego\" type=\"suv\" depart=\"0\" departPos=\"200\" departLane=\"0\""
          " departSpeed=\"20\">\n    <route edges=\"we\"/>\n  </vehicle>\n"
       << "  <vehicle id=\"lead\" type=\"pkw\" depart=\"0\" departPos=\"240\" departLane=\"0\""
          " departSpeed=\"18\">\n    <route edges=\"we\"/>\n  </vehicle>\n"
@@ -52,24 +54,6 @@ fs::path WriteSumoFolder(const fs::path& dir) {
   return dir / "case.sumocfg";
 }
 
-std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  std::stringstream hs(line);
-  for (std::string h; std::getline(hs, h, ',');) header.push_back(h);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    std::map<std::string, std::string> row;
-    std::stringstream ls(line);
-    std::string v;
-    for (std::size_t i = 0; std::getline(ls, v, ',') && i < header.size(); ++i) row[header[i]] = v;
-    rows.push_back(row);
-  }
-  return rows;
-}
-
 }  // namespace
 
 TEST_CASE("a run from a .sumocfg with its route files and the ego chosen by id", "[cli][sumo]") {
@@ -80,7 +64,7 @@ TEST_CASE("a run from a .sumocfg with its route files and the ego chosen by id",
                                        << "traffic: {rcs_dbsm: {lkw: 23.0}}\n"
                                        << "evaluation: {focus_object: lead}\n";
   const auto r = Run("run " + (dir / "scenario.yaml").string() + " --out " +
-                     (dir / "out").string() + " --no-figures -q");
+                     (dir / "out").string() + " --no-figures -q --detections csv");
   INFO(r.output);
   REQUIRE(r.code == 0);
   // What cannot be honoured is named, one line each, with the file and the element.
@@ -120,6 +104,21 @@ TEST_CASE("a run from a .sumocfg with its route files and the ego chosen by id",
   for (const auto& row : ReadCsv(dir / "out" / "objects.csv"))
     lead_scored = lead_scored || (row.at("name") == "lead" && row.at("scored") == "1");
   CHECK(lead_scored);
+  // The radars sit on the ego's box as SUMO simulates it (5.2 m x 2.0 m): the front radar at
+  // +2.6 m, outside the body, sees the lead. (On the scenario type's 4.5 m box it sat 0.35 m
+  // inside the body, which hid everything ahead.)
+  const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
+  bool front_checked = false;
+  for (const auto& s : summary.at("sensors_mounted")) {
+    if (s.at("name") != "front") continue;
+    CHECK(s.at("x").get<double>() == Approx(2.6));
+    front_checked = true;
+  }
+  CHECK(front_checked);
+  int front_lead = 0;
+  for (const auto& row : ReadCsv(dir / "out" / "detections.csv"))
+    front_lead += row.at("sensor_name") == "front" && row.at("source") == "lead";
+  CHECK(front_lead > 100);
 }
 
 TEST_CASE("SUMO file inputs that cannot be used are refused naming the key", "[cli][sumo]") {

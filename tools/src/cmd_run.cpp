@@ -78,8 +78,6 @@ std::vector<double> SnapshotTimes(const FilterRunOptions& options,
 
 int RunFilters(const FilterRunOptions& options) {
   if (options.threads > 0) omp_set_num_threads(options.threads);
-  // No nested teams: a filter running inside the modes' team uses one thread.
-  omp_set_max_active_levels(1);
   const std::vector<filter::WeightMode> modes = ParseModes(options.modes);
   std::vector<std::string> mode_names;
   for (auto m : modes) mode_names.emplace_back(filter::ToString(m));
@@ -115,9 +113,15 @@ int RunFilters(const FilterRunOptions& options) {
   std::size_t total_detections = 0;
   std::vector<GridSnapshot> snaps(modes.size());  // storage reused every step
   // The modes run concurrently as tasks, one thread each, in one parallel region per step instead
-  // of the filters' ~30: robust when another process shares the cores (docs/performance.md).
+  // of ~40 (the filters' regions and barriers, three times): robust when another process shares
+  // the cores (docs/performance.md).
   // With one mode (or one thread) the filter's own loops are parallel instead.
-  const int team = std::min(static_cast<int>(modes.size()), omp_get_max_threads());
+  const int threads = omp_get_max_threads();
+  const int team = std::min(static_cast<int>(modes.size()), threads);
+  // Threads beyond one per mode go to each filter's own loops (e.g. 8 threads, 3 modes: 3 x 2);
+  // on 2 cores that is 1, and nested regions stay off.
+  const int per_filter = std::max(1, threads / team);
+  omp_set_max_active_levels(per_filter > 1 ? 2 : 1);
   std::vector<std::exception_ptr> errors(modes.size());
   while (!StopSignal() && pipeline.Advance()) {
     const sim::Frame& f = pipeline.frame();
@@ -157,7 +161,10 @@ int RunFilters(const FilterRunOptions& options) {
     {
       for (std::size_t m = 0; m < modes.size(); ++m) {
 #pragma omp task depend(out : f_dep[m]) shared(pipeline, errors)
-        guarded(m, [&] { pipeline.UpdateFilter(m); });
+        guarded(m, [&] {
+          if (team > 1) omp_set_num_threads(per_filter);  // this task's nested regions only
+          pipeline.UpdateFilter(m);
+        });
         if (m == 0) {
           // clang-format off
 #pragma omp task depend(in: f_dep[0]) depend(out: t_dep[0]) \
@@ -308,6 +315,14 @@ int RunFilters(const FilterRunOptions& options) {
   // The grid frame as resolved at the ego's departure (docs/algorithm.md, "Grid frame").
   summary["grid_frame"] = {{"frame", scenario::ToString(config.grid.frame)},
                            {"yaw_deg", RadToDeg(pipeline.grid_frame().yaw())}};
+  // The radars as mounted on the ego's box as SUMO simulated it (config.json holds the rig as
+  // read, on the scenario type's box: they differ for an ego of the user's route files).
+  summary["sensors_mounted"] = nlohmann::json::array();
+  for (const auto& s : pipeline.radar().sensors())
+    summary["sensors_mounted"].push_back({{"name", s.name},
+                                          {"x", s.mount.position.x()},
+                                          {"y", s.mount.position.y()},
+                                          {"yaw_deg", RadToDeg(s.mount.yaw)}});
   summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!status.empty())

@@ -98,6 +98,10 @@ bool Pipeline::Advance() {
                            : 0.0;
     grid_frame_ = GridFrame(WrapAngle(yaw) == 0.0 ? 0.0 : yaw);
     centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
+    // The default radars sit on the ego's box as SUMO simulates it: an ego of the user's route
+    // files may not have the scenario type's box (a 5 m SUMO car put the front radar inside it).
+    if (scenario::PlaceRigOn(&config_.radar, f.ego.box.length, f.ego.box.width))
+      radar_ = radar::RadarModel(config_.radar.sensors, config_.radar.options, config_.sim.seed);
     frame_fixed_ = true;
   }
   last_time_ = f.time;
@@ -139,7 +143,8 @@ std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid&
   std::sort(detected.begin(), detected.end());
   for (const sim::VehicleState& v : frame().vehicles) {
     eval::TruthObject o;
-    o.id = ids_.Id(v.id);
+    // Registered by BuildScene this step: a look-up (this runs inside the modes' tasks).
+    o.id = *ids_.Find(v.id);
     o.detected_in_grid = std::binary_search(detected.begin(), detected.end(), o.id);
     o.box = g.ToGrid(v.box);
     o.velocity = g.VectorToGrid(v.velocity);

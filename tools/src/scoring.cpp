@@ -100,18 +100,13 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   const filter::ParticleSet& p = grid.weighted_particles();
   dynamic_particles_.clear();
   const BoxTest ego(ego_box);
-  // DynamicGrid::CellOf's arithmetic with the snapshot's geometry, inlined for 10^4 particles.
-  const double r = snapshot.resolution;
-  const double ox = static_cast<double>(snapshot.origin_ix);
-  const double oy = static_cast<double>(snapshot.origin_iy);
   for (std::size_t i = 0; i < grid.num_weighted_particles(); ++i) {
     if (!(p.weight[i] > 0.0f)) continue;
     const Position pos(p.x[i], p.y[i]);
-    if (!pos.allFinite() || ego.Contains(pos)) continue;
-    const double fx = std::floor(pos.x() / r) - ox, fy = std::floor(pos.y() / r) - oy;
-    if (fx < 0.0 || fy < 0.0 || fx >= snapshot.cells_x || fy >= snapshot.cells_y) continue;
-    const std::size_t k =
-        static_cast<std::size_t>(fy) * snapshot.cells_x + static_cast<std::size_t>(fx);
+    if (ego.Contains(pos)) continue;
+    const auto cell = grid.CellOf(pos);
+    if (!cell) continue;
+    const std::size_t k = static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x;
     if (snapshot.dynamic[k] > config_.dynamic_threshold)
       dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
   }

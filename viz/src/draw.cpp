@@ -1,5 +1,8 @@
 #include "draw.hpp"
 
+#include <cairo-pdf.h>
+#include <cairo-svg.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>

@@ -1,8 +1,6 @@
 // Private cairo helpers shared by the figure kinds: surfaces, text, ticks, legends, scale bars.
 #pragma once
 
-#include <cairo-pdf.h>
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <memory>

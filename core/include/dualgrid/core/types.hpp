@@ -79,15 +79,12 @@ struct OrientedBox {
     const Vector2 l = UnitVector(yaw + 0.5 * kPi) * (0.5 * width);
     return {center + f + l, center - f + l, center - f - l, center + f - l};
   }
-  /// True if `p` lies inside or on the box.
-  bool Contains(const Position& p) const {
-    const Vector2 d = Rotation(yaw).transpose() * (p - center);
-    return std::abs(d.x()) <= 0.5 * length && std::abs(d.y()) <= 0.5 * width;
-  }
+  /// True if `p` lies inside or on the box. For many points, BoxTest computes the rotation once.
+  bool Contains(const Position& p) const;
 };
 
-/// OrientedBox::Contains for many points: the rotation is computed once (a sincos per call showed
-/// in profiles). Same arithmetic as Contains, so the same answer bit for bit.
+/// The box inside test with the rotation computed once (a sincos per call showed in profiles);
+/// OrientedBox::Contains uses it, so both answer the same bit for bit.
 class BoxTest {
  public:
   explicit BoxTest(const OrientedBox& b)
@@ -105,6 +102,9 @@ class BoxTest {
   Matrix2 rt_;
   double hl_, hw_;
 };
+
+// One test for both: BoxTest's arithmetic is the definition, so they agree bit for bit.
+inline bool OrientedBox::Contains(const Position& p) const { return BoxTest(*this).Contains(p); }
 
 /// Velocity [m/s] of a point `p` of a rigid body moving with centre velocity `v` and yaw rate
 /// `omega` [rad/s] about `center`: v + omega x (p - center).

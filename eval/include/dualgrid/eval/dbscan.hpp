@@ -5,7 +5,8 @@
 // The clusters (components of the core graph) are found on a finer grid of side < eps / sqrt(2)
 // (Gunawan's grid DBSCAN): all core points of one fine cell are neighbours, and two fine cells are
 // joined after the first pair of their core points within eps, so dense clusters cost O(cells),
-// not O(points x density) (the highway's ~5,000 dynamic particles per mode: 0.5 -> 0.1 ms).
+// not O(points x density). bench_models' clusterer (10,500 particles on 8 vehicles): 1.16 -> 0.39
+// ms with this and the own-cell-first search below (docs/performance.md).
 #pragma once
 
 #include <cstdint>

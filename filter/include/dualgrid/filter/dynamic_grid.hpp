@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -78,6 +79,7 @@ class DynamicGrid {
   /// World position of a logical cell's centre.
   Position CellCenter(CellIndex c) const;
   /// Logical cell holding `p`, std::nullopt outside the grid (or before the first Update).
+  /// Inline: the scorer calls it for every particle.
   std::optional<CellIndex> CellOf(const Position& p) const;
   /// Throws std::out_of_range for an index outside the grid.
   CellState Cell(CellIndex c) const;
@@ -177,5 +179,14 @@ class DynamicGrid {
   std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
 };
+
+inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
+  if (!initialized_ || !p.allFinite()) return std::nullopt;
+  const double r = params_.resolution;
+  const double fx = std::floor(p.x() / r) - static_cast<double>(origin_gx_);
+  const double fy = std::floor(p.y() / r) - static_cast<double>(origin_gy_);
+  if (fx < 0.0 || fy < 0.0 || fx >= nx_ || fy >= ny_) return std::nullopt;
+  return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
+}
 
 }  // namespace dualgrid::filter

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -30,7 +31,16 @@ struct RadarConfig {
   std::vector<radar::SensorParams> sensors;  ///< default: radar::DefaultRig of the ego's box
   std::string accuracy = "datasheet";        ///< `sensors.accuracy`: "datasheet" or "clean"
   radar::ModelOptions options;
+  /// The ego box [m] the default mounts were placed on (the scenario's ego type; PlaceRigOn
+  /// moves them onto the box SUMO simulates, e.g. an ego of the user's route files).
+  double rig_length = 0.0, rig_width = 0.0;
+  /// Sensors whose `mount` the file gives: kept as given wherever the box is.
+  std::set<std::string> mounts_given;
 };
+
+/// Places the default mounts of `radar` on an ego box of `length` x `width` [m] (the rig of
+/// radar::DefaultRig for that box; given mounts stay). Returns whether a mount moved.
+bool PlaceRigOn(RadarConfig* radar, double length, double width);
 
 /// The `evaluation:` section (scoring as in the paper's Sec. V).
 struct EvaluationConfig {

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,7 @@ class SumoSimulation {
   std::map<std::string, LaneGeometry> lanes_;
   std::map<std::string, double> previous_yaw_;
   std::map<std::string, VehicleTypeSpec> sumo_types_;
+  std::set<std::string> own_types_;  // the scenario's types written to its route file
   std::uint64_t departures_ = 0;
 };
 
