@@ -8,11 +8,18 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake pkg-config sumo sumo-tools libeigen3-dev libyaml-cpp-dev catch2 libcli11-dev
   nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev zlib1g-dev
-  parallel)
+  parallel ffmpeg)
+# Only the test suite needs these: the replay viewer's browser test drives Debian's Chromium from
+# Python's standard library (tests/viz/viewer_check.py).
+TEST_PACKAGES=(chromium python3)
 BUILD_DIR=${DUALGRID_BUILD_DIR:-build}
 
 source scripts/lib/install_missing.sh
-install_missing "${PACKAGES[@]}"
+if [ "${1:-run}" = test ]; then
+  install_missing "${PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+else
+  install_missing "${PACKAGES[@]}"
+fi
 
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD_DIR" -j "$(nproc)"
@@ -20,7 +27,8 @@ cmake --build "$BUILD_DIR" -j "$(nproc)"
 case "${1:-run}" in
   run)
     scenario=${2:-scenarios/highway.yaml}
-    "$BUILD_DIR/tools/dualgrid" run "$scenario" --out "run/$(basename "$scenario" .yaml)"
+    # --video --viewer: the replay video and the interactive page beside the results.
+    "$BUILD_DIR/tools/dualgrid" run "$scenario" --out "run/$(basename "$scenario" .yaml)" --video --viewer
     ;;
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)"

@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
+#include "capture.hpp"
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
 #include "figures.hpp"
@@ -20,6 +23,8 @@
 #include "run_outputs.hpp"
 #include "scoring.hpp"
 #include "signals.hpp"
+#include "video.hpp"
+#include "viewer.hpp"
 
 namespace dualgrid::tools {
 
@@ -123,6 +128,16 @@ int RunFilters(const FilterRunOptions& options) {
   const int per_filter = std::max(1, threads / team);
   omp_set_max_active_levels(per_filter > 1 ? 2 : 1);
   std::vector<std::exception_ptr> errors(modes.size());
+  // The replay recording (docs/replay.md): opened at the first recorded step, once the grid
+  // frame is fixed.
+  const int record_every =
+      std::max(1, static_cast<int>(std::lround(options.record_interval / config.sim.step_length)));
+  std::unique_ptr<replay::Writer> recorder;
+  replay::Header record_header;
+  std::vector<replay::LiveCounter> counters(modes.size(),
+                                            replay::LiveCounter(config.evaluation.tracking));
+  std::vector<replay::Live> live(modes.size());
+  std::set<int> recorded_ids;
   while (!StopSignal() && pipeline.Advance()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
@@ -135,7 +150,9 @@ int RunFilters(const FilterRunOptions& options) {
       picture = true;
       ++next_snapshot;
     }
-    const bool with_velocity = picture && (options.figures || options.write_particles);
+    const bool record_now = options.record && (steps + 1) % record_every == 0;
+    const bool with_velocity =
+        (picture && (options.figures || options.write_particles)) || record_now;
     // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
     // and per object is computed once for the first and holds for every mode.
     std::vector<std::uint8_t> truth_classes;
@@ -196,6 +213,17 @@ int RunFilters(const FilterRunOptions& options) {
     for (std::size_t m = 0; m < modes.size(); ++m)
       clusters.Write(f, pipeline.grid_frame(), mode_names[m], scorers[m], objects, pipeline.ids());
     traces.Add(pipeline, trace_mode);
+    for (std::size_t m = 0; m < modes.size(); ++m) live[m] = counters[m].Count(scorers[m], objects);
+    if (record_now) {
+      if (!recorder) {
+        record_header = replay::MakeHeader(
+            pipeline, mode_names, record_every * config.sim.step_length, options.record_particles);
+        recorder = std::make_unique<replay::Writer>(out / "replay", record_header);
+      }
+      recorder->Add(
+          replay::Capture(pipeline, snaps, scorers, counters, live, objects, record_header));
+      for (const auto& o : objects) recorded_ids.insert(o.id);
+    }
     if (options.check_invariants) {
       for (std::size_t m = 0; m < modes.size(); ++m)
         if (const auto broken = pipeline.grid(m).CheckInvariants())
@@ -271,6 +299,20 @@ int RunFilters(const FilterRunOptions& options) {
   const std::string focus = traces.Focus();
   if (!focus.empty()) WriteWeights(traces.by_vehicle.at(focus), focus, out / "weights.csv");
   if (!options.run.quiet) std::cout << table.ToMarkdown() << "\n";
+  if (recorder) {
+    // After the results, before the figures: a failure here costs only the replay.
+    try {
+      record_header.metrics = mj["modes"];
+      for (int id : recorded_ids) record_header.names[std::to_string(id)] = pipeline.ids().Name(id);
+      record_header.complete = complete;
+      record_header.status = status;
+      recorder->Finish(record_header);
+    } catch (const std::exception& e) {
+      warnings.push_back(std::string("replay recording not written: ") + e.what());
+      std::cerr << "dualgrid: warning: " << warnings.back() << "\n";
+      recorder.reset();
+    }
+  }
 
   if (options.figures && !stop) {
     if (!focus.empty()) {
@@ -294,6 +336,21 @@ int RunFilters(const FilterRunOptions& options) {
                                 "tracked share " + what, p);
           },
           &warnings);
+    }
+  }
+
+  if (recorder && !stop && (options.video || options.viewer)) {
+    std::signal(SIGPIPE, SIG_IGN);  // a failing ffmpeg must not kill the run before summary.json
+    ReplayOptions ro;
+    ro.run_dir = out;
+    ro.quiet = options.run.quiet;
+    try {
+      const replay::Reader reader(out);
+      if (options.viewer) WriteViewer(reader, ro);
+      if (options.video) WriteVideo(reader, ro);
+    } catch (const std::exception& e) {
+      warnings.push_back(std::string("replay not written: ") + e.what());
+      std::cerr << "dualgrid: warning: " << warnings.back() << "\n";
     }
   }
 

@@ -47,6 +47,33 @@ struct FilterRunOptions {
   /// violation ends the run with exit code 1) and samples the resident memory every 60 s
   /// simulated into summary.json (`rss_mb`): the soak test's mode.
   bool check_invariants = false;
+  /// The replay recording (RUN_DIR/replay/, docs/replay.md): one frame every `record_interval`
+  /// [s] (rounded to whole steps) with up to `record_particles` particles per mode. On with
+  /// figures unless `--no-record`.
+  bool record = true;
+  double record_interval = 0.1;
+  int record_particles = 1000;
+  /// After the results: the replay video (`--video`) and the interactive viewer (`--viewer`),
+  /// as `dualgrid replay` would write them with its defaults.
+  bool video = false;
+  bool viewer = false;
+};
+
+/// `dualgrid replay`: the video and/or the interactive viewer of a recorded run, without SUMO.
+struct ReplayOptions {
+  std::filesystem::path run_dir;
+  bool video = false;              ///< MP4 (H.264) + preview; the default when neither is asked for
+  bool html = false;               ///< the self-contained interactive viewer
+  std::filesystem::path out;       ///< video file (.mp4); default RUN_DIR/replay.mp4
+  std::filesystem::path html_out;  ///< default RUN_DIR/replay.html
+  std::vector<std::string> modes;  ///< subset of the recorded modes; empty: all
+  bool particles = false;          ///< video: draw the recorded particles
+  bool detections = true;          ///< video: draw the detections, coloured per sensor
+  double from = 0.0, to = 0.0;     ///< time window [s]; to = 0: to the end
+  double speed = 1.0;              ///< video playback speed (1 = real time)
+  int width = 1920;                ///< video width [px]
+  std::string preview = "gif";     ///< "gif", "webm" or "none"
+  bool quiet = false;
 };
 
 /// `dualgrid experiment`: `run` over seeds 1..N in separate processes, then aggregated.
@@ -135,6 +162,7 @@ int RunCollect(const CollectOptions& options);
 int RunRegress(const RegressOptions& options);
 int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);
+int RunReplay(const ReplayOptions& options);
 int RunExperiment(const ExperimentOptions& options);
 int RunSnapshot(const SnapshotOptions& options);
 

@@ -177,6 +177,50 @@ int main(int argc, char** argv) {
       "and score them against the ground truth");
   AddRunOptions(run, &run_options.run, "Run folder (metrics, tables, figures, config)", true);
   AddFilterOptions(run, &run_options, &run_no_figures);
+  bool run_no_record = false;
+  run->add_flag("--no-record", run_no_record,
+                "Do not record the replay frames (RUN_DIR/replay/; off anyway with --no-figures)");
+  Opt(run, "--record-interval", &run_options.record_interval,
+      "Time between recorded replay frames [s], rounded to whole steps")
+      ->check(Number(0.001, 60.0, true));
+  Opt(run, "--record-particles", &run_options.record_particles,
+      "Particles recorded per mode and frame (an even subsample; 0: none)")
+      ->check(WholeNumber(0, 1000000));
+  run->add_flag("--video", run_options.video,
+                "Also write the replay video (replay.mp4 and a GIF preview; needs ffmpeg) as "
+                "`dualgrid replay` would");
+  run->add_flag(
+      "--viewer", run_options.viewer,
+      "Also write the interactive viewer (replay.html) as `dualgrid replay --html` would");
+
+  ReplayOptions rep;
+  auto* replay = app.add_subcommand(
+      "replay",
+      "Video (MP4 + GIF preview) and/or interactive HTML viewer of a recorded run, without "
+      "rerunning SUMO (docs/replay.md)");
+  replay->add_option("run_dir", rep.run_dir, "Run folder written by `dualgrid run`")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  replay->add_flag("--video", rep.video, "Write the video (the default unless --html is given)");
+  replay->add_flag("--html", rep.html, "Write the self-contained interactive viewer");
+  replay->add_option("--out,-o", rep.out, "Video file (default RUN_DIR/replay.mp4)")
+      ->check(NonEmptyPath());
+  replay->add_option("--html-out", rep.html_out, "Viewer file (default RUN_DIR/replay.html)")
+      ->check(NonEmptyPath());
+  replay->add_option("--modes", rep.modes, "Modes to show, comma-separated (default: all recorded)")
+      ->delimiter(',');
+  replay->add_flag("--particles", rep.particles, "Video: draw the recorded particles");
+  replay->add_flag_callback(
+      "--no-detections", [&rep] { rep.detections = false; }, "Video: leave the detections out");
+  Opt(replay, "--from", &rep.from, "First time [s]")->check(Number(0.0, kMaxDuration, false));
+  Opt(replay, "--to", &rep.to, "Last time [s] (0: the end)")
+      ->check(Number(0.0, kMaxDuration, false));
+  Opt(replay, "--speed", &rep.speed, "Video playback speed (1: real time)")
+      ->check(Number(0.1, 20.0, false));
+  Opt(replay, "--width", &rep.width, "Video width [px] (even)")->check(WholeNumber(320, 7680));
+  Opt(replay, "--preview", &rep.preview, "Short preview beside the video: gif, webm or none")
+      ->check(CLI::IsMember({"gif", "webm", "none"}));
+  replay->add_flag("--quiet,-q", rep.quiet, "No progress output");
 
   ExperimentOptions exp;
   bool exp_no_figures = false;
@@ -352,8 +396,13 @@ int main(int argc, char** argv) {
       return RunTangential(tan);
     }
     if (snapshot->parsed()) return RunSnapshot(snap);
+    if (replay->parsed()) return RunReplay(rep);
     if (run->parsed()) {
       run_options.figures = !run_no_figures;
+      run_options.record = run_options.figures && !run_no_record;
+      if ((run_options.video || run_options.viewer) && !run_options.record)
+        throw std::invalid_argument(
+            "--video and --viewer need the recording: drop --no-record / --no-figures");
       return RunFilters(run_options);
     }
     if (experiment->parsed()) {
