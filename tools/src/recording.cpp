@@ -142,16 +142,29 @@ void Writer::Add(const Frame& f) {
   }
   j["blob"] = {offset_, static_cast<std::uint64_t>(packed_size)};
   offset_ += packed_size;
-  index_.push_back(std::move(j));
+  index_.push_back(j.dump());
 }
 
 void Writer::Finish(const Header& final_header) {
   bin_.close();
   if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
   json j = HeaderJson(final_header);
-  j["frames"] = std::move(index_);
-  index_ = json::array();
-  WriteTextFile(dir_ / "index.json", j.dump() + "\n");
+  j["frames"] = json::array();
+  std::string text = j.dump();
+  // Splice the serialised frames into the empty "frames" array (the header's last key: nlohmann
+  // orders keys alphabetically, so find the array by its key).
+  const std::string key = "\"frames\":[]";
+  const std::size_t at = text.find(key);
+  assert(at != std::string::npos);
+  std::string frames = "\"frames\":[";
+  for (std::size_t i = 0; i < index_.size(); ++i) {
+    if (i) frames += ',';
+    frames += index_[i];
+  }
+  frames += ']';
+  text.replace(at, key.size(), frames);
+  index_.clear();
+  WriteTextFile(dir_ / "index.json", text + "\n");
 }
 
 Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {

@@ -111,7 +111,9 @@ class Writer {
   Header header_;
   std::ofstream bin_;
   std::uint64_t offset_ = 0;
-  nlohmann::json index_ = nlohmann::json::array();
+  /// Each frame's index entry, already serialised: a JSON tree of a long run's detections would
+  /// take ~6x the memory of its text.
+  std::vector<std::string> index_;
   std::vector<std::uint8_t> raw_, packed_;
 };
 
