@@ -247,6 +247,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   layout.view = {lo, lo + Vector2(h.cells_x * h.resolution, h.cells_y * h.resolution)};
   layout.panels = static_cast<int>(modes.size());
   if (o.detections) layout.sensors = h.sensors;
+  layout.particles = o.particles;
   try {
     layout.Validate();
   } catch (const std::invalid_argument& e) {

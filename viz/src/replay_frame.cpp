@@ -318,6 +318,12 @@ struct ReplayRenderer::Impl {
         SetColor(cr, SensorColor(static_cast<int>(k)));
         cairo_fill(cr);
       });
+    if (o.particles)
+      entry("particle", [&](double x0, double y0, double s) {
+        cairo_set_source_rgba(cr, 0.1, 0.1, 0.1, 0.8);
+        cairo_rectangle(cr, x0 + 0.4 * s, y0 + 0.4 * s, 0.2 * s, 0.2 * s);
+        cairo_fill(cr);
+      });
     entry("axes: metres from the ego, grid frame", [](double, double, double) {});
     return rows * row_h / fs_small;
   }

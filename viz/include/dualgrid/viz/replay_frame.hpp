@@ -57,6 +57,7 @@ struct ReplayLayoutOptions {
   /// Sensor names for the legend (pictures' detections index them); the legend wraps to as many
   /// rows as the width needs.
   std::vector<std::string> sensors;
+  bool particles = false;  ///< pictures carry particles: a legend entry for them
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
 };
