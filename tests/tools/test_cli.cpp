@@ -104,7 +104,7 @@ TEST_CASE("sim writes detections for all five radars", "[cli]") {
   for (const char* name :
        {",front_left,", ",front_right,", ",rear_left,", ",rear_right,", ",front,"})
     CHECK(csv.find(name) != std::string::npos);
-  CHECK(csv.find(",truck_3,") != std::string::npos);  // the parallel truck is seen
+  CHECK(csv.find(",alongside_truck,") != std::string::npos);  // the parallel truck is seen
 }
 
 TEST_CASE("An unknown sensor in a scenario is one line with a non-zero exit", "[cli]") {
