@@ -1,5 +1,6 @@
 #include <cairo.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "dualgrid/viz/birds_eye_view.hpp"
 #include "dualgrid/viz/charts.hpp"
 #include "dualgrid/viz/color.hpp"
+#include "dualgrid/viz/figure.hpp"
 #include "dualgrid/viz/grid_panels.hpp"
 #include "dualgrid/viz/map_transform.hpp"
 
@@ -36,17 +38,21 @@ struct Rgb8 {
   int r, g, b;
 };
 
-// A PNG read back through cairo (the same library that wrote it, but via its decoder).
+// A PNG read back through cairo (the same library that wrote it, but via its decoder). Figures
+// are laid out in points and rasterised at `scale` pixels per point (kPngScale by default).
 class Png {
  public:
-  explicit Png(const fs::path& path) : surface_(cairo_image_surface_create_from_png(path.c_str())) {
+  explicit Png(const fs::path& path, double scale = kPngScale)
+      : surface_(cairo_image_surface_create_from_png(path.c_str())), scale_(scale) {
     REQUIRE(cairo_surface_status(surface_) == CAIRO_STATUS_SUCCESS);
   }
   ~Png() { cairo_surface_destroy(surface_); }
   int width() const { return cairo_image_surface_get_width(surface_); }
   int height() const { return cairo_image_surface_get_height(surface_); }
-  // Pixel containing the continuous pixel coordinate p (our images are opaque).
-  Rgb8 At(const Vector2& p) const { return At(int(std::floor(p.x())), int(std::floor(p.y()))); }
+  // Pixel containing the point p [pt] of the figure (our images are opaque).
+  Rgb8 At(const Vector2& p) const {
+    return At(int(std::floor(p.x() * scale_)), int(std::floor(p.y() * scale_)));
+  }
   Rgb8 At(int x, int y) const {
     REQUIRE(x >= 0);
     REQUIRE(y >= 0);
@@ -60,7 +66,11 @@ class Png {
 
  private:
   cairo_surface_t* surface_;
+  double scale_;
 };
+
+// The PNG size of a figure `w` x `h` points.
+int Px(double points) { return int(std::ceil(points * kPngScale - 1e-6)); }
 
 // Exact colour up to 8-bit rounding: 1 level per channel.
 bool Near(const Rgb8& p, const Rgba& c, int tol = 1) {
@@ -234,24 +244,35 @@ TEST_CASE("RenderGridPanels: cell colours, truth outlines, layout", "[viz]") {
     panels.push_back(std::move(p));
   }
   GridFigureOptions opt;
-  opt.image_width = 1000;
+  opt.image_width = 500;  // [pt]: cells 0.5 m = 5.5 pt = 23 px, room to sample their centres
   opt.title = "t = 12.0 s";
+  opt.caption = "hue: direction of motion over ground";
   const GridFigureLayout layout = LayoutGridPanels(panels, opt);
   REQUIRE(layout.panels.size() == 3);
   for (int k = 0; k + 1 < 3; ++k)  // stacked vertically, no overlap, same x placement
     CHECK(layout.panels[k + 1].pixel_offset().y() >=
           layout.panels[k].pixel_offset().y() + layout.panels[k].pixel_height());
   CHECK(layout.panels[0].pixel_offset().x() == layout.panels[2].pixel_offset().x());
-  CHECK(layout.panels[0].scale() * 0.5 > 6.0);  // cells are several pixels wide
+  CHECK(layout.panels[0].scale() * 0.5 * kPngScale > 6.0);  // cells are several pixels wide
 
   const fs::path path = TempDir() / "grid_panels.png";
   fs::remove(path);
+  FigureAudit audit;
   RenderGridPanels(panels, path.string(), opt);
   REQUIRE(fs::exists(path));
   const Png png(path);
-  CHECK(png.width() == layout.width);
-  CHECK(png.height() == layout.height);
+  CHECK(png.width() == Px(layout.width));
+  CHECK(png.height() == Px(layout.height));
   CHECK(Near(png.At(2, 2), colors::kWhite));  // background
+  // Words: panel titles, shared axes (x labels once under the bottom panel), legend, caption.
+  REQUIRE(audit.records().size() == 1);
+  const FigureRecord& r = audit.records()[0];
+  for (const char* word :
+       {"position", "velocity", "dual", "x [m]", "y [m]", "+x", "\u2212y", "free", "static",
+        "unknown", "ground truth", "particle", "over ground", "t = 12.0 s"})
+    CHECK(r.HasText(word));
+  CHECK(std::count(r.strings.begin(), r.strings.end(), "x [m]") == 1);
+  CHECK(r.MinFontRatio() >= kMinFontRatio);
   for (int k = 0; k < 3; ++k) {
     INFO("panel " << k);
     const MapTransform& t = layout.panels[k];
@@ -301,12 +322,17 @@ TEST_CASE("RenderGridPanels rejects invalid rasters naming the field", "[viz]") 
 TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]") {
   BirdsEyeOptions opt;
   opt.pixel_width = 1600;
+  opt.png_scale = 1.0;  // one pixel per point: the raster scale is an option
   opt.title = "highway, t = 3.0 s";
+  opt.x_label = "x from the ego [m]";
+  opt.caption = "Arrows: motion over ground in 0.5 s.";
   BirdsEyeView view({{-40.0, -20.0}, {120.0, 20.0}}, opt);
-  REQUIRE(view.transform().pixel_height() == 400);
-  CHECK(view.transform().scale() == Approx(10.0));
+  // The axis margin takes part of the width; the map keeps the world's aspect.
+  CHECK(view.transform().pixel_width() < 1600);
+  CHECK(view.transform().pixel_width() > 1200);
+  CHECK(view.transform().pixel_height() == std::lround(40.0 * view.transform().scale()));
   const Vector2 shift = view.ToImagePixel({0, 0}) - view.transform().ToPixel({0, 0});
-  CHECK(shift.x() == 0.0);
+  CHECK(shift.x() > 0.0);  // axis margin
   CHECK(shift.y() > 0.0);  // title band
 
   for (int lane = 0; lane < 3; ++lane)
@@ -321,22 +347,26 @@ TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]")
   const Rgba fill{0.0, 0.0, 1.0, 1.0};
   VehicleStyle truck;
   truck.fill = fill;
-  truck.label = "truck 3";
+  truck.label = "truck";
   truck.velocity = Velocity(25, 0);
   view.DrawVehicle({Position(40, 2.0), 0.1, 12.0, 2.5}, truck);
+  VehicleStyle away;  // outside the map: neither drawn nor in the legend
+  away.legend = "parked";
+  view.DrawVehicle({Position(400, 2.0), 0.0, 4.0, 2.0}, away);
   std::vector<DetectionMark> dets = {
       {Position(60.0, 15.0), Velocity(-10.0, 0.0), 2, false},
-      {Position(80.0, -15.0), Velocity(0.0, 0.0), 1, true},
+      {Position(80.0, -15.0), Velocity(20.0, 0.0), 1, true},
   };
   view.DrawDetections(dets);
   const fs::path path = TempDir() / "birds_eye.png";
   fs::remove(path);
+  FigureAudit audit;
   view.Save(path.string());
   REQUIRE(fs::exists(path));
-  const Png png(path);
+  const Png png(path, 1.0);
   CHECK(png.width() == 1600);
   CHECK(png.height() == view.image_height());
-  CHECK(png.height() > 400);
+  CHECK(png.height() > view.transform().pixel_height());
 
   CHECK(Near(png.At(view.ToImagePixel({-30.0, 15.0})), colors::kWhite));  // background
   // Vehicle fill behind the centre (the velocity arrow starts at the centre).
@@ -345,9 +375,11 @@ TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]")
   CHECK(Near(png.At(view.ToImagePixel({0.0, -1.5})), colors::kEgo));
   CHECK(Near(png.At(view.ToImagePixel({-30.0, -1.5})), colors::kLane));
   CHECK(Near(png.At(view.ToImagePixel({-30.0, -7.2})), colors::kGuardRail));
-  // Inside the wedge over white: white composited with the sensor colour at alpha 0.12.
+  // Inside the wedge over white: a faint tint of the sensor colour; its edge in the full colour.
   const Rgba s0 = SensorColor(0);
-  CHECK(Near(png.At(view.ToImagePixel({90.0, 12.0})), Mix(colors::kWhite, s0, 0.12), 2));
+  CHECK(Near(png.At(view.ToImagePixel({90.0, 12.0})), Mix(colors::kWhite, s0, kSensorFovTint), 2));
+  const Position edge = fov.origin + 40.0 * UnitVector(DegToRad(20.0));
+  CHECK(Near(png.At(view.ToImagePixel(edge)), s0, 40));
   // Just outside the wedge edge (20 deg) at the same range: white.
   const Position outside = fov.origin + 40.0 * UnitVector(DegToRad(23.0));
   CHECK(Near(png.At(view.ToImagePixel(outside)), colors::kWhite));
@@ -355,12 +387,26 @@ TEST_CASE("BirdsEyeView draws the highway scene at the requested size", "[viz]")
   const Rgb8 det = png.At(view.ToImagePixel({60.0, 15.0}));
   INFO("detection " << Str(det));
   CHECK(Near(det, SensorColor(2), 3));
-  // Clutter cross darkens its centre pixel.
+  // Radial velocity arrow (-10 m/s * 0.5 s = 5 m west): drawn 2.5 m west of the dot.
+  const Rgb8 arrow = png.At(view.ToImagePixel({57.5, 15.0}));
+  CHECK(arrow.r + arrow.g + arrow.b < 3 * 230);
+  // The truck's velocity arrow (25 m/s * 0.5 s = 12.5 m east) reaches past its box (its shaft,
+  // black, 10 m east of the centre).
+  const Vector2 tip(50.0, 2.0);
+  CHECK(Near(png.At(view.ToImagePixel(tip)), colors::kBlack, 60));
+  // Clutter: a cross in its sensor's colour, and no arrow although its Doppler is 20 m/s.
   const Rgb8 clutter = png.At(view.ToImagePixel({80.0, -15.0}));
   CHECK(clutter.r + clutter.g + clutter.b < 3 * 200);
-  // Radial velocity arrow (-10 m/s * 0.2 s = 2 m west): drawn 1 m west of the dot.
-  const Rgb8 arrow = png.At(view.ToImagePixel({59.0, 15.0}));
-  CHECK(arrow.r + arrow.g + arrow.b < 3 * 230);
+  CHECK(Near(png.At(view.ToImagePixel({84.0, -15.0})), Mix(colors::kWhite, s0, kSensorFovTint), 2));
+  // Axes, legend and caption are words of the figure; fonts readable at one column.
+  REQUIRE(audit.records().size() == 1);
+  const FigureRecord& r = audit.records()[0];
+  for (const char* word : {"x from the ego [m]", "y [m]", "100", "\u221220", "front LRR", "ego",
+                           "truck", "velocity (0.5 s)", "radial velocity (0.5 s)",
+                           "clutter, no arrow", "over ground", "highway, t = 3.0 s"})
+    CHECK(r.HasText(word));
+  CHECK_FALSE(r.HasText("parked"));
+  CHECK(r.MinFontRatio() >= kMinFontRatio);
 }
 
 TEST_CASE("BirdsEyeView rejects bad input and unwritable paths", "[viz]") {
@@ -390,14 +436,19 @@ TEST_CASE("RenderBarChart draws grouped bars in mode colours", "[viz]") {
                   {"velocity", {0.6, 0.3, 0.1, 0.2}, {}},
                   {"dual", {0.9, 0.8, 0.95, 0.7}, {}}};
   chart.percent = true;
+  chart.caption = "Bar colour: the filter's weight mode.";
   const fs::path path = TempDir() / "bars.png";
   fs::remove(path);
+  FigureAudit audit;
   RenderBarChart(chart, path.string());
   const Png png(path);
-  CHECK(png.width() == chart.width);
-  CHECK(png.height() == chart.height);
+  const ChartLayout layout = LayoutBarChart(chart);
+  CHECK(png.width() == Px(layout.width));
+  CHECK(png.height() == Px(layout.height));
+  // A one-line title, one legend row and level names: the nominal height plus the caption.
+  CHECK(layout.height > chart.height);
   CHECK(Near(png.At(1, 1), colors::kWhite));
-  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const PlotArea a = layout.plot;
   const double slot = a.width / 4, bar_w = 0.8 * slot / 3;
   // The axis is [0, 1] (percent); sample each bar half-way up.
   for (int s = 0; s < 3; ++s)
@@ -411,6 +462,23 @@ TEST_CASE("RenderBarChart draws grouped bars in mode colours", "[viz]") {
       else
         CHECK(Near(png.At(mid), ModeColor(static_cast<Mode>(s))));
     }
+  // Value labels fit four groups of three bars; names, axis labels and caption are there.
+  REQUIRE(audit.records().size() == 1);
+  const FigureRecord& r = audit.records()[0];
+  for (const char* word : {"obj 4", "100%", "object", "tracked [% of visible time]", "weight mode"})
+    CHECK(r.HasText(word));
+  CHECK(r.MinFontRatio() >= kMinFontRatio);
+  // Twelve bars in a column are too narrow for "95%" at a readable size: no value labels. Four
+  // bars have room, and show them.
+  CHECK_FALSE(r.HasText("95%"));
+  BarChart few = chart;
+  few.categories.resize(2);
+  few.series.resize(2);
+  for (auto& series : few.series) series.values.resize(2);
+  RenderBarChart(few, path.string());
+  REQUIRE(audit.records().size() == 2);
+  CHECK(audit.records()[1].HasText("70%"));
+  CHECK(audit.records()[1].HasText("30%"));
   BarChart bad = chart;
   bad.series[1].values.pop_back();
   CheckInvalidArgument([&] { RenderBarChart(bad, path.string()); }, "series[1].values");
@@ -422,7 +490,9 @@ TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
   chart.title = "Particle weights (dual)";
   chart.y_label = "weight";
   chart.log_y = log_y;
-  LineSeries s{"w_position", {}, {}, {}, 4.0, false};
+  LineSeries s;
+  s.name = "w_position";
+  s.line_width = 2.0;
   for (int k = 0; k <= 100; ++k) {
     s.x.push_back(0.1 * k);
     s.y.push_back(log_y ? std::pow(10.0, 0.1 * k - 5.0) : 0.5);
@@ -438,11 +508,20 @@ TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
   }
   const fs::path path = TempDir() / (log_y ? "lines_log.png" : "lines.png");
   fs::remove(path);
+  FigureAudit audit;
   RenderLineChart(chart, path.string());
   const Png png(path);
-  CHECK(png.width() == chart.width);
-  CHECK(png.height() == chart.height);
-  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const ChartLayout layout = LayoutLineChart(chart);
+  CHECK(png.width() == Px(layout.width));
+  CHECK(png.height() == Px(layout.height));
+  // No caption, a one-line title and one legend row: the nominal size.
+  CHECK(layout.height == Approx(chart.height).margin(1.0));
+  const PlotArea a = layout.plot;
+  REQUIRE(audit.records().size() == 1);
+  // The span's label fits its span; the log axis labels decades (10 and a raised exponent).
+  CHECK(audit.records()[0].HasText("radial speed differs"));
+  CHECK(audit.records()[0].HasText(log_y ? "\u22125" : "0.4"));
+  CHECK(audit.records()[0].MinFontRatio() >= kMinFontRatio);
   // x axis spans the data [0, 10]; the series crosses mid-height at x = 5 either way
   // (0.5 of [0, 1] linear, 10^0 of [1e-5, 1e5] log).
   const Vector2 mid(a.left + 0.5 * a.width, a.top + 0.5 * a.height);
@@ -451,8 +530,8 @@ TEST_CASE("RenderLineChart draws series on linear and log axes", "[viz]") {
   INFO("on line " << Str(on));
   CHECK(Near(on, color, 3));
   // Well off the line, at x = 1 outside the span: background white.
-  CHECK(
-      Near(png.At(Vector2(a.left + 0.1 * a.width + 0.5, a.top + 0.1 * a.height)), colors::kWhite));
+  CHECK(Near(png.At(Vector2(a.left + 0.1 * a.width + 0.5, a.top + 0.15 * a.height)),
+             colors::kWhite));  // between grid lines
   LineChart bad = chart;
   bad.series[0].y.pop_back();
   CheckInvalidArgument([&] { RenderLineChart(bad, path.string()); }, "series[0].y");
@@ -488,12 +567,14 @@ TEST_CASE("Charts render degenerate inputs over generated cases", "[viz][propert
     line.log_y = trial % 3 == 0;
     const int nseries = count(rng);
     for (int i = 0; i < nseries; ++i) {
-      LineSeries s{"s" + std::to_string(i), {}, {}, {}, 2.0, i % 2 == 1};
+      LineSeries s{"s" + std::to_string(i), {}, {}, {}, 2.0, i % 2 == 1, {}};
       const int n = count(rng);
       const double x0 = u(rng);
+      const bool errors = rng() % 3 == 0;
       for (int k = 0; k < n; ++k) {
         s.x.push_back(rng() % 5 == 0 ? std::nan("") : x0 + (rng() % 3) * 0.5);
         s.y.push_back(value(false));
+        if (errors) s.errors.push_back(rng() % 4 == 0 ? std::nan("") : std::abs(u(rng)));
       }
       line.series.push_back(s);
     }
@@ -505,24 +586,26 @@ TEST_CASE("Charts render degenerate inputs over generated cases", "[viz][propert
     if (rng() % 4 == 0) line.y_min = line.log_y ? 0.01 : u(rng);
     fs::remove(path);
     REQUIRE_NOTHROW(RenderLineChart(line, path.string()));
-    CHECK(Png(path).width() == line.width);
+    CHECK(Png(path).width() == Px(line.width));
 
     BarChart bars;
     const int ncat = count(rng) * (trial % 7 == 0 ? 40 : 1);
     for (int c = 0; c < ncat; ++c) bars.categories.push_back("object_" + std::to_string(c));
     const int nbar = count(rng);
     for (int i = 0; i < nbar; ++i) {
-      BarSeries s{i % 2 ? "dual" : "position", {}, {}};
+      BarSeries s{i % 2 ? "dual" : "position", {}, {}, {}};
+      const bool errors = rng() % 3 == 0;
       for (int c = 0; c < ncat; ++c) {
         const double v = value(true);
         s.values.push_back(std::isinf(v) ? std::nan("") : v);
+        if (errors) s.errors.push_back(rng() % 4 == 0 ? std::nan("") : std::abs(u(rng)));
       }
       bars.series.push_back(s);
     }
     bars.percent = trial % 2 == 0;
     fs::remove(path);
     REQUIRE_NOTHROW(RenderBarChart(bars, path.string()));
-    CHECK(Png(path).height() == bars.height);
+    CHECK(Png(path).height() == Px(LayoutBarChart(bars).height));
   }
 }
 
@@ -530,21 +613,21 @@ TEST_CASE("A one-sample span and a single point are drawn, not dropped", "[viz]"
   LineChart chart;
   chart.y_min = 0.0;
   chart.y_max = 1.0;
-  chart.series.push_back({"one", {5.0}, {0.5}, {}, 3.0, false});
-  chart.series.push_back({"frame", {0.0, 10.0}, {std::nan(""), std::nan("")}, {}, 2.0, false});
+  chart.series.push_back({"one", {5.0}, {0.5}, {}, 3.0, false, {}});
+  chart.series.push_back({"frame", {0.0, 10.0}, {std::nan(""), std::nan("")}, {}, 2.0, false, {}});
   chart.x_min = 0.0;
   chart.x_max = 10.0;
   chart.spans.push_back({2.0, 2.0, ""});
   const fs::path path = TempDir() / "single.png";
   RenderLineChart(chart, path.string());
   const Png png(path);
-  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const PlotArea a = LayoutLineChart(chart).plot;
   // The single point is a dot of the series colour at (5, 0.5).
   CHECK(Near(png.At(Vector2(a.left + 0.5 * a.width, a.top + 0.5 * a.height)), CategoryColor(0), 3));
   // The zero-width span shades a thin band at x = 2 (grey over white), below the title area.
-  const Rgb8 band = png.At(Vector2(a.left + 0.2 * a.width, a.top + 0.8 * a.height));
+  const Rgb8 band = png.At(Vector2(a.left + 0.2 * a.width, a.top + 0.7 * a.height));
   CHECK(band.r < 250);
-  CHECK(Near(png.At(Vector2(a.left + 0.3 * a.width, a.top + 0.8 * a.height)), colors::kWhite));
+  CHECK(Near(png.At(Vector2(a.left + 0.3 * a.width, a.top + 0.7 * a.height)), colors::kWhite));
 }
 
 namespace {
@@ -581,19 +664,22 @@ TEST_CASE("figures are written as SVG and PDF vectors by extension", "[viz][vect
   RenderBarChart(chart, (dir / "bars.svg").string());
   RenderBarChart(chart, (dir / "bars.pdf").string());
   const std::string svg = ReadText(dir / "bars.svg");
+  const ChartLayout layout = LayoutBarChart(chart);
+  const int w = int(std::ceil(layout.width - 1e-9)), h = int(std::ceil(layout.height - 1e-9));
   // A vector drawing of the chart's size in points: bars as filled paths in the mode colours,
   // text as glyph outlines; no embedded raster.
   CHECK(svg.rfind("<?xml", 0) == 0);
-  CHECK(svg.find("width=\"" + std::to_string(chart.width) + "pt\" height=\"" +
-                 std::to_string(chart.height) + "pt\"") != std::string::npos);
+  CHECK(w == int(kSingleColumn));  // a column wide by default
+  CHECK(svg.find("width=\"" + std::to_string(w) + "pt\" height=\"" + std::to_string(h) + "pt\"") !=
+        std::string::npos);
   CHECK(svg.find(SvgFill(ModeColor(Mode::kPosition))) != std::string::npos);
   CHECK(svg.find(SvgFill(ModeColor(Mode::kDual))) != std::string::npos);
   CHECK(Count(svg, "<path") > 20);
   CHECK(Count(svg, "<image") == 0);
   const std::string pdf = ReadText(dir / "bars.pdf");
   CHECK(pdf.rfind("%PDF-", 0) == 0);
-  CHECK(pdf.find("/MediaBox [ 0 0 " + std::to_string(chart.width) + " " +
-                 std::to_string(chart.height) + " ]") != std::string::npos);
+  CHECK(pdf.find("/MediaBox [ 0 0 " + std::to_string(w) + " " + std::to_string(h) + " ]") !=
+        std::string::npos);
   // No creation date: the same figure is the same bytes at any time (runs compare digests).
   CHECK(pdf.find("/CreationDate") == std::string::npos);
 
@@ -650,21 +736,187 @@ TEST_CASE("bar charts draw confidence whiskers and validate them", "[viz]") {
   const fs::path path = TempDir() / "whiskers.png";
   RenderBarChart(chart, path.string());
   const Png png(path);
-  const PlotArea a = ChartPlotArea(chart.width, chart.height);
+  const PlotArea a = LayoutBarChart(chart).plot;
   const double bar_w = 0.8 * a.width;
-  const int xc = static_cast<int>(a.left + 0.1 * a.width + 0.5 * bar_w);
-  const auto py = [&](double v) {
-    return static_cast<int>(std::lround(a.top + a.height * (1 - v)));
+  const double xc = a.left + 0.1 * a.width + 0.5 * bar_w;
+  const auto at = [&](double x, double v) {
+    return png.At(Vector2(x, a.top + a.height * (1 - v)));
   };
   // The cap at 0.5 + 0.2 is black; above it, the background; beside the bar top, the bar colour.
-  CHECK(Near(png.At(xc, py(0.7)), colors::kBlack, 90));
-  CHECK(Near(png.At(xc, py(0.85)), colors::kWhite, 2));  // off the 0.8 grid line
-  CHECK(Near(png.At(static_cast<int>(a.left + 0.1 * a.width + 0.1 * bar_w), py(0.4)),
-             ModeColor(Mode::kDual), 3));
+  CHECK(Near(at(xc, 0.7), colors::kBlack, 90));
+  CHECK(Near(at(xc, 0.85), colors::kWhite, 2));  // off the 0.8 grid line
+  CHECK(Near(at(a.left + 0.1 * a.width + 0.1 * bar_w, 0.4), ModeColor(Mode::kDual), 3));
   chart.series[0].errors = {0.1, 0.2};
   CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
                        "series[0].errors has 2 values, expected 0 or 1");
   chart.series[0].errors = {-0.1};
   CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
                        "series[0].errors must be finite and >= 0");
+}
+
+TEST_CASE("line charts draw 95 % CI error bars and validate them", "[viz]") {
+  LineChart chart;
+  chart.x_label = "angle [deg]";
+  chart.y_min = 0.0;
+  chart.y_max = 1.0;
+  chart.x_min = 0.0;
+  chart.x_max = 10.0;
+  LineSeries s;
+  s.name = "dual";
+  s.x = {2.0, 8.0};
+  s.y = {0.5, 0.5};
+  s.errors = {0.2, std::nan("")};  // no interval at x = 8 (one seed)
+  chart.series.push_back(s);
+  const fs::path path = TempDir() / "error_bars.png";
+  RenderLineChart(chart, path.string());
+  const Png png(path);
+  const PlotArea a = LayoutLineChart(chart).plot;
+  const auto at = [&](double x, double y) {
+    return png.At(Vector2(a.left + a.width * x / 10.0, a.top + a.height * (1.0 - y)));
+  };
+  // The bar at x = 2 reaches 0.5 +- 0.2 in the series colour; at x = 8 there is none.
+  const Rgba dual = ModeColor(Mode::kDual);
+  CHECK(Near(at(2.0, 0.62), dual, 40));
+  CHECK(Near(at(2.0, 0.38), dual, 40));
+  CHECK(Near(at(2.0, 0.75), colors::kWhite, 2));
+  CHECK(Near(at(8.0, 0.62), colors::kWhite, 2));
+  chart.series[0].errors = {0.1};
+  CheckInvalidArgument([&] { RenderLineChart(chart, path.string()); },
+                       "series[0].errors has 1 values, expected 0 or 2");
+  chart.series[0].errors = {0.1, -1.0};
+  CheckInvalidArgument([&] { RenderLineChart(chart, path.string()); },
+                       "series[0].errors must be finite and >= 0");
+}
+
+TEST_CASE("bar charts turn category names that do not fit, and wrap long captions", "[viz]") {
+  BarChart chart;
+  chart.percent = true;
+  chart.x_label = "object";
+  chart.caption =
+      "A caption much longer than the figure is wide wraps into lines, each of them within the "
+      "figure's width, so that nothing is cut at the edge of a column.";
+  for (const char* name : {"lead", "follower", "oncoming_car", "oncoming_truck", "oncoming.0",
+                           "oncoming.1", "oncoming.2"})
+    chart.categories.push_back(name);
+  for (const char* mode : {"position", "velocity", "dual"})
+    chart.series.push_back({mode, std::vector<double>(chart.categories.size(), 0.9), {}, {}});
+  FigureAudit audit;
+  const fs::path path = TempDir() / "turned.png";
+  RenderBarChart(chart, path.string());
+  REQUIRE(audit.records().size() == 1);
+  const FigureRecord& r = audit.records()[0];
+  // Every name is drawn (turned 45 degrees, none thinned out at seven objects).
+  for (const std::string& name : chart.categories)
+    CHECK(std::count(r.strings.begin(), r.strings.end(), name) == 1);
+  // 21 bars: the value labels do not fit and are left out, not overlapped.
+  CHECK_FALSE(r.HasText("90%"));
+  // The caption is several lines, each narrower than the figure.
+  int caption_lines = 0;
+  for (const std::string& line : r.strings)
+    if (chart.caption.find(line) != std::string::npos && line.size() > 20) ++caption_lines;
+  CHECK(caption_lines >= 2);
+  // Turned names need more room under the plot than level ones: the figure grows.
+  CHECK(LayoutBarChart(chart).height > chart.height + 20.0);
+  CHECK(r.MinFontRatio() >= kMinFontRatio);
+}
+
+// The readability rule of issue 15: scaled to one column (3.5 in), every figure's smallest text
+// is at least 7 pt, i.e. min font / width >= 7 / 252, whatever width it is drawn at.
+TEST_CASE("every figure kind is readable at one column, at any width", "[viz][fonts]") {
+  const int width = GENERATE(int(kSingleColumn), int(kDoubleColumn), 1600);
+  INFO("width " << width);
+  const fs::path dir = TempDir();
+  FigureAudit audit;
+  // Grid panels: the 8:1 road grid (stacked) and a square grid (side by side).
+  for (const double ny : {50.0, 400.0}) {
+    std::vector<GridPanel> panels(3);
+    const char* names[] = {"position", "velocity", "dual"};
+    for (int k = 0; k < 3; ++k) {
+      panels[k].title = names[k];
+      panels[k].raster = UnknownRaster(400, int(ny), 0.5, Position(-100.0, -0.25 * ny));
+      panels[k].truth_boxes.push_back(OrientedBox{Position(10.0, 3.0), 0.0, 4.5, 1.8});
+      panels[k].ego_boxes.push_back(OrientedBox{Position(0.0, 0.0), 0.0, 4.5, 1.8});
+    }
+    GridFigureOptions opt;
+    opt.image_width = width;
+    opt.title = "Dynamic grids at t = 30.00 s";
+    opt.caption = "Cells: white free, black static, grey unknown.";
+    RenderGridPanels(panels, (dir / "fonts_grid.png").string(), opt);
+  }
+  // The scene.
+  BirdsEyeOptions bo;
+  bo.pixel_width = width;
+  bo.title = "highway, t = 30.00 s";
+  bo.caption = "Arrows: motion over ground in 0.5 s.";
+  BirdsEyeView view({Position(-60, -22), Position(140, 22)}, bo);
+  view.DrawSensorFov({Position(2.3, 0.0), 0.0, DegToRad(10.0), 200.0, 4, "front"});
+  VehicleStyle vs;
+  vs.label = "alongside_truck";
+  vs.velocity = Velocity(28.0, 0.0);
+  view.DrawVehicle({Position(0, 3.5), 0.0, 12.0, 2.5}, vs);
+  view.DrawDetections(
+      {{Position(5, 3), Velocity(3, 1), 4, false}, {Position(50, -9), {}, 4, true}});
+  view.DrawLabel(Position(-50, 15), "t = 30 s");
+  view.Save((dir / "fonts_scene.png").string());
+  // Charts: bars with whiskers and many objects, lines on linear and log axes with a span and
+  // error bars.
+  BarChart bars;
+  bars.width = width;
+  bars.title = "highway: D_v per object, mean and 95 % CI over 5 seeds";
+  bars.y_label = "tracked share D_v (tracked with the right velocity)";
+  bars.x_label = "object (SUMO vehicle id)";
+  bars.percent = true;
+  bars.caption = "Whiskers: 95 % confidence interval of the mean.";
+  for (int c = 0; c < 30; ++c) bars.categories.push_back("oncoming." + std::to_string(c));
+  for (const char* mode : {"position", "velocity", "dual"})
+    bars.series.push_back({mode, std::vector<double>(30, 0.8), {}, std::vector<double>(30, 0.05)});
+  RenderBarChart(bars, (dir / "fonts_bars.png").string());
+  for (const bool log_y : {false, true}) {
+    LineChart line;
+    line.width = width;
+    line.title = "Weights on alongside_truck (dual filter, paper Fig. 4)";
+    line.y_label = "share within 2 m/s";
+    line.log_y = log_y;
+    line.caption = "Share of each weight held by particles within 2 m/s of the true velocity.";
+    LineSeries ls;
+    ls.name = "w_position";
+    for (int k = 1; k <= 50; ++k) {
+      ls.x.push_back(k);
+      ls.y.push_back(log_y ? std::pow(10.0, 0.1 * k - 3.0) : 0.5);
+      ls.errors.push_back(0.1 * ls.y.back());
+    }
+    line.series.push_back(ls);
+    line.spans.push_back({10.0, 30.0, "Doppler < speed / 2"});
+    RenderLineChart(line, (dir / "fonts_line.png").string());
+  }
+  REQUIRE(audit.records().size() == 6);
+  for (const FigureRecord& r : audit.records()) {
+    INFO(r.path << ": smallest text " << r.min_font << " pt of " << r.width << " pt");
+    CHECK(r.width == width);
+    CHECK(r.texts > 10);
+    CHECK(r.MinFontRatio() >= kMinFontRatio);
+    CHECK(r.png_scale == kPngScale);
+  }
+  // The PNG is the figure at 300 dpi.
+  CHECK(Png(dir / "fonts_bars.png").width() == Px(width));
+}
+
+TEST_CASE("the font record catches text too small for one column", "[viz][fonts]") {
+  // The check of the test above can fail: a grid figure with 3 pt fonts at one column width.
+  std::vector<GridPanel> panels(1);
+  panels[0].raster = UnknownRaster(40, 10, 0.5, Position(0.0, 0.0));
+  GridFigureOptions opt;
+  opt.font_size = 3.0;
+  FigureAudit audit;
+  RenderGridPanels(panels, (TempDir() / "tiny_fonts.svg").string(), opt);
+  REQUIRE(audit.records().size() == 1);
+  CHECK(audit.records()[0].min_font == Approx(0.9 * 3.0));
+  CHECK(audit.records()[0].MinFontRatio() < kMinFontRatio);
+  // Nested audits both see a figure; the inner one ends with its scope.
+  {
+    FigureAudit inner;
+    RenderGridPanels(panels, (TempDir() / "tiny_fonts.svg").string(), opt);
+    CHECK(inner.records().size() == 1);
+  }
+  CHECK(audit.records().size() == 2);
 }

@@ -21,9 +21,15 @@ bool BirdsEyeOptions::IsValid(std::string* error) const {
     if (error) *error = msg;
     return false;
   };
-  if (pixel_width < 200 || pixel_width > 20000) return fail("pixel_width must be in [200, 20000]");
-  if (!(font_size >= 6.0 && font_size <= 72.0)) return fail("font_size must be in [6, 72]");
+  if (pixel_width < 100 || pixel_width > 20000) return fail("pixel_width must be in [100, 20000]");
+  if (!(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0)))
+    return fail("font_size must be 0 (automatic) or in [2, 200]");
+  if (!(png_scale > 0.0 && png_scale <= 32.0)) return fail("png_scale must be in (0, 32]");
   return true;
+}
+
+double BirdsEyeOptions::BaseFont() const {
+  return font_size > 0.0 ? font_size : BaseFontSize(pixel_width);
 }
 
 bool DetectionStyle::IsValid(std::string* error) const {
@@ -39,18 +45,58 @@ bool DetectionStyle::IsValid(std::string* error) const {
 }
 
 namespace {
-constexpr double kPad = 10.0;
-// Right part of the legend band: scale bar and speed colour bar.
-constexpr double kRightBlock = 300.0;
-constexpr double kColorBarWidth = 160.0;
+
+// Sizes in u: one point at one column width (base font 8 pt); the picture looks the same at any
+// width, only larger.
+struct Sizes {
+  double fs, sm, u, pad, gap;
+  explicit Sizes(const BirdsEyeOptions& o)
+      : fs(o.BaseFont()), sm(0.9 * fs), u(fs / 8.0), pad(4.0 * u), gap(2.0 * u) {}
+  detail::MapAxesStyle Axes() const {
+    return {.font_size = sm, .tick_length = 2.5 * u, .line_width = 0.6 * u};
+  }
+};
+
+// Margins around the map: left (y ticks and label) and right (half the last x tick label).
+struct Margins {
+  double left = 0.0, right = 0.0;
+};
+
+Margins MarginsFor(const WorldRect& world, const BirdsEyeOptions& o, const Sizes& z) {
+  if (!o.axes) return {};
+  detail::Measure m;
+  Margins g{z.pad + (o.y_label.empty() ? 0.0 : detail::LineHeight(z.fs) + z.u) + 20.0 * z.u,
+            z.pad + 6.0 * z.u};
+  for (int pass = 0; pass < 2; ++pass) {
+    const int w = std::max(10, static_cast<int>(o.pixel_width - g.left - g.right));
+    g.left = z.pad + (o.y_label.empty() ? 0.0 : detail::LineHeight(z.fs) + z.u) +
+             detail::MapAxesLabelWidth(m.cr(), MapTransform(world, w), z.Axes());
+  }
+  return g;
+}
+
+int MapWidth(const BirdsEyeOptions& o, const Margins& g) {
+  return std::max(10, static_cast<int>(o.pixel_width - g.left - g.right));
+}
+
+// Width of the right part of the legend band (scale bar without axes, speed colour bar).
+double RightBlock(const BirdsEyeOptions& o, bool speed_bar) {
+  return (!o.axes || speed_bar) ? 0.42 * o.pixel_width : 0.0;
+}
+
 }  // namespace
 
 struct BirdsEyeView::Impl {
   Impl(const WorldRect& world, const BirdsEyeOptions& opt)
       : options(opt),
-        transform(world, opt.pixel_width),
+        z(opt),
+        margins(MarginsFor(world, opt, z)),
+        transform(world, MapWidth(opt, margins)),
         map(transform.pixel_width(), transform.pixel_height()) {
     cairo_set_line_join(map.cr(), CAIRO_LINE_JOIN_ROUND);
+    if (!opt.title.empty())
+      title_lines = detail::WrapText(measure.cr(), opt.title, 1.05 * z.fs,
+                                     opt.pixel_width - 2.0 * z.pad, true);
   }
 
   void AddLegend(const LegendItem& item) {
@@ -59,15 +105,31 @@ struct BirdsEyeView::Impl {
     legend.push_back(item);
   }
   double TitleHeight() const {
-    return options.title.empty() ? 0.0 : std::round(options.font_size * 1.3 * 2.2);
+    return title_lines.empty()
+               ? 0.0
+               : z.pad + title_lines.size() * detail::LineHeight(1.05 * z.fs) + z.gap;
+  }
+  double AxesHeight() const {
+    if (!options.axes) return 0.0;
+    return z.Axes().tick_length + 0.3 * z.sm + detail::LineHeight(z.sm) +
+           (options.x_label.empty() ? 0.0 : z.u + detail::LineHeight(z.fs));
+  }
+  double LegendWidth() const {
+    return options.pixel_width - RightBlock(options, speed_bar) - 2.0 * z.pad;
   }
   double LegendHeight() const {
-    const double fs = options.font_size;
-    const double left = detail::LayoutLegendRow(
-        map.cr(), legend, kPad, 0.0, options.pixel_width - kRightBlock - 2 * kPad, fs, false);
-    const double right = fs * 1.6 + (speed_bar ? fs * 3.2 : 0.0);
-    return std::round(std::max(left, right) + 2.0 * kPad);
+    const double left =
+        detail::LayoutLegendRow(measure.cr(), legend, 0.0, 0.0, LegendWidth(), z.sm, false);
+    double right = 0.0;
+    if (!options.axes) right = 1.6 * z.sm;
+    if (speed_bar) right += 3.2 * z.sm;
+    return std::max(left, right);
   }
+  double CaptionHeight() const {
+    return detail::DrawParagraph(measure.cr(), options.caption, 0.0, 0.0,
+                                 options.pixel_width - 2.0 * z.pad, {.size = z.sm}, false);
+  }
+  Vector2 MapOffset() const { return {margins.left, TitleHeight()}; }
   void PathPolyline(const std::vector<Position>& line) const {
     cairo_t* cr = map.cr();
     cairo_new_path(cr);
@@ -78,9 +140,24 @@ struct BirdsEyeView::Impl {
   }
 
   BirdsEyeOptions options;
+  Sizes z;
+  Margins margins;
   MapTransform transform;
   detail::Canvas map;
+  detail::Measure measure;
+  std::vector<std::string> title_lines;
   std::vector<LegendItem> legend;
+  // Labels placed so far (x0, y0, x1, y1 in map units): a label goes above its box, else below,
+  // where it overlaps none of them.
+  struct Box {
+    double x0, y0, x1, y1;
+    bool Overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+  };
+  std::vector<Box> labels;
+  bool InView(const Vector2& p) const {
+    return p.x() >= 0.0 && p.y() >= 0.0 && p.x() <= transform.pixel_width() &&
+           p.y() <= transform.pixel_height();
+  }
   bool speed_bar = false;
   double max_speed = 0.0;
 };
@@ -97,14 +174,17 @@ BirdsEyeView::~BirdsEyeView() = default;
 const MapTransform& BirdsEyeView::transform() const { return impl_->transform; }
 
 Vector2 BirdsEyeView::ToImagePixel(const Position& world) const {
-  return impl_->transform.ToPixel(world) + Vector2(0.0, impl_->TitleHeight());
+  return impl_->transform.ToPixel(world) + impl_->MapOffset();
 }
 
-int BirdsEyeView::image_width() const { return impl_->transform.pixel_width(); }
+int BirdsEyeView::image_width() const { return impl_->options.pixel_width; }
 
 int BirdsEyeView::image_height() const {
-  return static_cast<int>(impl_->TitleHeight()) + impl_->transform.pixel_height() +
-         static_cast<int>(impl_->LegendHeight());
+  const Impl& im = *impl_;
+  const double caption = im.CaptionHeight();
+  const double h = im.TitleHeight() + im.transform.pixel_height() + im.AxesHeight() + im.z.pad +
+                   im.LegendHeight() + (caption > 0.0 ? im.z.gap + caption : 0.0) + im.z.pad;
+  return static_cast<int>(std::ceil(h));
 }
 
 void BirdsEyeView::DrawLane(const std::vector<Position>& centre_line, double width) {
@@ -112,17 +192,17 @@ void BirdsEyeView::DrawLane(const std::vector<Position>& centre_line, double wid
     throw std::invalid_argument("BirdsEyeView::DrawLane: width must be positive");
   if (centre_line.size() < 2) return;
   cairo_t* cr = impl_->map.cr();
-  const double w = width * impl_->transform.scale();
+  const double w = width * impl_->transform.scale(), u = impl_->z.u;
   cairo_save(cr);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
   // A slightly wider dark band under the light one leaves a thin edge line between lanes.
   impl_->PathPolyline(centre_line);
   SetColor(cr, colors::kLaneEdge);
-  cairo_set_line_width(cr, w + 1.5);
+  cairo_set_line_width(cr, w + 0.4 * u);
   cairo_stroke(cr);
   impl_->PathPolyline(centre_line);
   SetColor(cr, colors::kLane);
-  cairo_set_line_width(cr, std::max(1.0, w - 1.5));
+  cairo_set_line_width(cr, std::max(0.3 * u, w - 0.4 * u));
   cairo_stroke(cr);
   cairo_restore(cr);
   impl_->AddLegend({"lane", colors::kLane, Marker::kSwatch, colors::kLaneEdge});
@@ -134,7 +214,7 @@ void BirdsEyeView::DrawGuardRail(const std::vector<Position>& polyline, double w
   cairo_save(cr);
   impl_->PathPolyline(polyline);
   SetColor(cr, colors::kGuardRail);
-  cairo_set_line_width(cr, std::max(2.0, width * impl_->transform.scale()));
+  cairo_set_line_width(cr, std::max(0.8 * impl_->z.u, width * impl_->transform.scale()));
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_stroke(cr);
   cairo_restore(cr);
@@ -144,20 +224,29 @@ void BirdsEyeView::DrawGuardRail(const std::vector<Position>& polyline, double w
 void BirdsEyeView::DrawVehicle(const OrientedBox& box, const VehicleStyle& style) {
   cairo_t* cr = impl_->map.cr();
   const MapTransform& t = impl_->transform;
+  const double u = impl_->z.u;
   const Rgba fill = style.ego ? colors::kEgo : style.fill;
+  double top = 1e300, bottom = -1e300, left = 1e300, right = -1e300;
+  for (const Position& c : box.Corners()) {
+    const Vector2 p = t.ToPixel(c);
+    top = std::min(top, p.y());
+    bottom = std::max(bottom, p.y());
+    left = std::min(left, p.x());
+    right = std::max(right, p.x());
+  }
+  // A box outside the map draws nothing and adds no legend entry.
+  if (right < 0.0 || bottom < 0.0 || left > t.pixel_width() || top > t.pixel_height()) return;
   cairo_save(cr);
   cairo_new_path(cr);
-  double top = 1e300;
   for (const Position& c : box.Corners()) {
     const Vector2 p = t.ToPixel(c);
     cairo_line_to(cr, p.x(), p.y());
-    top = std::min(top, p.y());
   }
   cairo_close_path(cr);
   SetColor(cr, fill);
   cairo_fill_preserve(cr);
   SetColor(cr, style.ego ? colors::kBlack : Mix(fill, colors::kBlack, 0.55));
-  cairo_set_line_width(cr, style.ego ? 2.5 : 1.5);
+  cairo_set_line_width(cr, (style.ego ? 0.9 : 0.5) * u);
   cairo_stroke(cr);
   // Heading mark: a darker triangle in the front quarter of the box.
   const Vector2 f = UnitVector(box.yaw), l = UnitVector(box.yaw + 0.5 * kPi);
@@ -175,25 +264,34 @@ void BirdsEyeView::DrawVehicle(const OrientedBox& box, const VehicleStyle& style
     const Vector2 c = t.ToPixel(box.center);
     const Vector2 e = c + t.VectorToPixel(*style.velocity * style.arrow_scale);
     SetColor(cr, colors::kBlack);
-    detail::DrawArrow(cr, c.x(), c.y(), e.x(), e.y(), 1.8, 8.0);
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "velocity (%g s)", style.arrow_scale);
+    detail::DrawArrow(cr, c.x(), c.y(), e.x(), e.y(), 0.7 * u, 3.2 * u);
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s (%g s)",
+                  style.velocity_legend.empty() ? "velocity" : style.velocity_legend.c_str(),
+                  style.arrow_scale);
     impl_->AddLegend({buf, colors::kBlack, Marker::kArrow});
   }
   cairo_restore(cr);
   if (!style.label.empty()) {
-    DrawText(cr, style.label, t.ToPixel(box.center).x(), top - 3.0,
-             {.size = impl_->options.font_size * 0.85,
-              .bold = style.ego,
-              .h = HAlign::kCenter,
-              .v = VAlign::kBottom,
-              .halo = true});
+    const double sm = impl_->z.sm;
+    const double w = detail::TextWidth(cr, style.label, sm, style.ego), h = detail::LineHeight(sm);
+    // Centred over the box, but inside the map (a label cut by the edge is unreadable).
+    const double cx = std::clamp(t.ToPixel(box.center).x(), 0.5 * w,
+                                 std::max(0.5 * w, t.pixel_width() - 0.5 * w));
+    const Impl::Box above{cx - 0.5 * w, top - 0.8 * u - h, cx + 0.5 * w, top - 0.8 * u};
+    const Impl::Box below{cx - 0.5 * w, bottom + 0.8 * u, cx + 0.5 * w, bottom + 0.8 * u + h};
+    const auto free = [&](const Impl::Box& b) {
+      return std::none_of(impl_->labels.begin(), impl_->labels.end(),
+                          [&](const Impl::Box& o) { return o.Overlaps(b); });
+    };
+    const Impl::Box at = free(above) || !free(below) ? above : below;
+    impl_->labels.push_back(at);
+    DrawText(
+        cr, style.label, cx, at.y1 - 0.2 * h,
+        {.size = sm, .bold = style.ego, .h = HAlign::kCenter, .v = VAlign::kBottom, .halo = true});
   }
-  if (style.ego)
-    impl_->AddLegend({"ego", colors::kEgo});
-  else
-    impl_->AddLegend({"vehicle", colors::kVehicle, Marker::kSwatch,
-                      Mix(colors::kVehicle, colors::kBlack, 0.55)});
+  const std::string legend = !style.legend.empty() ? style.legend : style.ego ? "ego" : "vehicle";
+  impl_->AddLegend({legend, fill, Marker::kSwatch, Mix(fill, colors::kBlack, 0.55)});
 }
 
 void BirdsEyeView::DrawSensorFov(const SensorFov& fov) {
@@ -219,15 +317,16 @@ void BirdsEyeView::DrawSensorFov(const SensorFov& fov) {
               -(fov.boresight - fov.half_fov));
     cairo_close_path(cr);
   }
-  SetColor(cr, WithAlpha(c, 0.12));
+  // A faint tint and an opaque outline: overlapping wedges stay readable by their outlines.
+  SetColor(cr, WithAlpha(c, kSensorFovTint));
   cairo_fill_preserve(cr);
-  SetColor(cr, WithAlpha(c, 0.6));
-  cairo_set_line_width(cr, 1.2);
+  SetColor(cr, c);
+  cairo_set_line_width(cr, 0.6 * impl_->z.u);
   cairo_stroke(cr);
   cairo_restore(cr);
   const std::string name =
       fov.name.empty() ? "sensor " + std::to_string(fov.sensor_index) : fov.name;
-  impl_->AddLegend({name, c, Marker::kWedge});
+  impl_->AddLegend({name, c, Marker::kSensor});
 }
 
 void BirdsEyeView::DrawDetections(const std::vector<DetectionMark>& detections,
@@ -237,37 +336,41 @@ void BirdsEyeView::DrawDetections(const std::vector<DetectionMark>& detections,
     throw std::invalid_argument("BirdsEyeView::DrawDetections: style." + error);
   cairo_t* cr = impl_->map.cr();
   const MapTransform& t = impl_->transform;
+  const double u = impl_->z.u;
   const bool by_speed = style.coloring == DetectionColoring::kBySpeed;
+  const auto color_of = [&](const DetectionMark& d) {
+    return by_speed ? SequentialColor(d.radial_velocity.norm() / style.max_speed)
+                    : SensorColor(d.sensor_index);
+  };
   bool any_clutter = false, any_target = false, any_arrow = false;
   cairo_save(cr);
   // Arrows first so the dots stay visible on top.
   if (style.arrow_scale > 0.0) {
     for (const DetectionMark& d : detections) {
+      if (d.clutter && !style.clutter_arrows) continue;
+      if (!impl_->InView(t.ToPixel(d.position))) continue;
       const Vector2 v = d.radial_velocity * style.arrow_scale;
-      if (v.norm() * t.scale() < 2.0) continue;
-      const Rgba c = by_speed ? SequentialColor(d.radial_velocity.norm() / style.max_speed)
-                              : SensorColor(d.sensor_index);
+      if (v.norm() * t.scale() < 1.0 * u) continue;
       const Vector2 p = t.ToPixel(d.position), e = p + t.VectorToPixel(v);
-      SetColor(cr, WithAlpha(c, 0.85));
-      detail::DrawArrow(cr, p.x(), p.y(), e.x(), e.y(), 1.2, 6.0);
+      SetColor(cr, WithAlpha(color_of(d), 0.9));
+      detail::DrawArrow(cr, p.x(), p.y(), e.x(), e.y(), 0.5 * u, 2.4 * u);
       any_arrow = true;
     }
   }
+  const double radius = style.radius_px * u;
   for (const DetectionMark& d : detections) {
-    const Rgba c = by_speed ? SequentialColor(d.radial_velocity.norm() / style.max_speed)
-                            : SensorColor(d.sensor_index);
     const Vector2 p = t.ToPixel(d.position);
+    if (!impl_->InView(p)) continue;  // outside: no legend entry for it either
+    SetColor(cr, color_of(d));
     if (d.clutter) {
-      SetColor(cr, c);
-      detail::DrawCross(cr, p.x(), p.y(), style.radius_px * 1.2, 1.6);
+      detail::DrawCross(cr, p.x(), p.y(), radius, 0.5 * u);
       any_clutter = true;
     } else {
       cairo_new_path(cr);
-      cairo_arc(cr, p.x(), p.y(), style.radius_px, 0.0, 2.0 * kPi);
-      SetColor(cr, c);
+      cairo_arc(cr, p.x(), p.y(), radius, 0.0, 2.0 * kPi);
       cairo_fill_preserve(cr);
       SetColor(cr, WithAlpha(colors::kBlack, 0.6));
-      cairo_set_line_width(cr, 0.6);
+      cairo_set_line_width(cr, 0.25 * u);
       cairo_stroke(cr);
       any_target = true;
     }
@@ -275,9 +378,11 @@ void BirdsEyeView::DrawDetections(const std::vector<DetectionMark>& detections,
   cairo_restore(cr);
   const Rgba legend_color = by_speed ? SequentialColor(0.5) : Rgba{0.35, 0.35, 0.35, 1.0};
   if (any_target) impl_->AddLegend({"detection", legend_color, Marker::kDot});
-  if (any_clutter) impl_->AddLegend({"clutter", legend_color, Marker::kCross});
+  if (any_clutter)
+    impl_->AddLegend({std::string("clutter") + (style.clutter_arrows ? "" : ", no arrow"),
+                      legend_color, Marker::kCross});
   if (any_arrow) {
-    char buf[64];
+    char buf[96];
     std::snprintf(buf, sizeof buf, "radial velocity (%g s)", style.arrow_scale);
     impl_->AddLegend({buf, legend_color, Marker::kArrow});
   }
@@ -290,51 +395,73 @@ void BirdsEyeView::DrawDetections(const std::vector<DetectionMark>& detections,
 void BirdsEyeView::DrawLabel(const Position& at, const std::string& text) {
   const Vector2 p = impl_->transform.ToPixel(at);
   DrawText(impl_->map.cr(), text, p.x(), p.y(),
-           {.size = impl_->options.font_size, .v = VAlign::kMiddle, .halo = true});
+           {.size = impl_->z.sm, .v = VAlign::kMiddle, .halo = true});
 }
 
 void BirdsEyeView::Save(const std::string& path) const {
   const Impl& im = *impl_;
-  const double fs = im.options.font_size;
-  const double title_h = im.TitleHeight();
-  const int map_h = im.transform.pixel_height();
+  const Sizes& z = im.z;
+  const double fs = z.fs, sm = z.sm, u = z.u;
+  const Vector2 off = im.MapOffset();
+  const double map_w = im.transform.pixel_width(), map_h = im.transform.pixel_height();
   detail::Canvas out(image_width(), image_height());
+  out.SetRasterScale(im.options.png_scale);
   cairo_t* cr = out.cr();
-  cairo_set_source_surface(cr, im.map.surface(), 0.0, title_h);
-  cairo_paint(cr);
-  // Thin frame around the map separates it from the bands.
-  cairo_rectangle(cr, 0.5, title_h + 0.5, out.width() - 1.0, map_h - 1.0);
-  SetColor(cr, {0.6, 0.6, 0.6, 1.0});
-  cairo_set_line_width(cr, 1.0);
-  cairo_stroke(cr);
-  if (title_h > 0.0)
-    DrawText(cr, im.options.title, 0.5 * out.width(), 0.5 * title_h,
-             {.size = fs * 1.3, .bold = true, .h = HAlign::kCenter, .v = VAlign::kMiddle});
-  const double band_y = title_h + map_h + kPad;
-  detail::LayoutLegendRow(cr, im.legend, kPad, band_y, out.width() - kRightBlock - 2 * kPad, fs,
-                          true);
-  const double right_x = out.width() - kRightBlock + kPad;
-  detail::DrawScaleBar(cr, right_x, band_y + fs * 1.1, im.transform.scale(), kRightBlock * 0.55,
-                       fs);
+  out.PaintCanvas(im.map, off.x(), off.y());
+  for (std::size_t i = 0; i < im.title_lines.size(); ++i)
+    DrawText(cr, im.title_lines[i], 0.5 * out.width(), z.pad + i * detail::LineHeight(1.05 * fs),
+             {.size = 1.05 * fs, .bold = true, .h = HAlign::kCenter, .v = VAlign::kTop});
+  if (im.options.axes) {
+    MapTransform placed(im.transform.world(), im.transform.pixel_width(), off);
+    detail::MapAxesStyle axes = z.Axes();
+    axes.label_left_room = off.x();
+    axes.label_right_room = im.margins.right;
+    detail::DrawMapAxes(cr, placed, axes);
+    DrawText(cr, im.options.x_label, off.x() + 0.5 * map_w,
+             off.y() + map_h + im.AxesHeight() - detail::LineHeight(fs),
+             {.size = fs, .h = HAlign::kCenter, .v = VAlign::kTop});
+    DrawText(cr, im.options.y_label, z.pad + 0.5 * detail::LineHeight(fs), off.y() + 0.5 * map_h,
+             {.size = fs, .h = HAlign::kCenter, .v = VAlign::kMiddle, .angle = -0.5 * kPi});
+  } else {
+    // A thin frame separates the map from the bands.
+    cairo_rectangle(cr, 0.25 * u, off.y() + 0.25 * u, out.width() - 0.5 * u, map_h - 0.5 * u);
+    SetColor(cr, {0.6, 0.6, 0.6, 1.0});
+    cairo_set_line_width(cr, 0.5 * u);
+    cairo_stroke(cr);
+  }
+  const double band_y = off.y() + map_h + im.AxesHeight() + z.pad;
+  detail::LayoutLegendRow(cr, im.legend, z.pad, band_y, im.LegendWidth(), sm, true);
+  const double right_x = out.width() - RightBlock(im.options, im.speed_bar) + z.pad;
+  double right_y = band_y;
+  if (!im.options.axes) {
+    detail::DrawScaleBar(cr, right_x, band_y + 1.1 * sm, im.transform.scale(),
+                         0.5 * RightBlock(im.options, im.speed_bar), sm);
+    right_y += 1.6 * sm;
+  }
   if (im.speed_bar) {
     // Horizontal colour bar for |compensated radial speed|.
-    const double y = band_y + fs * 1.6 + 4.0, h = fs * 0.8;
-    for (int i = 0; i < static_cast<int>(kColorBarWidth); ++i) {
-      SetColor(cr, SequentialColor((i + 0.5) / kColorBarWidth));
-      cairo_rectangle(cr, right_x + i, y, 1.0, h);
+    const double bar_w = 0.45 * RightBlock(im.options, true);
+    const double y = right_y + 0.5 * u, h = 0.8 * sm;
+    const int steps = 64;
+    for (int i = 0; i < steps; ++i) {
+      SetColor(cr, SequentialColor((i + 0.5) / steps));
+      cairo_rectangle(cr, right_x + bar_w * i / steps, y, bar_w / steps + 0.05 * u, h);
       cairo_fill(cr);
     }
-    cairo_rectangle(cr, right_x + 0.5, y + 0.5, kColorBarWidth - 1.0, h - 1.0);
+    cairo_rectangle(cr, right_x, y, bar_w, h);
     SetColor(cr, colors::kBlack);
+    cairo_set_line_width(cr, 0.4 * u);
     cairo_stroke(cr);
-    const detail::TextStyle tick{.size = fs * 0.8, .h = HAlign::kCenter, .v = VAlign::kTop};
+    const detail::TextStyle tick{.size = sm, .h = HAlign::kCenter, .v = VAlign::kTop};
     char buf[32];
-    DrawText(cr, "0", right_x, y + h + 1.0, tick);
+    DrawText(cr, "0", right_x, y + h + 0.3 * u, tick);
     std::snprintf(buf, sizeof buf, "%g", im.max_speed);
-    DrawText(cr, buf, right_x + kColorBarWidth, y + h + 1.0, tick);
-    DrawText(cr, "|v_r| [m/s]", right_x + kColorBarWidth + 8.0, y + 0.5 * h,
-             {.size = fs, .v = VAlign::kMiddle});
+    DrawText(cr, buf, right_x + bar_w, y + h + 0.3 * u, tick);
+    DrawText(cr, "|v_r| [m/s]", right_x + bar_w + 2.0 * u, y + 0.5 * h,
+             {.size = sm, .v = VAlign::kMiddle});
   }
+  detail::DrawParagraph(cr, im.options.caption, z.pad, band_y + im.LegendHeight() + z.gap,
+                        out.width() - 2.0 * z.pad, {.size = sm});
   out.Save(path);
 }
 

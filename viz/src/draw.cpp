@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/viz/figure.hpp"
 
 namespace dualgrid::viz::detail {
 
@@ -26,18 +27,55 @@ std::string Lower(std::string s) {
   return s;
 }
 
+// The text record of a canvas hangs on its recording surface, so DrawText, which sees only a
+// context, finds it through the context's target.
+const cairo_user_data_key_t kTextRecordKey{};
+
+TextRecord* RecordOf(cairo_t* cr) {
+  return static_cast<TextRecord*>(
+      cairo_surface_get_user_data(cairo_get_target(cr), &kTextRecordKey));
+}
+
 }  // namespace
+
+void TextRecord::Add(const std::string& text, double size) {
+  min_size = std::min(min_size, size);
+  ++count;
+  strings.push_back(text);
+}
+
+void TextRecord::Merge(const TextRecord& other) {
+  min_size = std::min(min_size, other.min_size);
+  count += other.count;
+  strings.insert(strings.end(), other.strings.begin(), other.strings.end());
+}
 
 Canvas::Canvas(int width, int height)
     : width_(width),
       height_(height),
+      text_(std::make_unique<TextRecord>()),
       surface_(RecordingSurface(width, height)),
       cr_(cairo_create(surface_.get())) {
   if (width <= 0 || height <= 0 || cairo_surface_status(surface_.get()) != CAIRO_STATUS_SUCCESS)
     throw std::runtime_error("viz: cannot create a " + std::to_string(width) + "x" +
                              std::to_string(height) + " drawing");
+  cairo_surface_set_user_data(surface_.get(), &kTextRecordKey, text_.get(), nullptr);
   cairo_set_source_rgb(cr(), 1.0, 1.0, 1.0);
   cairo_paint(cr());
+}
+
+void Canvas::SetRasterScale(double pixels_per_unit) {
+  if (!(pixels_per_unit > 0.0 && pixels_per_unit <= 32.0))
+    throw std::invalid_argument("viz: raster scale must be in (0, 32] pixels per unit");
+  raster_scale_ = pixels_per_unit;
+}
+
+void Canvas::PaintCanvas(const Canvas& other, double x, double y) {
+  cairo_save(cr());
+  cairo_set_source_surface(cr(), other.surface(), x, y);
+  cairo_paint(cr());
+  cairo_restore(cr());
+  text_->Merge(other.text_record());
 }
 
 void Canvas::Save(const std::string& path) const {
@@ -46,7 +84,9 @@ void Canvas::Save(const std::string& path) const {
   const std::string ext = dot == std::string::npos ? "" : Lower(path.substr(dot));
   SurfacePtr target;
   if (ext == ".png") {
-    target.reset(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, width_, height_));
+    target.reset(cairo_image_surface_create(
+        CAIRO_FORMAT_ARGB32, static_cast<int>(std::ceil(width_ * raster_scale_ - 1e-6)),
+        static_cast<int>(std::ceil(height_ * raster_scale_ - 1e-6))));
   } else if (ext == ".svg") {
     target.reset(cairo_svg_surface_create(path.c_str(), width_, height_));
   } else if (ext == ".pdf") {
@@ -65,6 +105,9 @@ void Canvas::Save(const std::string& path) const {
     fail(cairo_surface_status(target.get()));
   {
     ContextPtr cr(cairo_create(target.get()));
+    // The recording is replayed at the raster scale: lines and text are drawn again at that
+    // resolution, not enlarged.
+    if (ext == ".png") cairo_scale(cr.get(), raster_scale_, raster_scale_);
     cairo_set_source_surface(cr.get(), surface_.get(), 0.0, 0.0);
     cairo_paint(cr.get());
     if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) fail(cairo_status(cr.get()));
@@ -73,13 +116,20 @@ void Canvas::Save(const std::string& path) const {
     cairo_surface_flush(target.get());
     const cairo_status_t status = cairo_surface_write_to_png(target.get(), path.c_str());
     if (status != CAIRO_STATUS_SUCCESS) fail(status);
-    return;
+  } else {
+    // SVG and PDF surfaces write their file when finished; errors show in the surface status.
+    cairo_surface_finish(target.get());
+    if (cairo_surface_status(target.get()) != CAIRO_STATUS_SUCCESS)
+      fail(cairo_surface_status(target.get()));
   }
-  // SVG and PDF surfaces write their file when finished; errors show in the surface status.
-  cairo_surface_finish(target.get());
-  if (cairo_surface_status(target.get()) != CAIRO_STATUS_SUCCESS)
-    fail(cairo_surface_status(target.get()));
+  FigureAudit::Report({path, static_cast<double>(width_), static_cast<double>(height_),
+                       ext == ".png" ? raster_scale_ : 1.0, text_->min_size, text_->count,
+                       text_->strings});
 }
+
+Measure::Measure()
+    : surface_(cairo_recording_surface_create(CAIRO_CONTENT_COLOR_ALPHA, nullptr)),
+      cr_(cairo_create(surface_.get())) {}
 
 void SetColor(cairo_t* cr, const Rgba& c) { cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a); }
 
@@ -100,6 +150,12 @@ double TextWidth(cairo_t* cr, const std::string& text, double size, bool bold) {
 
 void DrawText(cairo_t* cr, const std::string& text, double x, double y, const TextStyle& style) {
   if (text.empty()) return;
+  if (TextRecord* record = RecordOf(cr)) {
+    // The size as it lands on the page: font size times the transformation's (area) scale.
+    cairo_matrix_t m;
+    cairo_get_matrix(cr, &m);
+    record->Add(text, style.size * std::sqrt(std::abs(m.xx * m.yy - m.xy * m.yx)));
+  }
   cairo_save(cr);
   SelectFont(cr, style.size, style.bold);
   cairo_text_extents_t ext;
@@ -119,7 +175,7 @@ void DrawText(cairo_t* cr, const std::string& text, double x, double y, const Te
   if (style.halo) {
     cairo_text_path(cr, text.c_str());
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
-    cairo_set_line_width(cr, 3.0);
+    cairo_set_line_width(cr, 3.0 / 14.0 * style.size);
     cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
     cairo_stroke(cr);
     cairo_move_to(cr, dx, dy);
@@ -171,32 +227,34 @@ double DrawScaleBar(cairo_t* cr, double x, double y, double px_per_m, double max
                     double font_size) {
   const double len_m = NiceScaleLength(px_per_m, max_px);
   const double len_px = len_m * px_per_m;
-  const double h = 6.0;
+  const double u = font_size / 14.0;  // sizes were designed at font size 14
+  const double h = 6.0 * u;
   cairo_save(cr);
   // Two halves, black and white, in a black frame: classic map scale bar.
-  cairo_set_line_width(cr, 1.0);
+  cairo_set_line_width(cr, u);
   cairo_rectangle(cr, x, y - h, 0.5 * len_px, h);
   SetColor(cr, colors::kBlack);
   cairo_fill(cr);
-  cairo_rectangle(cr, x + 0.5, y - h + 0.5, len_px - 1.0, h - 1.0);
+  cairo_rectangle(cr, x + 0.5 * u, y - h + 0.5 * u, len_px - u, h - u);
   cairo_stroke(cr);
   cairo_restore(cr);
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g m", len_m);
   TextStyle ts{.size = font_size, .h = HAlign::kLeft, .v = VAlign::kMiddle};
-  const double label_x = x + len_px + 6.0;
+  const double label_x = x + len_px + 6.0 * u;
   DrawText(cr, buf, label_x, y - 0.5 * h, ts);
-  return len_px + 6.0 + TextWidth(cr, buf, font_size);
+  return len_px + 6.0 * u + TextWidth(cr, buf, font_size);
 }
 
 namespace {
-constexpr double kMarkerWidth = 22.0;
-constexpr double kMarkerGap = 6.0;
-constexpr double kItemGap = 18.0;
+// Legend geometry at font size 14; everything scales with the font size.
+double MarkerWidth(double font_size) { return 22.0 / 14.0 * font_size; }
+double MarkerGap(double font_size) { return 6.0 / 14.0 * font_size; }
+double ItemGap(double font_size) { return 18.0 / 14.0 * font_size; }
 }  // namespace
 
 double LegendItemWidth(cairo_t* cr, const LegendItem& item, double font_size) {
-  return kMarkerWidth + kMarkerGap + TextWidth(cr, item.label, font_size);
+  return MarkerWidth(font_size) + MarkerGap(font_size) + TextWidth(cr, item.label, font_size);
 }
 
 void DrawArrow(cairo_t* cr, double x0, double y0, double x1, double y1, double line_width,
@@ -233,28 +291,29 @@ void DrawCross(cairo_t* cr, double x, double y, double half, double line_width) 
 
 void DrawLegendItem(cairo_t* cr, const LegendItem& item, double x, double y, double font_size) {
   cairo_save(cr);
-  const double w = kMarkerWidth, h = std::min(12.0, font_size);
+  const double u = font_size / 14.0;  // sizes below were designed at font size 14
+  const double w = MarkerWidth(font_size), h = std::min(12.0 * u, font_size);
   switch (item.marker) {
     case Marker::kSwatch:
-      cairo_rectangle(cr, x + 0.5, y - 0.5 * h + 0.5, w - 1.0, h - 1.0);
+      cairo_rectangle(cr, x + 0.5 * u, y - 0.5 * h + 0.5 * u, w - u, h - u);
       SetColor(cr, item.color);
       cairo_fill_preserve(cr);
       SetColor(cr, item.outline);
-      cairo_set_line_width(cr, 1.0);
+      cairo_set_line_width(cr, u);
       cairo_stroke(cr);
       break;
     case Marker::kOutline:
-      cairo_rectangle(cr, x + 1.5, y - 0.5 * h + 1.0, w - 3.0, h - 2.0);
+      cairo_rectangle(cr, x + 1.5 * u, y - 0.5 * h + u, w - 3.0 * u, h - 2.0 * u);
       SetColor(cr, item.color);
-      cairo_set_line_width(cr, 2.0);
+      cairo_set_line_width(cr, 2.0 * u);
       cairo_stroke(cr);
       break;
     case Marker::kLine:
     case Marker::kDashedLine: {
       SetColor(cr, item.color);
-      cairo_set_line_width(cr, 3.0);
+      cairo_set_line_width(cr, 3.0 * u);
       if (item.marker == Marker::kDashedLine) {
-        const double dash[] = {5.0, 3.0};
+        const double dash[] = {5.0 * u, 3.0 * u};
         cairo_set_dash(cr, dash, 2, 0.0);
       }
       cairo_move_to(cr, x, y);
@@ -264,30 +323,37 @@ void DrawLegendItem(cairo_t* cr, const LegendItem& item, double x, double y, dou
     }
     case Marker::kDot:
       SetColor(cr, item.color);
-      cairo_arc(cr, x + 0.5 * w, y, 3.5, 0.0, 2.0 * kPi);
+      cairo_arc(cr, x + 0.5 * w, y, 3.5 * u, 0.0, 2.0 * kPi);
       cairo_fill(cr);
       break;
     case Marker::kCross:
       SetColor(cr, item.color);
-      DrawCross(cr, x + 0.5 * w, y, 4.0, 1.8);
+      DrawCross(cr, x + 0.5 * w, y, 4.0 * u, 1.8 * u);
       break;
     case Marker::kArrow:
       SetColor(cr, item.color);
-      DrawArrow(cr, x, y, x + w, y, 1.5, 7.0);
+      DrawArrow(cr, x, y, x + w, y, 1.5 * u, 7.0 * u);
       break;
     case Marker::kWedge:
-      cairo_move_to(cr, x + 2.0, y);
-      cairo_arc(cr, x + 2.0, y, w - 2.0, -0.45, 0.45);
+    case Marker::kSensor:
+      cairo_move_to(cr, x + 2.0 * u, y);
+      cairo_arc(cr, x + 2.0 * u, y, w - 2.0 * u, -0.45, 0.45);
       cairo_close_path(cr);
-      SetColor(cr, WithAlpha(item.color, 0.3));
-      cairo_fill_preserve(cr);
+      if (item.marker == Marker::kWedge) {
+        SetColor(cr, WithAlpha(item.color, 0.3));
+        cairo_fill_preserve(cr);
+      }
       SetColor(cr, item.color);
-      cairo_set_line_width(cr, 1.2);
+      cairo_set_line_width(cr, (item.marker == Marker::kSensor ? 2.0 : 1.2) * u);
       cairo_stroke(cr);
+      if (item.marker == Marker::kSensor) {  // the colour of its detections, opaque
+        cairo_arc(cr, x + 0.62 * w, y, 3.0 * u, 0.0, 2.0 * kPi);
+        cairo_fill(cr);
+      }
       break;
   }
   cairo_restore(cr);
-  DrawText(cr, item.label, x + kMarkerWidth + kMarkerGap, y,
+  DrawText(cr, item.label, x + w + MarkerGap(font_size), y,
            {.size = font_size, .h = HAlign::kLeft, .v = VAlign::kMiddle});
 }
 
@@ -305,9 +371,120 @@ double LayoutLegendRow(cairo_t* cr, const std::vector<LegendItem>& items, double
       ++rows;
     }
     if (draw) DrawLegendItem(cr, item, cx, cy, font_size);
-    cx += w + kItemGap;
+    cx += w + ItemGap(font_size);
   }
   return rows * row_h;
+}
+
+double LineHeight(double size) { return 1.25 * size; }
+
+std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double size,
+                                  double max_width, bool bold) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t nl = text.find('\n', start);
+    const std::string para = text.substr(start, nl == std::string::npos ? nl : nl - start);
+    std::string line, word;
+    const auto flush_word = [&] {
+      if (word.empty()) return;
+      const std::string candidate = line.empty() ? word : line + " " + word;
+      if (!line.empty() && TextWidth(cr, candidate, size, bold) > max_width) {
+        lines.push_back(line);
+        line = word;
+      } else {
+        line = candidate;
+      }
+      word.clear();
+    };
+    for (const char c : para) {
+      if (c == ' ')
+        flush_word();
+      else
+        word += c;
+    }
+    flush_word();
+    lines.push_back(line);
+    if (nl == std::string::npos) break;
+    start = nl + 1;
+  }
+  return lines;
+}
+
+double DrawParagraph(cairo_t* cr, const std::string& text, double x, double y, double max_width,
+                     const TextStyle& style, bool draw) {
+  if (text.empty()) return 0.0;
+  const std::vector<std::string> lines = WrapText(cr, text, style.size, max_width, style.bold);
+  if (draw) {
+    TextStyle s = style;
+    s.v = VAlign::kTop;
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      DrawText(cr, lines[i], x, y + i * LineHeight(style.size), s);
+  }
+  return lines.size() * LineHeight(style.size);
+}
+
+namespace {
+double TickStep(const std::vector<double>& ticks) {
+  return ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
+}
+// About one labelled tick per 5.5 font sizes across and per 3 font sizes up the map.
+std::vector<double> XTicks(const MapTransform& t, double fs) {
+  return NiceTicks(t.world().min.x(), t.world().max.x(),
+                   std::max(2, static_cast<int>(t.pixel_width() / (5.5 * fs))));
+}
+std::vector<double> YTicks(const MapTransform& t, double fs) {
+  return NiceTicks(t.world().min.y(), t.world().max.y(),
+                   std::max(2, static_cast<int>(t.pixel_height() / (3.0 * fs))));
+}
+}  // namespace
+
+double MapAxesLabelWidth(cairo_t* cr, const MapTransform& t, const MapAxesStyle& style) {
+  if (!style.label_y) return style.tick_length;
+  const std::vector<double> yt = YTicks(t, style.font_size);
+  double widest = 0.0;
+  for (double v : yt)
+    widest = std::max(widest, TextWidth(cr, FormatTick(v, TickStep(yt)), style.font_size));
+  return style.tick_length + 0.3 * style.font_size + widest;
+}
+
+double DrawMapAxes(cairo_t* cr, const MapTransform& t, const MapAxesStyle& style) {
+  const double fs = style.font_size;
+  const double x0 = t.pixel_offset().x(), y0 = t.pixel_offset().y();
+  const double w = t.pixel_width(), h = t.pixel_height();
+  const WorldRect& wr = t.world();
+  cairo_save(cr);
+  SetColor(cr, colors::kBlack);
+  cairo_set_line_width(cr, style.line_width);
+  const double half = 0.5 * style.line_width;
+  cairo_rectangle(cr, x0 - half, y0 - half, w + style.line_width, h + style.line_width);
+  cairo_stroke(cr);
+  const std::vector<double> xt = XTicks(t, fs), yt = YTicks(t, fs);
+  const double gap = 0.3 * fs;
+  for (double v : xt) {
+    const double px = t.ToPixel({v, wr.min.y()}).x();
+    cairo_move_to(cr, px, y0 + h);
+    cairo_line_to(cr, px, y0 + h + style.tick_length);
+    cairo_stroke(cr);
+    if (!style.label_x) continue;
+    const std::string label = FormatTick(v, TickStep(xt));
+    const double half = 0.5 * TextWidth(cr, label, fs);
+    if (px - half < x0 - style.label_left_room || px + half > x0 + w + style.label_right_room)
+      continue;
+    DrawText(cr, label, px, y0 + h + style.tick_length + gap,
+             {.size = fs, .h = HAlign::kCenter, .v = VAlign::kTop});
+  }
+  for (double v : yt) {
+    const double py = t.ToPixel({wr.min.x(), v}).y();
+    cairo_move_to(cr, x0 - style.tick_length, py);
+    cairo_line_to(cr, x0, py);
+    cairo_stroke(cr);
+    if (style.label_y)
+      DrawText(cr, FormatTick(v, TickStep(yt)), x0 - style.tick_length - gap, py,
+               {.size = fs, .h = HAlign::kRight, .v = VAlign::kMiddle});
+  }
+  cairo_restore(cr);
+  return style.tick_length + (style.label_x ? gap + LineHeight(fs) : 0.0);
 }
 
 }  // namespace dualgrid::viz::detail

@@ -56,12 +56,18 @@ bool GridFigureOptions::IsValid(std::string* error) const {
     if (error) *error = msg;
     return false;
   };
-  if (image_width < 500 || image_width > 20000) return fail("image_width must be in [500, 20000]");
-  if (!(font_size >= 6.0 && font_size <= 40.0)) return fail("font_size must be in [6, 40]");
+  if (image_width < 100 || image_width > 5000) return fail("image_width must be in [100, 5000] pt");
+  if (!(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0)))
+    return fail("font_size must be 0 (automatic) or in [2, 200] pt");
   if (columns < 0) return fail("columns must be >= 0 (0: automatic)");
+  if (!(png_scale > 0.0 && png_scale <= 32.0)) return fail("png_scale must be in (0, 32]");
   std::string sub;
   if (!cell.IsValid(&sub)) return fail("cell." + sub);
   return true;
+}
+
+double GridFigureOptions::BaseFont() const {
+  return font_size > 0.0 ? font_size : BaseFontSize(image_width);
 }
 
 Rgba CellColor(float free, float static_occ, float dynamic, float vx, float vy,
@@ -91,27 +97,39 @@ Rgba CellColor(float free, float static_occ, float dynamic, float vx, float vy,
 
 namespace {
 
+constexpr Rgba kEgoOutline{0.05, 0.55, 0.05, 1.0};
+
+// Everything is measured in u (one point at one column width) and the fonts: the figure looks
+// the same at any width, only larger.
 struct Metrics {
-  double left, right_col, fig_title, panel_title, tick_band, x_label, pad;
+  double fs, sm, u, pad, gap, panel_title, tick, col_gap, wheel_r;
+  std::vector<std::string> title_lines;
+  double TitleHeight() const { return title_lines.size() * detail::LineHeight(1.05 * fs); }
 };
 
-Metrics MetricsFor(const GridFigureOptions& o) {
-  const double fs = o.font_size;
-  return {std::round(fs * 4.6),
-          std::round(fs * 15.0),
-          o.title.empty() ? 0.0 : std::round(fs * 1.3 * 2.4),
-          std::round(fs * 2.0),
-          std::round(fs * 1.7),
-          std::round(fs * 1.8),
-          8.0};
+Metrics MetricsFor(cairo_t* m, const GridFigureOptions& o) {
+  Metrics k;
+  k.fs = o.BaseFont();
+  k.sm = 0.9 * k.fs;
+  k.u = k.fs / 8.0;
+  k.pad = 4.0 * k.u;
+  k.gap = 2.0 * k.u;
+  k.panel_title = detail::LineHeight(k.fs) + k.u;
+  k.tick = 2.5 * k.u;
+  k.col_gap = 4.0 * k.u;
+  k.wheel_r = 13.0 * k.u;
+  if (!o.title.empty())
+    k.title_lines = detail::WrapText(m, o.title, 1.05 * k.fs, o.image_width - 2.0 * k.pad, true);
+  return k;
 }
 
-// Height the legend column needs, from the same constants DrawLegendColumn uses.
-double LegendColumnHeight(double fs, double wheel_r, int items) {
-  return fs * 2.6 + 2.0 * wheel_r + fs * 2.6 + fs * 1.4 + items * fs * 1.6 + fs * 3.0;
+detail::MapAxesStyle AxesStyle(const Metrics& k, bool label_x, bool label_y) {
+  return {.font_size = k.sm,
+          .tick_length = k.tick,
+          .line_width = 0.6 * k.u,
+          .label_x = label_x,
+          .label_y = label_y};
 }
-
-double WheelRadius(double fs) { return std::round(fs * 3.6); }
 
 void Validate(const std::vector<GridPanel>& panels, const GridFigureOptions& options) {
   std::string error;
@@ -122,6 +140,114 @@ void Validate(const std::vector<GridPanel>& panels, const GridFigureOptions& opt
       throw std::invalid_argument("RenderGridPanels: panels[" + std::to_string(i) + "].raster." +
                                   error);
   }
+}
+
+std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
+  std::vector<LegendItem> items = {
+      {"free", colors::kWhite},
+      {"static", colors::kBlack},
+      {"unknown", colors::kUnknown},
+  };
+  const auto any = [&](auto member) {
+    return std::any_of(panels.begin(), panels.end(),
+                       [&](const GridPanel& p) { return !(p.*member).empty(); });
+  };
+  if (any(&GridPanel::truth_boxes))
+    items.push_back({"ground truth", colors::kBlack, Marker::kOutline});
+  if (any(&GridPanel::ego_boxes)) items.push_back({"ego", kEgoOutline, Marker::kOutline});
+  if (any(&GridPanel::particles)) items.push_back({"particle", colors::kBlack, Marker::kDot});
+  return items;
+}
+
+// The line under the legend items: how the cell colours combine.
+std::string ColoringNote(const GridFigureOptions& options) {
+  char buf[96];
+  if (options.cell.coloring == CellColoring::kThreshold)
+    std::snprintf(buf, sizeof buf, "wheel: direction of motion, shown if P(dyn) > %g",
+                  options.cell.dynamic_threshold);
+  else
+    std::snprintf(buf, sizeof buf, "wheel: direction of motion; colours blended by mass");
+  return buf;
+}
+
+// The legend band under the panels: the hue wheel (width and height) and the items right of it.
+struct LegendBand {
+  double wheel_w, wheel_h, items_x, items_w, items_h, height;
+};
+
+LegendBand BandFor(cairo_t* m, const Metrics& k, const std::vector<LegendItem>& items,
+                   const GridFigureOptions& options) {
+  const int image_width = options.image_width;
+  LegendBand b;
+  b.wheel_w = 2.0 * k.wheel_r + 2.0 * (detail::TextWidth(m, "\u2212x", k.sm) + 2.0 * k.u);
+  b.wheel_h = 2.0 * k.wheel_r + 2.0 * detail::LineHeight(k.sm);
+  b.items_x = k.pad + b.wheel_w + 6.0 * k.u;
+  b.items_w = image_width - b.items_x - k.pad;
+  b.items_h = detail::LayoutLegendRow(m, items, 0.0, 0.0, b.items_w, k.sm, false);
+  b.height =
+      std::max(b.wheel_h, b.items_h + detail::DrawParagraph(m, ColoringNote(options), 0.0, 0.0,
+                                                            b.items_w, {.size = k.sm}, false));
+  return b;
+}
+
+struct Placement {
+  GridFigureLayout layout;
+  int columns = 1;
+  double legend_top = 0.0, caption_top = 0.0, x_label_y = 0.0;
+};
+
+Placement Place(cairo_t* m, const std::vector<GridPanel>& panels, const GridFigureOptions& options,
+                const Metrics& k) {
+  Placement p;
+  p.layout.width = options.image_width;
+  const int n = static_cast<int>(panels.size());
+  int columns = std::min(options.columns, n);
+  if (columns == 0) {
+    const WorldRect e = panels.front().raster.Extent();
+    const double aspect = (e.max.x() - e.min.x()) / std::max(1e-9, e.max.y() - e.min.y());
+    columns = aspect <= 2.5 ? n : 1;
+  }
+  p.columns = columns;
+  // Left margin: the y label and the y tick labels, measured on a first guess of the panel size.
+  const auto map_width = [&](double left) {
+    return std::max(
+        10, static_cast<int>((options.image_width - left - k.pad - (columns - 1) * k.col_gap) /
+                             columns));
+  };
+  const double label_band = options.y_label.empty() ? 0.0 : detail::LineHeight(k.fs) + k.u;
+  double left = k.pad + label_band + 30.0 * k.u;
+  for (int pass = 0; pass < 2; ++pass) {
+    const MapTransform guess(panels.front().raster.Extent(), map_width(left));
+    left = k.pad + label_band + detail::MapAxesLabelWidth(m, guess, AxesStyle(k, true, true));
+  }
+  const int map_w = map_width(left);
+  double y = k.pad + k.TitleHeight() + (k.title_lines.empty() ? 0.0 : k.gap);
+  const int rows = (n + columns - 1) / columns;
+  for (int i = 0; i < n; ++i) {
+    const int col = i % columns, row = i / columns;
+    if (col == 0) y += k.panel_title;
+    p.layout.panels.emplace_back(panels[i].raster.Extent(), map_w,
+                                 Vector2(left + col * (map_w + k.col_gap), y));
+    if (col == columns - 1 || i == n - 1) {
+      double row_h = 0.0;
+      for (int j = row * columns; j <= i; ++j)
+        row_h = std::max(row_h, double(p.layout.panels[j].pixel_height()));
+      // Inner rows share the bottom row's x labels: their tick marks only.
+      y += row_h + (row == rows - 1 ? 0.0 : k.tick + k.gap);
+    }
+  }
+  y += k.tick + 0.3 * k.sm + detail::LineHeight(k.sm);  // the bottom row's tick labels
+  p.x_label_y = y + k.u;
+  if (!options.x_label.empty()) y += k.u + detail::LineHeight(k.fs);
+  p.legend_top = y + 3.0 * k.u;
+  const LegendBand band = BandFor(m, k, LegendItems(panels), options);
+  y = p.legend_top + band.height;
+  p.caption_top = y + 3.0 * k.u;
+  const double caption_h = detail::DrawParagraph(
+      m, options.caption, k.pad, 0.0, options.image_width - 2.0 * k.pad, {.size = k.sm}, false);
+  if (caption_h > 0.0) y = p.caption_top + caption_h;
+  p.layout.height = static_cast<int>(std::ceil(y + k.pad));
+  return p;
 }
 
 // One image pixel per cell, rows flipped so world +y is up; painted scaled with NEAREST filtering
@@ -158,37 +284,37 @@ void PathBox(cairo_t* cr, const MapTransform& t, const OrientedBox& box) {
   cairo_close_path(cr);
 }
 
-void StrokeHaloed(cairo_t* cr, const MapTransform& t, const OrientedBox& box, const Rgba& color) {
-  // White halo under the outline keeps it visible on black (static) and on any hue.
+void StrokeHaloed(cairo_t* cr, const MapTransform& t, const OrientedBox& box, const Rgba& color,
+                  double u) {
+  // White halo under the outline keeps it visible on black (static) and on any hue; both thin,
+  // so that a car (2 pt wide at one column) still shows its cells.
   PathBox(cr, t, box);
   SetColor(cr, colors::kWhite);
-  cairo_set_line_width(cr, 4.0);
+  cairo_set_line_width(cr, 1.3 * u);
   cairo_stroke(cr);
   PathBox(cr, t, box);
   SetColor(cr, color);
-  cairo_set_line_width(cr, 2.0);
+  cairo_set_line_width(cr, 0.6 * u);
   cairo_stroke(cr);
 }
 
-constexpr Rgba kEgoOutline{0.05, 0.55, 0.05, 1.0};
-
 void DrawPanel(cairo_t* cr, const GridPanel& panel, const MapTransform& t,
-               const GridFigureOptions& options, const Metrics& m) {
-  const double fs = options.font_size;
+               const GridFigureOptions& options, const Metrics& k, bool label_x, bool label_y,
+               double left_room, double right_room) {
   const double x0 = t.pixel_offset().x(), y0 = t.pixel_offset().y();
   const double w = t.pixel_width(), h = t.pixel_height();
   const GridRaster& g = panel.raster;
 
   // Title, with the mode's colour as a swatch when the title names a mode.
+  const double title_y = y0 - 0.5 * k.panel_title;
   double title_x = x0;
   if (const auto mode = ModeFromName(panel.title)) {
-    cairo_rectangle(cr, x0, y0 - m.panel_title * 0.5 - fs * 0.4, fs * 0.8, fs * 0.8);
+    cairo_rectangle(cr, x0, title_y - 0.4 * k.fs, 0.8 * k.fs, 0.8 * k.fs);
     SetColor(cr, ModeColor(*mode));
     cairo_fill(cr);
-    title_x += fs * 1.2;
+    title_x += 1.2 * k.fs;
   }
-  DrawText(cr, panel.title, title_x, y0 - m.panel_title * 0.5,
-           {.size = fs * 1.1, .bold = true, .v = VAlign::kMiddle});
+  DrawText(cr, panel.title, title_x, title_y, {.size = k.fs, .bold = true, .v = VAlign::kMiddle});
 
   cairo_save(cr);
   cairo_rectangle(cr, x0, y0, w, h);
@@ -209,124 +335,77 @@ void DrawPanel(cairo_t* cr, const GridPanel& panel, const MapTransform& t,
   }
   if (!panel.particles.empty()) {
     SetColor(cr, WithAlpha(colors::kBlack, 0.5));
+    const double d = 0.5 * k.u;
     for (const Position& p : panel.particles) {
       const Vector2 q = t.ToPixel(p);
-      cairo_rectangle(cr, q.x() - 0.9, q.y() - 0.9, 1.8, 1.8);
+      cairo_rectangle(cr, q.x() - 0.5 * d, q.y() - 0.5 * d, d, d);
     }
     cairo_fill(cr);
   }
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_MITER);
-  for (const OrientedBox& b : panel.ego_boxes) StrokeHaloed(cr, t, b, kEgoOutline);
-  for (const OrientedBox& b : panel.truth_boxes) StrokeHaloed(cr, t, b, colors::kBlack);
+  for (const OrientedBox& b : panel.ego_boxes) StrokeHaloed(cr, t, b, kEgoOutline, k.u);
+  for (const OrientedBox& b : panel.truth_boxes) StrokeHaloed(cr, t, b, colors::kBlack, k.u);
   cairo_restore(cr);
-
-  // Frame and ticks (world metres).
-  cairo_save(cr);
-  SetColor(cr, colors::kBlack);
-  cairo_set_line_width(cr, 1.0);
-  cairo_rectangle(cr, x0 - 0.5, y0 - 0.5, w + 1.0, h + 1.0);
-  cairo_stroke(cr);
-  const WorldRect& wr = t.world();
-  const std::vector<double> xt =
-      detail::NiceTicks(wr.min.x(), wr.max.x(), std::max(2, int(w / 90)));
-  const std::vector<double> yt =
-      detail::NiceTicks(wr.min.y(), wr.max.y(), std::max(2, int(h / 45)));
-  const detail::TextStyle tick_x{.size = fs * 0.8, .h = HAlign::kCenter, .v = VAlign::kTop};
-  const detail::TextStyle tick_y{.size = fs * 0.8, .h = HAlign::kRight, .v = VAlign::kMiddle};
-  for (double v : xt) {
-    const double px = t.ToPixel({v, wr.min.y()}).x();
-    cairo_move_to(cr, px, y0 + h);
-    cairo_line_to(cr, px, y0 + h + 5.0);
-    cairo_stroke(cr);
-    DrawText(cr, detail::FormatTick(v, xt.size() > 1 ? xt[1] - xt[0] : 1.0), px, y0 + h + 6.0,
-             tick_x);
-  }
-  for (double v : yt) {
-    const double py = t.ToPixel({wr.min.x(), v}).y();
-    cairo_move_to(cr, x0 - 5.0, py);
-    cairo_line_to(cr, x0, py);
-    cairo_stroke(cr);
-    DrawText(cr, detail::FormatTick(v, yt.size() > 1 ? yt[1] - yt[0] : 1.0), x0 - 7.0, py, tick_y);
-  }
-  cairo_restore(cr);
-  DrawText(cr, options.y_label, x0 - m.left + fs * 0.9, y0 + 0.5 * h,
-           {.size = fs * 0.9, .h = HAlign::kCenter, .v = VAlign::kMiddle, .angle = -0.5 * kPi});
+  detail::MapAxesStyle axes = AxesStyle(k, label_x, label_y);
+  axes.label_left_room = left_room;
+  axes.label_right_room = right_room;
+  detail::DrawMapAxes(cr, t, axes);
 }
 
-void DrawLegendColumn(cairo_t* cr, double x, double y, const GridFigureOptions& options,
-                      const std::vector<LegendItem>& items, double px_per_m) {
-  const double fs = options.font_size;
-  const double r = WheelRadius(fs);
-  DrawText(cr, "dynamic: direction", x, y, {.size = fs * 0.9, .bold = true, .v = VAlign::kTop});
-  DrawText(cr, "of motion", x, y + fs * 1.2, {.size = fs * 0.9, .bold = true, .v = VAlign::kTop});
-  const double cx = x + fs * 1.8 + r, cy = y + fs * 2.6 + fs * 1.3 + r;
-  // Hue wheel (a ring) in world orientation (+x right, +y up), one pixel at a time: sector
-  // paths would leave antialiasing seams between sectors.
-  {
-    const int n = static_cast<int>(2.0 * r) + 2;
-    detail::SurfacePtr ring(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, n, n));
-    cairo_surface_flush(ring.get());
-    unsigned char* data = cairo_image_surface_get_data(ring.get());
-    const int stride = cairo_image_surface_get_stride(ring.get());
-    for (int j = 0; j < n; ++j) {
-      auto* row = reinterpret_cast<std::uint32_t*>(data + j * stride);
-      for (int i = 0; i < n; ++i) {
-        const double dx = i + 0.5 - 0.5 * n, dy = 0.5 * n - (j + 0.5);
-        const double d = std::hypot(dx, dy);
-        // Coverage of a 1-px-wide soft edge on both rims, premultiplied into the colour.
-        const double a =
-            std::clamp(r - d + 0.5, 0.0, 1.0) * std::clamp(d - 0.45 * r + 0.5, 0.0, 1.0);
-        const Rgba c = HueColor(std::atan2(dy, dx));
-        const auto ch = [a](double v) {
-          return static_cast<std::uint32_t>(std::lround(v * a * 255.0));
-        };
-        row[i] = (ch(1.0) << 24) | (ch(c.r) << 16) | (ch(c.g) << 8) | ch(c.b);
-      }
+// Hue wheel (a ring) in world orientation (+x right, +y up), drawn pixel by pixel at the PNG's
+// resolution: sector paths would leave antialiasing seams between sectors.
+void DrawHueWheel(cairo_t* cr, double cx, double cy, double r, double png_scale, double u) {
+  const double s = std::max(1.0, png_scale);
+  const int n = static_cast<int>(std::ceil(2.0 * r * s)) + 2;
+  const double rr = r * s;
+  detail::SurfacePtr ring(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, n, n));
+  cairo_surface_flush(ring.get());
+  unsigned char* data = cairo_image_surface_get_data(ring.get());
+  const int stride = cairo_image_surface_get_stride(ring.get());
+  for (int j = 0; j < n; ++j) {
+    auto* row = reinterpret_cast<std::uint32_t*>(data + j * stride);
+    for (int i = 0; i < n; ++i) {
+      const double dx = i + 0.5 - 0.5 * n, dy = 0.5 * n - (j + 0.5);
+      const double d = std::hypot(dx, dy);
+      // Coverage of a 1-px-wide soft edge on both rims, premultiplied into the colour.
+      const double a =
+          std::clamp(rr - d + 0.5, 0.0, 1.0) * std::clamp(d - 0.45 * rr + 0.5, 0.0, 1.0);
+      const Rgba c = HueColor(std::atan2(dy, dx));
+      const auto ch = [a](double v) {
+        return static_cast<std::uint32_t>(std::lround(v * a * 255.0));
+      };
+      row[i] = (ch(1.0) << 24) | (ch(c.r) << 16) | (ch(c.g) << 8) | ch(c.b);
     }
-    cairo_surface_mark_dirty(ring.get());
-    cairo_set_source_surface(cr, ring.get(), cx - 0.5 * n, cy - 0.5 * n);
-    cairo_paint(cr);
   }
+  cairo_surface_mark_dirty(ring.get());
+  cairo_save(cr);
+  cairo_translate(cr, cx - 0.5 * n / s, cy - 0.5 * n / s);
+  cairo_scale(cr, 1.0 / s, 1.0 / s);
+  cairo_set_source_surface(cr, ring.get(), 0.0, 0.0);
+  cairo_paint(cr);
+  cairo_restore(cr);
   cairo_new_path(cr);
   cairo_arc(cr, cx, cy, r, 0.0, 2.0 * kPi);
   SetColor(cr, colors::kBlack);
-  cairo_set_line_width(cr, 1.0);
+  cairo_set_line_width(cr, 0.5 * u);
   cairo_stroke(cr);
-  const detail::TextStyle lab{.size = fs * 0.85, .h = HAlign::kCenter, .v = VAlign::kMiddle};
-  DrawText(cr, "+x", cx + r + fs * 1.0, cy, lab);
-  DrawText(cr, "\u2212x", cx - r - fs * 1.0, cy, lab);
-  DrawText(cr, "+y", cx, cy - r - fs * 0.7, lab);
-  DrawText(cr, "\u2212y", cx, cy + r + fs * 0.7, lab);
-  double yy = cy + r + fs * 1.3 + fs * 0.2;
-  char buf[96];
-  if (options.cell.coloring == CellColoring::kThreshold)
-    std::snprintf(buf, sizeof buf, "shown if P(dyn) > %g", options.cell.dynamic_threshold);
-  else
-    std::snprintf(buf, sizeof buf, "colours blended by mass");
-  DrawText(cr, buf, x, yy + fs * 0.7, {.size = fs * 0.8, .v = VAlign::kMiddle});
-  yy += fs * 1.4 + fs * 0.8;
-  for (const LegendItem& item : items) {
-    detail::DrawLegendItem(cr, item, x, yy, fs * 0.9);
-    yy += fs * 1.6;
-  }
-  detail::DrawScaleBar(cr, x, yy + fs * 0.6, px_per_m, 120.0, fs * 0.9);
 }
 
-std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
-  std::vector<LegendItem> items = {
-      {"free", colors::kWhite},
-      {"static", colors::kBlack},
-      {"unknown", colors::kUnknown},
-  };
-  const auto any = [&](auto member) {
-    return std::any_of(panels.begin(), panels.end(),
-                       [&](const GridPanel& p) { return !(p.*member).empty(); });
-  };
-  if (any(&GridPanel::truth_boxes))
-    items.push_back({"ground truth", colors::kBlack, Marker::kOutline});
-  if (any(&GridPanel::ego_boxes)) items.push_back({"ego", kEgoOutline, Marker::kOutline});
-  if (any(&GridPanel::particles)) items.push_back({"particle", colors::kBlack, Marker::kDot});
-  return items;
+void DrawLegendBand(cairo_t* cr, const std::vector<GridPanel>& panels,
+                    const GridFigureOptions& options, const Metrics& k, double top) {
+  const std::vector<LegendItem> items = LegendItems(panels);
+  const LegendBand band = BandFor(cr, k, items, options);
+  const double cx = k.pad + 0.5 * band.wheel_w, cy = top + 0.5 * band.wheel_h;
+  DrawHueWheel(cr, cx, cy, k.wheel_r, options.png_scale, k.u);
+  const detail::TextStyle lab{.size = k.sm, .h = HAlign::kCenter, .v = VAlign::kMiddle};
+  const double side = k.wheel_r + 0.5 * detail::TextWidth(cr, "\u2212x", k.sm) + 1.5 * k.u;
+  DrawText(cr, "+x", cx + side, cy, lab);
+  DrawText(cr, "\u2212x", cx - side, cy, lab);
+  DrawText(cr, "+y", cx, cy - k.wheel_r - 0.5 * detail::LineHeight(k.sm), lab);
+  DrawText(cr, "\u2212y", cx, cy + k.wheel_r + 0.5 * detail::LineHeight(k.sm), lab);
+  detail::LayoutLegendRow(cr, items, band.items_x, top, band.items_w, k.sm, true);
+  detail::DrawParagraph(cr, ColoringNote(options), band.items_x, top + band.items_h, band.items_w,
+                        {.size = k.sm});
 }
 
 }  // namespace
@@ -334,65 +413,53 @@ std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
 GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
                                   const GridFigureOptions& options) {
   Validate(panels, options);
-  const Metrics m = MetricsFor(options);
-  GridFigureLayout layout;
-  layout.width = options.image_width;
-  const int n = static_cast<int>(panels.size());
-  int columns = std::min(options.columns, n);
-  if (columns == 0) {
-    const WorldRect e = panels.front().raster.Extent();
-    const double aspect = (e.max.x() - e.min.x()) / std::max(1e-9, e.max.y() - e.min.y());
-    columns = aspect <= 2.5 ? n : 1;
-  }
-  // Side by side, each panel keeps a left margin for its y ticks.
-  const double all_w = options.image_width - m.left - m.right_col;
-  const int map_w = static_cast<int>((all_w - (columns - 1) * m.left) / columns);
-  double y = m.pad + m.fig_title;
-  for (int i = 0; i < n; ++i) {
-    const int col = i % columns;
-    if (col == 0) y += m.panel_title;
-    layout.panels.emplace_back(panels[i].raster.Extent(), map_w,
-                               Vector2(m.left + col * (map_w + m.left), y));
-    if (col == columns - 1 || i == n - 1)
-      y += layout.panels.back().pixel_height() + m.tick_band +
-           (i == n - 1 ? 0.0 : m.x_label * (columns > 1 ? 1.0 : 0.0));
-  }
-  y += m.x_label + m.pad;
-  const double fs = options.font_size;
-  const double legend_h = m.pad + m.fig_title + m.panel_title +
-                          LegendColumnHeight(fs, WheelRadius(fs), LegendItems(panels).size()) +
-                          m.pad;
-  layout.height = static_cast<int>(std::ceil(std::max(y, legend_h)));
-  return layout;
+  detail::Measure m;
+  return Place(m.cr(), panels, options, MetricsFor(m.cr(), options)).layout;
 }
 
 void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& path,
                       const GridFigureOptions& options) {
-  const GridFigureLayout layout = LayoutGridPanels(panels, options);
-  const Metrics m = MetricsFor(options);
-  const double fs = options.font_size;
+  Validate(panels, options);
+  detail::Measure m;
+  const Metrics k = MetricsFor(m.cr(), options);
+  const Placement p = Place(m.cr(), panels, options, k);
+  const GridFigureLayout& layout = p.layout;
   detail::Canvas canvas(layout.width, layout.height);
+  canvas.SetRasterScale(options.png_scale);
   cairo_t* cr = canvas.cr();
-  if (!options.title.empty())
-    DrawText(cr, options.title, 0.5 * layout.width, m.pad + 0.5 * m.fig_title,
-             {.size = fs * 1.3, .bold = true, .h = HAlign::kCenter, .v = VAlign::kMiddle});
-  for (std::size_t i = 0; i < panels.size(); ++i)
-    DrawPanel(cr, panels[i], layout.panels[i], options, m);
-  // The x label under each panel of the last row (the bottom panel when stacked).
+  for (std::size_t i = 0; i < k.title_lines.size(); ++i)
+    DrawText(cr, k.title_lines[i], 0.5 * layout.width, k.pad + i * detail::LineHeight(1.05 * k.fs),
+             {.size = 1.05 * k.fs, .bold = true, .h = HAlign::kCenter, .v = VAlign::kTop});
   const double last_y = layout.panels.back().pixel_offset().y();
+  for (std::size_t i = 0; i < panels.size(); ++i) {
+    const MapTransform& t = layout.panels[i];
+    const int col = static_cast<int>(i) % p.columns;
+    // Shared axes: x labels under the bottom row, y labels left of the first column; x labels
+    // stay clear of the neighbouring panels' and of the image's edge.
+    const double left_room = col == 0 ? t.pixel_offset().x() - k.pad : 0.5 * k.col_gap;
+    const double right_room = col == p.columns - 1 || i + 1 == panels.size()
+                                  ? layout.width - k.pad - t.pixel_offset().x() - t.pixel_width()
+                                  : 0.5 * k.col_gap;
+    DrawPanel(cr, panels[i], t, options, k, t.pixel_offset().y() == last_y, col == 0, left_room,
+              right_room);
+  }
   for (const MapTransform& t : layout.panels) {
     if (t.pixel_offset().y() != last_y) continue;
-    DrawText(cr, options.x_label, t.pixel_offset().x() + 0.5 * t.pixel_width(),
-             t.pixel_offset().y() + t.pixel_height() + m.tick_band + 0.5 * m.x_label,
-             {.size = fs * 0.9, .h = HAlign::kCenter, .v = VAlign::kMiddle});
+    DrawText(cr, options.x_label, t.pixel_offset().x() + 0.5 * t.pixel_width(), p.x_label_y,
+             {.size = k.fs, .h = HAlign::kCenter, .v = VAlign::kTop});
   }
-  // The legend column right of the rightmost panel.
-  const MapTransform* right = &layout.panels.front();
-  for (const MapTransform& t : layout.panels)
-    if (t.pixel_offset().x() > right->pixel_offset().x()) right = &t;
-  const MapTransform& first = *right;
-  DrawLegendColumn(cr, first.pixel_offset().x() + first.pixel_width() + fs * 1.5,
-                   first.pixel_offset().y(), options, LegendItems(panels), first.scale());
+  if (!options.y_label.empty()) {
+    // Centred on the panels' column, left of the tick labels.
+    const MapTransform& first = layout.panels.front();
+    const double top = first.pixel_offset().y();
+    const double bottom =
+        layout.panels.back().pixel_offset().y() + layout.panels.back().pixel_height();
+    DrawText(cr, options.y_label, k.pad + 0.5 * detail::LineHeight(k.fs), 0.5 * (top + bottom),
+             {.size = k.fs, .h = HAlign::kCenter, .v = VAlign::kMiddle, .angle = -0.5 * kPi});
+  }
+  DrawLegendBand(cr, panels, options, k, p.legend_top);
+  detail::DrawParagraph(cr, options.caption, k.pad, p.caption_top, layout.width - 2.0 * k.pad,
+                        {.size = k.sm});
   canvas.Save(path);
 }
 

@@ -1,4 +1,5 @@
-// Bird's-eye map of the scene: lanes, guard rails, vehicles, radar fields of view and detections.
+// Bird's-eye map of the scene: lanes, guard rails, vehicles, radar fields of view and detections,
+// laid out in points at a column width (dualgrid/viz/figure.hpp), with axes in metres.
 #pragma once
 
 #include <memory>
@@ -8,18 +9,30 @@
 
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/viz/color.hpp"
+#include "dualgrid/viz/figure.hpp"
 #include "dualgrid/viz/map_transform.hpp"
 
 namespace dualgrid::viz {
 
 struct BirdsEyeOptions {
-  /// Image width [px]; the map height follows from the world rectangle (equal aspect).
-  int pixel_width = 1600;
-  /// Drawn in a band above the map when not empty.
+  /// Image width [pt] (PNG: times png_scale), axis margin included; the map height follows from
+  /// the world rectangle (equal aspect).
+  int pixel_width = static_cast<int>(kSingleColumn);
+  /// Drawn in a band above the map when not empty (wrapped).
   std::string title;
-  /// Font size [px] of title (x1.3), legend and labels.
-  double font_size = 14.0;
+  /// Base font size [pt] (axis labels; titles 1.05x, ticks, legend, labels and caption 0.9x);
+  /// 0: BaseFontSize(pixel_width), readable at one column.
+  double font_size = 0.0;
+  /// Metre ticks left of and under the map, labelled with the world coordinates (a caller that
+  /// draws relative to the ego passes relative coordinates); without axes a scale bar.
+  bool axes = true;
+  std::string x_label = "x [m]", y_label = "y [m]";
+  /// Wrapped under the legend when not empty: frames of the arrows, meaning of the colours.
+  std::string caption;
+  double png_scale = kPngScale;  ///< PNG pixels per point
   bool IsValid(std::string* error) const;
+  /// font_size, or the automatic one.
+  double BaseFont() const;
 };
 
 /// How vehicles are drawn.
@@ -29,10 +42,18 @@ struct VehicleStyle {
   std::string label;
   /// Ego: green fill, thicker outline, own legend entry.
   bool ego = false;
-  /// Optional ground-truth velocity [m/s] drawn as an arrow of length v * arrow_scale [s].
+  /// Legend entry of the box in its fill colour; empty: "vehicle" (or "ego").
+  std::string legend;
+  /// Optional ground-truth velocity [m/s] drawn as an arrow of length v * arrow_scale [s]; its
+  /// legend entry says "velocity" unless `velocity_legend` says otherwise (a caption says in which
+  /// frame).
   std::optional<Velocity> velocity;
   double arrow_scale = 0.5;
+  std::string velocity_legend;
 };
+
+/// Opacity of a field of view's fill; its outline is opaque, so overlapping wedges stay readable.
+inline constexpr double kSensorFovTint = 0.05;
 
 /// A radar field of view: a wedge from `origin` around `boresight` (world frame).
 struct SensorFov {
@@ -64,16 +85,21 @@ struct DetectionStyle {
   DetectionColoring coloring = DetectionColoring::kBySensor;
   /// Speed mapped to the top of the colour map [m/s] (kBySpeed).
   double max_speed = 40.0;
-  /// Arrow = radial_velocity * arrow_scale [s]; 0 disables arrows.
-  double arrow_scale = 0.2;
-  /// Dot radius [px].
-  double radius_px = 2.5;
+  /// Arrow = radial_velocity * arrow_scale [s] (the same scale as the vehicles' arrows keeps the
+  /// two comparable); 0 disables arrows.
+  double arrow_scale = 0.5;
+  /// Clutter is a small cross without an arrow unless set: its Doppler is noise, and its long
+  /// random arrows would dominate the picture.
+  bool clutter_arrows = false;
+  /// Dot radius [pt at one column width; scaled with the figure].
+  double radius_px = 1.1;
   bool IsValid(std::string* error) const;
 };
 
 /// Immediate-mode map canvas: each Draw call paints onto the map at once (later calls on top);
-/// the title band, legend band (with entries collected from the calls) and scale bar are added by
-/// Save. Image layout, top to bottom: title band (if any), map, legend band.
+/// the title band, axes, legend band (with entries collected from the calls) and caption are
+/// added by Save. Image layout, top to bottom: title band (if any), map with its axes, legend
+/// band, caption.
 class BirdsEyeView {
  public:
   /// Throws std::invalid_argument (naming the field) for a bad rectangle or options.
@@ -84,10 +110,11 @@ class BirdsEyeView {
 
   /// Map-area transform (pixel offset 0: map coordinates).
   const MapTransform& transform() const;
-  /// World point to pixel coordinates of the saved image (the map is shifted by the title band).
+  /// World point to coordinates of the saved image [pt] (the map is shifted by the title band and
+  /// the axis margin; PNG pixels: times png_scale).
   Vector2 ToImagePixel(const Position& world) const;
   int image_width() const;
-  /// Height of the image Save would write now (depends on the legend entries so far).
+  /// Height of the image Save would write now [pt] (depends on the legend entries so far).
   int image_height() const;
 
   /// A lane centre line with its width [m]: light grey band with a darker edge.

@@ -1,4 +1,5 @@
-// Dynamic occupancy grid pictures (paper Fig. 7): one panel per filter mode, stacked vertically.
+// Dynamic occupancy grid pictures (paper Fig. 7): one panel per filter mode, stacked or side by
+// side, laid out in points at a column width (dualgrid/viz/figure.hpp).
 #pragma once
 
 #include <string>
@@ -6,6 +7,7 @@
 
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/viz/color.hpp"
+#include "dualgrid/viz/figure.hpp"
 #include "dualgrid/viz/map_transform.hpp"
 
 namespace dualgrid::viz {
@@ -54,17 +56,25 @@ struct GridPanel {
 };
 
 struct GridFigureOptions {
-  /// Whole image width [px]: left axis margin + map + right legend column.
-  int image_width = 1600;
+  /// Whole image width [pt] (PNG: times png_scale): left axis margin + panels; the legend band
+  /// and caption go underneath.
+  int image_width = static_cast<int>(kSingleColumn);
   std::string title;  ///< figure title above all panels when not empty
+  /// Wrapped under the legend when not empty: what the colours, outlines and axes mean.
+  std::string caption;
   CellColorOptions cell;
-  double font_size = 14.0;
+  /// Base font size [pt]; 0: BaseFontSize(image_width), readable at one column (the smallest
+  /// text is 0.9 of it).
+  double font_size = 0.0;
   /// Axis labels (the frame and origin of the rasters' coordinates, e.g. relative to the ego).
   std::string x_label = "x [m]", y_label = "y [m]";
   /// Panels per row: 0 = automatic (side by side when a panel is at most 2.5 times as wide as
   /// high, e.g. a square grid; stacked for the paper's 8:1 road grid), else 1..panels.
   int columns = 0;
+  double png_scale = kPngScale;  ///< PNG pixels per point
   bool IsValid(std::string* error) const;
+  /// font_size, or the automatic one.
+  double BaseFont() const;
 };
 
 /// Where each panel's map lands in the image (exposed so callers and tests can locate cells).
@@ -79,8 +89,9 @@ GridFigureLayout LayoutGridPanels(const std::vector<GridPanel>& panels,
                                   const GridFigureOptions& options = {});
 
 /// Renders the panels stacked or side by side (options.columns), each with its title and axes in
-/// metres, plus a legend
-/// column (hue wheel for the direction of motion, free/static/unknown swatches, scale bar).
+/// metres (stacked panels share the x labels, side by side ones the y labels), then a legend band
+/// (hue wheel for the direction of motion, free/static/unknown swatches, outlines) and the
+/// caption.
 /// Throws std::invalid_argument for bad input, std::runtime_error if the PNG cannot be written.
 /// `path` ends in .png, .svg or .pdf (the cells are an embedded raster in SVG and PDF).
 void RenderGridPanels(const std::vector<GridPanel>& panels, const std::string& path,
