@@ -1,8 +1,10 @@
 // Runs the dualgrid program as a user would and checks its output and errors.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -16,6 +18,27 @@ using namespace dualgrid::testing;
 namespace {
 
 fs::path TempDir(const std::string& name) { return dualgrid::testing::TempDir("cli", name); }
+
+// A path of cairo's SVG: its style attribute and its points (M/L coordinates only).
+struct SvgPath {
+  std::string style;
+  std::vector<std::pair<double, double>> points;
+};
+
+std::vector<SvgPath> SvgPaths(const std::string& svg) {
+  std::vector<SvgPath> out;
+  const std::regex path(R"re(<path style="([^"]*)" d="([^"]*)")re");
+  const std::regex point(R"re([ML] (-?[0-9.]+) (-?[0-9.]+))re");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), path); it != std::sregex_iterator();
+       ++it) {
+    SvgPath p{(*it)[1], {}};
+    const std::string d = (*it)[2];
+    for (auto q = std::sregex_iterator(d.begin(), d.end(), point); q != std::sregex_iterator(); ++q)
+      p.points.emplace_back(std::stod((*q)[1]), std::stod((*q)[2]));
+    out.push_back(std::move(p));
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -78,6 +101,42 @@ TEST_CASE("snapshot writes the format its --out names", "[cli]") {
     const std::string text = Slurp(dir / name);
     CHECK(text.rfind(std::string(name) == "hw.svg" ? "<?xml" : "%PDF-", 0) == 0);
   }
+  // Every arrow is motion over ground (docs/output.md): the ego's own velocity arrow starts at its
+  // centre and points east along the road, and every vehicle's arrow (black, 0.7 pt) is at least
+  // 2.5 ego lengths long (all drive 25-35 m/s, 0.5 s of motion). Arrows of the velocity relative
+  // to the ego would give the ego none and the truck alongside a stub.
+  const std::vector<SvgPath> paths = SvgPaths(Slurp(dir / "hw.svg"));
+  const auto ego = std::find_if(paths.begin(), paths.end(), [](const SvgPath& p) {
+    return p.style.find("fill:rgb(30%,78%,30%)") != std::string::npos && p.points.size() >= 4;
+  });
+  REQUIRE(ego != paths.end());
+  double cx = 0.0, cy = 0.0, length = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    cx += 0.25 * ego->points[i].first;
+    cy += 0.25 * ego->points[i].second;
+    const auto& [x1, y1] = ego->points[(i + 1) % 4];
+    length = std::max(length, std::hypot(x1 - ego->points[i].first, y1 - ego->points[i].second));
+  }
+  int arrows = 0, ego_arrows = 0;
+  for (const SvgPath& p : paths) {
+    if (p.style.find("stroke-width:0.7;") == std::string::npos ||
+        p.style.find("stroke:rgb(0%,0%,0%)") == std::string::npos || p.points.size() != 2)
+      continue;
+    ++arrows;
+    const auto [x0, y0] = p.points[0];
+    const auto [x1, y1] = p.points[1];
+    INFO("arrow from (" << x0 << ", " << y0 << ") to (" << x1 << ", " << y1 << "), ego length "
+                        << length);
+    CHECK(std::hypot(x1 - x0, y1 - y0) > 2.5 * length);
+    if (std::hypot(x0 - cx, y0 - cy) < 0.1 * length) {
+      ++ego_arrows;
+      CHECK(x1 - x0 > 2.5 * length);
+      CHECK(std::abs(y1 - y0) < 0.1 * length);
+    }
+  }
+  CHECK(ego_arrows == 1);
+  CHECK(arrows >= 3);  // the ego, the truck alongside and the car overtaking on the right
+
   const Result bad =
       Run("snapshot scenarios/highway.yaml --time 3 -q --out " + (dir / "hw.jpg").string());
   CHECK(bad.code != 0);
@@ -240,4 +299,91 @@ TEST_CASE("Runs that cannot produce a frame are errors, not empty results", "[cl
   r = Run("snapshot scenarios/simple_road.yaml --time 0.01 -q --out " + (dir / "x.png").string());
   CHECK(r.code != 0);
   CHECK(CountLines(r.output) == 1);
+}
+
+namespace {
+
+std::vector<nlohmann::json> AuditRecords(const fs::path& file) {
+  std::vector<nlohmann::json> out;
+  std::istringstream in(Slurp(file));
+  for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+// The figure's texts joined by spaces: a phrase of a caption that wrapped is found too.
+bool HasText(const nlohmann::json& record, const std::string& part) {
+  std::string all;
+  for (const auto& s : record.at("strings")) all += s.get<std::string>() + " ";
+  return all.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+// Issue 15: every figure the program draws is readable at one column (smallest font / width >=
+// 7 pt / 3.5 in), its PNG is 300 dpi, and it says what it shows: axes relative to the ego,
+// frames of the arrows, what the colours and whiskers mean. The figures report themselves
+// through DUALGRID_FIGURE_AUDIT (docs/output.md).
+TEST_CASE("Every figure a user gets is readable at one column and says what it shows",
+          "[cli][figures]") {
+  const auto dir = TempDir("figure_audit");
+  const auto audit = dir / "audit.jsonl";
+  const std::string env =
+      "DUALGRID_FIGURE_AUDIT=" + audit.string() + " " + std::string(DUALGRID_EXE) + " ";
+  Result r = Shell(env +
+                   "experiment scenarios/highway.yaml --seeds 2 --duration 2 --snapshots 1 "
+                   "-q --out " +
+                   (dir / "exp").string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  r = Shell(env + "snapshot scenarios/simple_road.yaml --time 2 -q --out " +
+            (dir / "snap.pdf").string());
+  REQUIRE(r.code == 0);
+  r = Shell(env +
+            "sweep tangential --set tangential.sensor=front --set tangential.angle=0:90:90 "
+            "--set tangential.count=1 --seeds 2 --duration 8 -j 2 -q --out " +
+            (dir / "sweep").string());
+  REQUIRE(r.code == 0);
+
+  std::map<std::string, std::vector<nlohmann::json>> kinds;
+  for (const nlohmann::json& rec : AuditRecords(audit)) {
+    const fs::path path = rec.at("path").get<std::string>();
+    const std::string name = path.filename().string();
+    INFO(name << ": smallest text " << rec.at("min_font") << " of " << rec.at("width"));
+    CHECK(rec.at("texts").get<int>() > 5);
+    CHECK(rec.at("min_font").get<double>() / rec.at("width").get<double>() >= 7.0 / 252.0);
+    if (path.extension() == ".png") CHECK(rec.at("png_scale").get<double>() == Approx(300.0 / 72));
+    std::string kind = name.substr(0, name.find('.'));
+    if (kind.rfind("grid_t", 0) == 0) kind = "grid";
+    if (kind.rfind("scene_t", 0) == 0) kind = "scene";
+    if (path.parent_path().parent_path().filename() == "sweep") kind = "sweep";
+    if (path.parent_path().parent_path().filename() == "exp") kind = "experiment_" + kind;
+    kinds[kind].push_back(rec);
+  }
+  // Every kind is there, in its three formats (the snapshot in the one it was asked for).
+  for (const char* kind : {"grid", "scene", "weights", "tracked_share", "tracked_share_v",
+                           "experiment_tracked_share", "experiment_tracked_share_v"}) {
+    INFO(kind);
+    CHECK(kinds[kind].size() == 3);
+  }
+  CHECK(kinds["snap"].size() == 1);
+  CHECK(kinds["sweep"].size() >= 15);  // five metrics, png + svg + pdf
+  const auto all = [&](const std::string& kind, const std::string& text) {
+    INFO(kind << " says '" << text << "'");
+    REQUIRE_FALSE(kinds[kind].empty());
+    for (const auto& rec : kinds[kind]) CHECK(HasText(rec, text));
+  };
+  for (const char* kind : {"scene", "snap"}) {
+    for (const char* text : {"x from the ego [m]", "motion over ground", "front_left", "rear_right",
+                             "velocity (0.5 s)", "radial velocity (0.5 s)", "Colour: the radar"})
+      all(kind, text);
+  }
+  for (const char* text : {"position", "velocity", "dual", "x from the ego [m]", "over ground",
+                           "white free, black static, grey unknown"})
+    all("grid", text);
+  for (const char* text : {"w_position", "w_velocity", "alongside_truck", "radial likelihood"})
+    all("weights", text);
+  all("tracked_share_v", "One run: no confidence interval");
+  all("experiment_tracked_share", "whiskers: 95 % confidence interval");
+  all("experiment_tracked_share_v", "alongside_truck");
+  all("sweep", "error bars: 95 % confidence interval");
 }

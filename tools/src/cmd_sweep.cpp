@@ -385,7 +385,7 @@ int RunCollect(const CollectOptions& o) {
   WriteTextFile(out / "sweep.json", summary.dump(2) + "\n");
 
   // Figures: each metric against the first numeric axis with several values, one line per mode
-  // (mean) with dashed mean +- CI; one figure per combination of the other axes.
+  // (mean) with 95 % CI error bars; one figure per combination of the other axes.
   std::vector<std::string> warnings;
   const auto axes = plan.at("axes");
   int xaxis = -1;
@@ -418,30 +418,24 @@ int RunCollect(const CollectOptions& o) {
                       (others.empty() ? "" : " (" + others + ")");
         chart.x_label = keys[xaxis];
         chart.y_label = metric;
+        chart.caption =
+            "Points: mean over the seeds of each setting; error bars: 95 % confidence interval "
+            "of the mean (Student t), none with one seed. Colour: the filter's weight mode.";
         bool any = false;
         for (const char* mode : {"position", "velocity", "dual"}) {
-          viz::LineSeries mean{mode, {}, {}}, lo{std::string(mode) + " 95 % CI", {}, {}},
-              hi{"", {}, {}};
-          lo.dashed = hi.dashed = true;
-          lo.line_width = hi.line_width = 1.0;
-          if (const auto c = viz::ModeFromName(mode)) lo.color = hi.color = viz::ModeColor(*c);
+          viz::LineSeries mean;
+          mean.name = mode;
           for (const auto& sid : ids) {
             const auto it = samples.find({sid, mode, metric});
             if (it == samples.end()) continue;
             const eval::Summary s = eval::Summarize(it->second);
-            const double x = std::stod(setting_of.at(sid).at("values")[xaxis].get<std::string>());
-            mean.x.push_back(x);
+            mean.x.push_back(std::stod(setting_of.at(sid).at("values")[xaxis].get<std::string>()));
             mean.y.push_back(s.mean);
-            lo.x.push_back(x);
-            hi.x.push_back(x);
-            lo.y.push_back(s.mean - s.half_width.value_or(0.0));
-            hi.y.push_back(s.mean + s.half_width.value_or(0.0));
+            mean.errors.push_back(s.half_width.value_or(std::nan("")));
           }
           if (mean.x.empty()) continue;
           any = true;
-          chart.series.push_back(mean);
-          chart.series.push_back(lo);
-          chart.series.push_back(hi);
+          chart.series.push_back(std::move(mean));
         }
         if (!any) continue;
         std::string name =

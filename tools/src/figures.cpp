@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include "dualgrid/viz/birds_eye_view.hpp"
 #include "dualgrid/viz/charts.hpp"
@@ -30,11 +31,16 @@ bool TryFigure(const std::filesystem::path& path, const std::function<void()>& d
 
 namespace {
 
-// " (grid frame: x along 152 deg)" when the picture is turned from the world, else "".
-std::string FrameNote(const GridFrame& g) {
-  if (g.identity()) return "";
-  return "  (grid frame: x axis at " + Fixed(RadToDeg(g.yaw()), 0) + " deg from world east)";
+// The caption's sentence on the axes of a picture in the grid frame, relative to the ego.
+std::string AxesNote(const GridFrame& g) {
+  return "Axes: metres from the ego along the grid frame's axes (" +
+         (g.identity() ? std::string("here world east and north")
+                       : "x axis at " + Fixed(RadToDeg(g.yaw()), 0) + " deg from world east") +
+         ").";
 }
+
+// One arrow length for vehicles and detections: the two kinds of arrow compare directly.
+constexpr double kArrowSeconds = 0.5;
 
 }  // namespace
 
@@ -56,50 +62,67 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
                  double ahead, double half_width) {
   const sim::Frame& f = pipeline.frame();
   const GridFrame& g = pipeline.grid_frame();
-  const Position c = g.ToGrid(f.ego.box.center);
+  // Drawn relative to the ego in the grid frame, like the grid figures: the axes read as metres
+  // from the ego.
+  const Position ego = g.ToGrid(f.ego.box.center);
+  const auto rel = [&](const Position& p) { return Position(g.ToGrid(p) - ego); };
+  const auto rel_box = [&](OrientedBox b) {
+    b = g.ToGrid(b);
+    b.center -= ego;
+    return b;
+  };
   viz::BirdsEyeOptions options;
-  options.title = pipeline.config().sim.name + "  t = " + Fixed(f.time, 2) + " s  (" +
-                  std::to_string(pipeline.detections().size()) + " detections)" + FrameNote(g);
-  viz::BirdsEyeView view({c + Position(-behind, -half_width), c + Position(ahead, half_width)},
-                         options);
-  auto to_grid = [&](std::vector<Position> points) {
-    for (Position& p : points) p = g.ToGrid(p);
+  options.title = pipeline.config().sim.name + ", t = " + Fixed(f.time, 2) + " s: radar view (" +
+                  std::to_string(pipeline.detections().size()) + " detections)";
+  options.x_label = "x from the ego [m]";
+  options.y_label = "y [m]";
+  options.caption =
+      AxesNote(g) + " Arrows: motion over ground in " + Fixed(kArrowSeconds, 1) +
+      " s; black: a vehicle's velocity (SUMO); coloured: a detection's radial velocity, ego "
+      "motion compensated (short where a vehicle moves across the line of sight). Colour: the "
+      "radar (field of view outline, its detections).";
+  viz::BirdsEyeView view({Position(-behind, -half_width), Position(ahead, half_width)}, options);
+  auto to_rel = [&](std::vector<Position> points) {
+    for (Position& p : points) p = rel(p);
     return points;
   };
   for (const auto& lane : pipeline.simulation().LaneShapes())
-    view.DrawLane(to_grid(lane.points), lane.width);
+    view.DrawLane(to_rel(lane.points), lane.width);
   for (const auto& rail : pipeline.config().sim.guard_rails)
-    view.DrawGuardRail(to_grid(rail.points));
+    view.DrawGuardRail(to_rel(rail.points));
   for (const auto& p : pipeline.config().sim.parked) {
     viz::VehicleStyle style;
     style.fill = viz::colors::kGuardRail;
     style.label = p.id;
-    view.DrawVehicle(g.ToGrid(p.box), style);
+    style.legend = "parked";
+    view.DrawVehicle(rel_box(p.box), style);
   }
   const auto& radar = pipeline.radar();
   const auto poses = radar.SensorPoses(pipeline.ego_motion().pose);
   for (std::size_t s = 0; s < poses.size(); ++s) {
     const auto& p = radar.sensors()[s];
-    view.DrawSensorFov({g.ToGrid(poses[s].position), g.YawToGrid(poses[s].yaw), 0.5 * p.fov,
-                        p.max_range, static_cast<int>(s), p.name});
+    view.DrawSensorFov({rel(poses[s].position), g.YawToGrid(poses[s].yaw), 0.5 * p.fov, p.max_range,
+                        static_cast<int>(s), p.name});
   }
   for (const auto& v : f.vehicles) {
     viz::VehicleStyle style;
     style.label = v.id;
-    // Relative motion reads better at speed.
-    style.velocity = g.VectorToGrid(v.velocity - f.ego.velocity);
-    view.DrawVehicle(g.ToGrid(v.box), style);
+    style.velocity = g.VectorToGrid(v.velocity);  // over ground, as the detections' arrows
+    style.arrow_scale = kArrowSeconds;
+    view.DrawVehicle(rel_box(v.box), style);
   }
-  viz::VehicleStyle ego_style;
+  viz::VehicleStyle ego_style;  // no label: the green box at the axes' origin
   ego_style.ego = true;
-  ego_style.label = "ego";
-  view.DrawVehicle(g.ToGrid(f.ego.box), ego_style);
+  ego_style.velocity = g.VectorToGrid(f.ego.velocity);
+  ego_style.arrow_scale = kArrowSeconds;
+  view.DrawVehicle(rel_box(f.ego.box), ego_style);
   std::vector<viz::DetectionMark> marks;
   for (const auto& d : pipeline.detections())
-    marks.push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world), d.sensor,
-                     d.is_clutter});
+    marks.push_back(
+        {rel(d.position_world), g.VectorToGrid(d.radial_velocity_world), d.sensor, d.is_clutter});
   viz::DetectionStyle style;
-  style.coloring = viz::DetectionColoring::kBySpeed;
+  style.coloring = viz::DetectionColoring::kBySensor;
+  style.arrow_scale = kArrowSeconds;
   view.DrawDetections(marks, style);
   view.Save(path.string());
 }
@@ -134,11 +157,15 @@ void RenderGridFigure(const std::vector<std::string>& modes,
     panels.push_back(std::move(panel));
   }
   viz::GridFigureOptions options;
-  options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the title)
+  options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the caption)
   options.y_label = "y [m]";
-  options.title = "Dynamic grid at t = " + Fixed(time, 2) +
-                  " s: hue = direction of motion, white free, black static, grey unknown" +
-                  FrameNote(g);
+  options.title = "Dynamic grids at t = " + Fixed(time, 2) + " s";
+  options.caption =
+      "Cells: white free, black static, grey unknown; dynamic mass in the hue of its direction "
+      "of motion over ground (the cell's mean particle velocity, grid frame: wheel), colours "
+      "blended by the cell's masses. Black outlines: ground-truth vehicle boxes (SUMO); green: "
+      "the ego. " +
+      AxesNote(g);
   viz::RenderGridPanels(panels, path.string(), options);
 }
 
@@ -162,13 +189,22 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
                          const std::filesystem::path& path, const TrackedShares& errors) {
   viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
-  chart.x_label = "object";
+  chart.x_label = "object (SUMO vehicle id)";
   chart.y_label = y_label;
   chart.percent = true;
-  chart.value_labels = shares.size() <= 12;
-  // 60 px per bar up to a 4000 px wide image; beyond that the bars narrow (to 1 px) and the
-  // object names are thinned out.
-  chart.width = std::clamp(60 * static_cast<int>(shares.size() * modes.size()) + 200, 1000, 4000);
+  // One column wide whatever the number of objects: a wider chart would need larger fonts
+  // (readability at one column) and show no more. Names turn, then thin out; value labels only
+  // where they fit their bars.
+  const bool velocity_aware = y_label.find("D_v") != std::string::npos;
+  chart.caption =
+      std::string("Bar colour: the filter's weight mode. ") +
+      (velocity_aware ? "D_v: share of an object's frames in the grid in which a cluster with the "
+                        "right velocity sits on it. "
+                      : "D: share of an object's frames in the grid in which a cluster sits on "
+                        "it. ") +
+      (errors.empty() ? "One run: no confidence interval."
+                      : "Bars: mean over the seeds; whiskers: 95 % confidence interval of the "
+                        "mean (Student t), none where fewer than two seeds scored the object.");
   for (const auto& [name, row] : shares) chart.categories.push_back(name);
   for (std::size_t m = 0; m < modes.size(); ++m) {
     viz::BarSeries s;
@@ -183,25 +219,42 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
                        const std::filesystem::path& path) {
   viz::LineChart chart;
-  chart.title = "Weights on " + object + " (" + mode + " filter): share held by particles within " +
-                Fixed(WeightTrace::kGoodVelocity, 0) + " m/s of its true velocity";
-  chart.y_label = "share of the weight";
+  chart.title = "Weights on " + object + " (" + mode + " filter, paper Fig. 4)";
+  chart.y_label = "share within " + Fixed(WeightTrace::kGoodVelocity, 0) + " m/s";
   chart.y_min = 0.0;
   chart.y_max = 1.0;
-  chart.series.push_back(
-      {"w_position", trace.time, trace.position_share, viz::ModeColor(viz::Mode::kPosition)});
-  chart.series.push_back(
-      {"w_velocity", trace.time, trace.velocity_share, viz::ModeColor(viz::Mode::kVelocity)});
+  // Not the paper's Fig. 4 quantity (one particle's weights): readers compare the two, so the
+  // caption says what is plotted and why w_velocity sits above w_position by default.
+  chart.caption =
+      "Share of each weight on " + object + " held by its particles within " +
+      Fixed(WeightTrace::kGoodVelocity, 0) +
+      " m/s of its true velocity. w_position scores positions only; w_velocity also scores the "
+      "Doppler. With the radial likelihood (dualgrid preset, the default) a particle with the "
+      "true velocity always matches the radial speed, even across the line of sight, so "
+      "w_velocity's share sits at or above w_position's. The paper's Fig. 4 (w_velocity drops "
+      "while the Doppler is below the speed) is eq. (8) in its vector form (paper preset), "
+      "which compares the whole velocity with the radial one: there w_velocity's share can "
+      "fall near 0.";
+  for (const bool v : {false, true}) {
+    viz::LineSeries s;
+    s.name = v ? "w_velocity" : "w_position";
+    s.x = trace.time;
+    s.y = v ? trace.velocity_share : trace.position_share;
+    s.color = viz::ModeColor(v ? viz::Mode::kVelocity : viz::Mode::kPosition);
+    chart.series.push_back(std::move(s));
+  }
   // Shade where most detections see less than half of the object's speed (tangential motion).
   std::optional<double> start;
   for (std::size_t i = 0; i <= trace.time.size(); ++i) {
     const bool low = i < trace.time.size() && trace.tangential_share[i] > 0.5;
     if (low && !start) start = trace.time[i];
     if (!low && start) {
-      chart.spans.push_back({*start, trace.time[i - 1], "most Doppler < 50 % of speed"});
+      chart.spans.push_back({*start, trace.time[i - 1], "Doppler < speed / 2"});
       start.reset();
     }
   }
+  if (!chart.spans.empty())
+    chart.caption += " Shaded: most of the object's detections see less than half its speed.";
   viz::RenderLineChart(chart, path.string());
 }
 
