@@ -280,8 +280,10 @@ void BirdsEyeView::DrawVehicle(const OrientedBox& box, const VehicleStyle& style
                                  std::max(0.5 * w, t.pixel_width() - 0.5 * w));
     const Impl::Box above{cx - 0.5 * w, top - 0.8 * u - h, cx + 0.5 * w, top - 0.8 * u};
     const Impl::Box below{cx - 0.5 * w, bottom + 0.8 * u, cx + 0.5 * w, bottom + 0.8 * u + h};
+    // Free: inside the map and clear of the labels placed so far.
     const auto free = [&](const Impl::Box& b) {
-      return std::none_of(impl_->labels.begin(), impl_->labels.end(),
+      return b.y0 >= 0.0 && b.y1 <= t.pixel_height() &&
+             std::none_of(impl_->labels.begin(), impl_->labels.end(),
                           [&](const Impl::Box& o) { return o.Overlaps(b); });
     };
     const Impl::Box at = free(above) || !free(below) ? above : below;

@@ -30,7 +30,7 @@ double WidestLabel(cairo_t* m, const std::vector<std::string>& labels, double si
 
 ChartFrame LayoutChartFrame(cairo_t* m, const ChartText& text, int width, int height,
                             double y_tick_width, const std::function<double(double)>& x_tick_height,
-                            double headroom) {
+                            const std::function<double()>& headroom) {
   ChartFrame f;
   f.u = width / kSingleColumn;
   f.base = BaseFontSize(width);
@@ -63,9 +63,9 @@ ChartFrame LayoutChartFrame(cairo_t* m, const ChartText& text, int width, int he
   f.legend_top = f.pad + title_h + (title_h > 0.0 ? gap : 0.0);
   const double row_w = LegendRowWidth(m, text.legend, f.small);
   f.legend_x = row_w <= a.width ? a.left + a.width - row_w : a.left;
-  a.top = f.legend_top + legend_h + (legend_h > 0.0 ? gap : 0.0) + headroom;
-
   const double x_ticks_h = x_tick_height(a.width);
+  a.top = f.legend_top + legend_h + (legend_h > 0.0 ? gap : 0.0) + headroom();
+
   const double x_label_h = text.x_label.empty() ? 0.0 : f.u + LineHeight(f.base);
   f.x_ticks_top = a.top + a.height + f.tick_length + f.label_gap;
   f.x_label_top = f.x_ticks_top + x_ticks_h + f.u;

@@ -33,10 +33,11 @@ struct ChartFrame {
 
 /// Lays the frame out around a plot whose y tick labels are `y_tick_width` wide;
 /// `x_tick_height(plot_width)` says how tall the x tick labels are (it may choose them from the
-/// plot's width); `headroom` is extra space above the plot (value labels over full bars).
+/// plot's width); `headroom()`, asked after it, is extra space above the plot (value labels over
+/// full bars, when they are drawn).
 ChartFrame LayoutChartFrame(cairo_t* m, const ChartText& text, int width, int height,
                             double y_tick_width, const std::function<double(double)>& x_tick_height,
-                            double headroom);
+                            const std::function<double()>& headroom);
 
 double WidestLabel(cairo_t* m, const std::vector<std::string>& labels, double size);
 

@@ -153,7 +153,7 @@ BarGeometry BarLayout(cairo_t* m, const BarChart& chart) {
         g.value_labels = labels_fit(plot_width);
         return g.categories.height;
       },
-      chart.value_labels ? detail::LineHeight(sm) : 0.0);
+      [&] { return g.value_labels ? detail::LineHeight(sm) : 0.0; });
   return g;
 }
 
@@ -164,7 +164,7 @@ PlotArea ChartPlotArea(int width, int height) {
   cairo_t* m = cairo_create(s);
   const ChartFrame f = detail::LayoutChartFrame(
       m, {}, width, height, detail::TextWidth(m, "100%", SmallFontSize(width)),
-      [&](double) { return detail::LineHeight(SmallFontSize(width)); }, 0.0);
+      [&](double) { return detail::LineHeight(SmallFontSize(width)); }, [] { return 0.0; });
   cairo_destroy(m);
   cairo_surface_destroy(s);
   return f.layout.plot;
@@ -382,7 +382,7 @@ LineGeometry LineLayout(cairo_t* m, const LineChart& chart) {
             detail::NiceTicks(x_lo, x_hi, std::max(2, static_cast<int>(plot_width / (5.0 * sm))));
         return detail::LineHeight(sm);
       },
-      0.0);
+      [] { return 0.0; });
   return g;
 }
 

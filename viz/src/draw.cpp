@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <stdexcept>
 
 #include "dualgrid/core/types.hpp"
@@ -385,25 +386,25 @@ std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double s
   while (start <= text.size()) {
     const std::size_t nl = text.find('\n', start);
     const std::string para = text.substr(start, nl == std::string::npos ? nl : nl - start);
-    std::string line, word;
-    const auto flush_word = [&] {
-      if (word.empty()) return;
-      const std::string candidate = line.empty() ? word : line + " " + word;
+    // Words split at spaces; a "%" stays with its number ("95 %" is never broken).
+    std::vector<std::string> words;
+    std::istringstream in(para);
+    for (std::string w; in >> w;) {
+      if (w.front() == '%' && !words.empty())
+        words.back() += " " + w;
+      else
+        words.push_back(w);
+    }
+    std::string line;
+    for (const std::string& w : words) {
+      const std::string candidate = line.empty() ? w : line + " " + w;
       if (!line.empty() && TextWidth(cr, candidate, size, bold) > max_width) {
         lines.push_back(line);
-        line = word;
+        line = w;
       } else {
         line = candidate;
       }
-      word.clear();
-    };
-    for (const char c : para) {
-      if (c == ' ')
-        flush_word();
-      else
-        word += c;
     }
-    flush_word();
     lines.push_back(line);
     if (nl == std::string::npos) break;
     start = nl + 1;

@@ -131,7 +131,7 @@ void DrawArrow(cairo_t* cr, double x0, double y0, double x1, double y1, double l
 void DrawCross(cairo_t* cr, double x, double y, double half, double line_width);
 
 /// `text` split at spaces into lines at most `max_width` wide at `size` (a longer word has a line
-/// of its own); "\n" forces a break.
+/// of its own, a "%" stays with the word before it); "\n" forces a break.
 std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double size,
                                   double max_width, bool bold = false);
 /// Line advance of wrapped text: 1.25 x size.
