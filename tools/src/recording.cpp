@@ -242,6 +242,15 @@ std::vector<std::uint8_t> Reader::Compressed(std::size_t i) const {
 }
 
 Frame Reader::Load(std::size_t i) const {
+  try {
+    return LoadFrame(i);
+  } catch (const json::exception& e) {
+    throw std::invalid_argument((dir_ / "index.json").string() + ": frames[" + std::to_string(i) +
+                                "]: " + e.what());
+  }
+}
+
+Frame Reader::LoadFrame(std::size_t i) const {
   const std::string where = (dir_ / "index.json").string() + ": frames[" + std::to_string(i) + "]";
   const json& j = index_["frames"].at(i);
   const Header& h = header_;

@@ -132,6 +132,8 @@ class Reader {
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
+  Frame LoadFrame(std::size_t i) const;
+
   std::filesystem::path dir_;
   nlohmann::json index_;
   Header header_;

@@ -110,12 +110,16 @@ class FfmpegPipe {
     close(fds[0]);
     fd_ = fds[1];
   }
-  ~FfmpegPipe() {
+  ~FfmpegPipe() { Kill(); }
+  /// Stops ffmpeg without waiting for its output (on an error).
+  void Kill() {
     if (fd_ >= 0) close(fd_);
+    fd_ = -1;
     if (pid_ > 0) {
       kill(pid_, SIGTERM);
       waitpid(pid_, nullptr, 0);
     }
+    pid_ = -1;
   }
   /// False when ffmpeg stopped reading (it failed; see Close()).
   bool Write(const std::uint8_t* data, std::size_t n) {
@@ -292,14 +296,20 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   Progress progress("replay video " + out.filename().string(), static_cast<int>(last - first),
                     !o.quiet);
   const std::size_t bytes = static_cast<std::size_t>(renderer.width()) * renderer.height() * 4;
-  for (std::size_t i = first; i < last; ++i) {
-    const replay::Frame f = i == first ? first_frame : reader.Load(i);
-    const std::uint8_t* raster = renderer.Render(ToPicture(reader, f, modes, o));
-    if (!pipe.Write(raster, bytes)) break;  // ffmpeg stopped: Close() reports why
-    progress.Update(static_cast<int>(i - first + 1), "t=" + Fixed(f.time, 1) + " s");
+  try {
+    for (std::size_t i = first; i < last; ++i) {
+      const replay::Frame f = i == first ? first_frame : reader.Load(i);
+      const std::uint8_t* raster = renderer.Render(ToPicture(reader, f, modes, o));
+      if (!pipe.Write(raster, bytes)) break;  // ffmpeg stopped: Close() reports why
+      progress.Update(static_cast<int>(i - first + 1), "t=" + Fixed(f.time, 1) + " s");
+    }
+    progress.Finish();
+    pipe.Close();
+  } catch (...) {
+    pipe.Kill();
+    fs::remove(part);  // a video that did not finish must not stay behind looking like one
+    throw;
   }
-  progress.Finish();
-  pipe.Close();
   fs::rename(part, out);
 
   if (o.preview != "none") {
@@ -318,7 +328,13 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
       args.insert(args.end(), {"-vf", "setpts=PTS/4,fps=8,scale=480:-2", "-c:v", "libvpx-vp9",
                                "-b:v", "0", "-crf", "40", "-deadline", "realtime", "-f", "webm"});
     args.push_back(preview_part.string());
-    RunFfmpeg(args, log);
+    try {
+      RunFfmpeg(args, log);
+    } catch (const std::exception& e) {
+      fs::remove(preview_part);
+      throw std::runtime_error(std::string(e.what()) + " (the video itself, " + out.string() +
+                               ", is complete)");
+    }
     fs::rename(preview_part, preview);
   }
   fs::remove(log);
