@@ -822,6 +822,17 @@ TEST_CASE("bar charts turn category names that do not fit, and wrap long caption
   // Turned names need more room under the plot than level ones: the figure grows.
   CHECK(LayoutBarChart(chart).height > chart.height + 20.0);
   CHECK(r.MinFontRatio() >= kMinFontRatio);
+  // A word longer than a line (a sweep's key=value identifiers) breaks after its '_', '.' or '='
+  // instead of running off the figure.
+  chart.title = "D_v vs angle (tangential.sensor=front_left_filter.preset=dualgrid_filter."
+                "num_particles=30000_filter.velocity_likelihood=radial)";
+  RenderBarChart(chart, path.string());
+  REQUIRE(audit.records().size() == 2);
+  const auto& lines = audit.records()[1].strings;
+  const int broken = static_cast<int>(std::count_if(lines.begin(), lines.end(), [](const auto& l) {
+    return !l.empty() && std::string("_.=").find(l.back()) != std::string::npos;
+  }));
+  CHECK(broken >= 1);
 }
 
 // The readability rule of issue 15: scaled to one column (3.5 in), every figure's smallest text

@@ -35,6 +35,14 @@ namespace fs = std::filesystem;
 constexpr const char* kGenerator = "tangential";
 constexpr const char* kMetrics[] = {"D", "D_v", "delta_x", "delta_v", "t_d"};
 
+// The unit of a metric of the tables (docs/output.md).
+std::string MetricUnit(const std::string& metric) {
+  if (metric == "D" || metric == "D_v") return "%";
+  if (metric == "delta_x") return "m";
+  if (metric == "delta_v") return "m/s";
+  return "s";
+}
+
 }  // namespace
 
 // Sets one `tangential.KEY` option of the generator; throws std::invalid_argument.
@@ -403,21 +411,26 @@ int RunCollect(const CollectOptions& o) {
     fs::create_directories(out / "figures");
     // Group settings by the values of the other axes.
     std::map<std::string, std::vector<std::string>> groups;  // label of others -> setting ids
+    // The same label for a title: spaced, so that a long one wraps between the pairs.
+    std::map<std::string, std::string> titles;
     for (const auto& s : plan.at("settings")) {
-      std::string others;
+      std::string others, title;
       for (std::size_t i = 0; i < keys.size(); ++i)
-        if (static_cast<int>(i) != xaxis && axes[i].at("values").size() > 1)
-          others +=
-              (others.empty() ? "" : "_") + keys[i] + "=" + s.at("values")[i].get<std::string>();
+        if (static_cast<int>(i) != xaxis && axes[i].at("values").size() > 1) {
+          const std::string value = s.at("values")[i].get<std::string>();
+          others += (others.empty() ? "" : "_") + keys[i] + "=" + value;
+          title += (title.empty() ? "" : ", ") + keys[i] + " = " + value;
+        }
       groups[others].push_back(s.at("id"));
+      titles[others] = title;
     }
     for (const char* metric : kMetrics) {
       for (const auto& [others, ids] : groups) {
         viz::LineChart chart;
         chart.title = std::string(metric) + " vs " + keys[xaxis] +
-                      (others.empty() ? "" : " (" + others + ")");
+                      (others.empty() ? "" : " (" + titles.at(others) + ")");
         chart.x_label = keys[xaxis];
-        chart.y_label = metric;
+        chart.y_label = std::string(metric) + " [" + MetricUnit(metric) + "]";
         chart.caption =
             "Points: mean over the seeds of each setting; error bars: 95 % confidence interval "
             "of the mean (Student t), none with one seed. Colour: the filter's weight mode.";

@@ -464,17 +464,27 @@ void DrawSeries(cairo_t* cr, const LineChart& chart, const LineGeometry& g) {
   cairo_clip(cr);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  // Rank of each series among those with error bars.
+  std::vector<int> rank(chart.series.size(), 0);
+  int with_errors = 0;
+  for (std::size_t i = 0; i < chart.series.size(); ++i)
+    if (std::any_of(chart.series[i].errors.begin(), chart.series[i].errors.end(),
+                    [](double e) { return std::isfinite(e); }))
+      rank[i] = with_errors++;
   for (std::size_t i = 0; i < chart.series.size(); ++i) {
     const LineSeries& s = chart.series[i];
     const Rgba color = SeriesColor(s.name, s.color, static_cast<int>(i));
     const double lw = s.line_width * f.u;
     SetColor(cr, color);
-    // Error bars first, under the line.
+    // Error bars first, under the line; the series' bars side by side around their x (dodged)
+    // where several series have them, so that bars at one x do not hide each other.
+    const double dodge = (rank[i] - 0.5 * (with_errors - 1)) * 1.6 * f.u;
     for (std::size_t k = 0; k < s.errors.size(); ++k) {
       if (!Usable(chart, s.x[k], s.y[k]) || !std::isfinite(s.errors[k])) continue;
       const double lo = s.y[k] - s.errors[k];
       const double y_lo = chart.log_y && lo <= 0.0 ? a.top + a.height : g.ToPy(lo);
-      ErrorBar(cr, g.ToPx(s.x[k]), y_lo, g.ToPy(s.y[k] + s.errors[k]), 2.0 * f.u, 0.7 * f.u);
+      ErrorBar(cr, g.ToPx(s.x[k]) + dodge, y_lo, g.ToPy(s.y[k] + s.errors[k]), 1.6 * f.u,
+               0.7 * f.u);
     }
     cairo_new_path(cr);
     for (std::size_t k = 0; k < s.x.size(); ++k) {

@@ -39,6 +39,10 @@ TextRecord* RecordOf(cairo_t* cr) {
 
 }  // namespace
 
+void AttachTextRecord(cairo_surface_t* surface, TextRecord* record) {
+  cairo_surface_set_user_data(surface, &kTextRecordKey, record, nullptr);
+}
+
 void TextRecord::Add(const std::string& text, double size) {
   min_size = std::min(min_size, size);
   ++count;
@@ -60,7 +64,7 @@ Canvas::Canvas(int width, int height)
   if (width <= 0 || height <= 0 || cairo_surface_status(surface_.get()) != CAIRO_STATUS_SUCCESS)
     throw std::runtime_error("viz: cannot create a " + std::to_string(width) + "x" +
                              std::to_string(height) + " drawing");
-  cairo_surface_set_user_data(surface_.get(), &kTextRecordKey, text_.get(), nullptr);
+  AttachTextRecord(surface_.get(), text_.get());
   cairo_set_source_rgb(cr(), 1.0, 1.0, 1.0);
   cairo_paint(cr());
 }
@@ -379,6 +383,32 @@ double LayoutLegendRow(cairo_t* cr, const std::vector<LegendItem>& items, double
 
 double LineHeight(double size) { return 1.25 * size; }
 
+namespace {
+// A word wider than the line, split after '_', '.', '=', '/' or ',' into pieces that fit where
+// it can be (identifiers and paths); a piece without such a break stays whole.
+std::vector<std::string> SplitLongWord(cairo_t* cr, const std::string& word, double size,
+                                       double max_width, bool bold) {
+  std::vector<std::string> pieces;
+  std::string piece, run;  // run: the characters since the last break point
+  for (const char c : word) {
+    run += c;
+    if (std::string("_.=/,").find(c) == std::string::npos) continue;
+    if (!piece.empty() && TextWidth(cr, piece + run, size, bold) > max_width) {
+      pieces.push_back(piece);
+      piece.clear();
+    }
+    piece += run;
+    run.clear();
+  }
+  if (!piece.empty() && TextWidth(cr, piece + run, size, bold) > max_width) {
+    pieces.push_back(piece);
+    piece.clear();
+  }
+  pieces.push_back(piece + run);
+  return pieces;
+}
+}  // namespace
+
 std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double size,
                                   double max_width, bool bold) {
   std::vector<std::string> lines;
@@ -396,13 +426,20 @@ std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double s
         words.push_back(w);
     }
     std::string line;
-    for (const std::string& w : words) {
-      const std::string candidate = line.empty() ? w : line + " " + w;
-      if (!line.empty() && TextWidth(cr, candidate, size, bold) > max_width) {
-        lines.push_back(line);
-        line = w;
-      } else {
-        line = candidate;
+    for (const std::string& word : words) {
+      const std::vector<std::string> pieces = TextWidth(cr, word, size, bold) > max_width
+                                                  ? SplitLongWord(cr, word, size, max_width, bold)
+                                                  : std::vector<std::string>{word};
+      for (std::size_t i = 0; i < pieces.size(); ++i) {
+        // Pieces of one word join without a space.
+        const std::string& w = pieces[i];
+        const std::string candidate = line.empty() ? w : line + (i == 0 ? " " : "") + w;
+        if (!line.empty() && TextWidth(cr, candidate, size, bold) > max_width) {
+          lines.push_back(line);
+          line = w;
+        } else {
+          line = candidate;
+        }
       }
     }
     lines.push_back(line);

@@ -32,6 +32,11 @@ struct TextRecord {
   void Merge(const TextRecord& other);
 };
 
+/// Makes DrawText record into `record` the texts drawn on `surface` (a canvas does this for its
+/// own surface; a raster of one's own, e.g. a video frame, can use it to check its fonts). The
+/// record must outlive the drawing; nullptr detaches.
+void AttachTextRecord(cairo_surface_t* surface, TextRecord* record);
+
 /// A drawing of width x height units (pixels in PNG, points in SVG and PDF) with a context,
 /// cleared to white. Drawn into a cairo recording surface, so one drawing is written as a raster
 /// or as vectors (text as text, lines as paths; embedded images such as grid cells stay rasters).
@@ -131,7 +136,8 @@ void DrawArrow(cairo_t* cr, double x0, double y0, double x1, double y1, double l
 void DrawCross(cairo_t* cr, double x, double y, double half, double line_width);
 
 /// `text` split at spaces into lines at most `max_width` wide at `size` (a longer word has a line
-/// of its own, a "%" stays with the word before it); "\n" forces a break.
+/// of its own, broken after '_', '.', '=', '/' or ',' if it has them; a "%" stays with the word
+/// before it); "\n" forces a break.
 std::vector<std::string> WrapText(cairo_t* cr, const std::string& text, double size,
                                   double max_width, bool bold = false);
 /// Line advance of wrapped text: 1.25 x size.
