@@ -23,8 +23,9 @@ std::int16_t Centimetres(float v) {
 // A mass in 1/255 steps, rounded to a whole per cent first: a read-out shows two decimals, and
 // 101 levels compress ~25 % better than 256.
 std::uint8_t Quantise(float mass) {
-  const long percent = std::lround(std::clamp(mass, 0.0f, 1.0f) * 100.0f);
-  return static_cast<std::uint8_t>(std::lround(percent * 2.55));
+  // Non-negative, so adding 0.5 and truncating rounds (std::lround was 2 % of a recorded run).
+  const int percent = static_cast<int>(std::clamp(mass, 0.0f, 1.0f) * 100.0f + 0.5f);
+  return static_cast<std::uint8_t>(static_cast<int>(percent * 2.55f + 0.5f));
 }
 
 // Below this quantised dynamic mass (0.05) a cell's mean velocity is not recorded: its colour

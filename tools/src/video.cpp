@@ -315,17 +315,18 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   if (o.preview != "none") {
     const fs::path preview = out.parent_path() / (out.stem().string() + "_preview." + o.preview);
     const fs::path preview_part = fs::path(preview).concat(".part");
-    // The whole run at 4x, 480 px wide, 8 frames/s, at most 20 s: small enough for a README.
+    // The run at 4x, 480 px wide, 6 frames/s, at most 15 s (the first minute of the run): a
+    // few MB (the cells' noise defeats GIF's compression; fewer colours and no dithering help).
     std::vector<std::string> args = {
         ffmpeg->string(), "-hide_banner", "-nostdin", "-loglevel", "error", "-y", "-i",
-        out.string(),     "-t",           "20"};
+        out.string(),     "-t",           "15"};
     if (o.preview == "gif")
       args.insert(args.end(), {"-vf",
-                               "setpts=PTS/4,fps=8,scale=480:-2:flags=lanczos,split[a][b];"
-                               "[a]palettegen=max_colors=128[p];[b][p]paletteuse=dither=bayer",
+                               "setpts=PTS/4,fps=6,scale=480:-2:flags=lanczos,split[a][b];"
+                               "[a]palettegen=max_colors=64[p];[b][p]paletteuse=dither=none",
                                "-loop", "0", "-f", "gif"});
     else
-      args.insert(args.end(), {"-vf", "setpts=PTS/4,fps=8,scale=480:-2", "-c:v", "libvpx-vp9",
+      args.insert(args.end(), {"-vf", "setpts=PTS/4,fps=6,scale=480:-2", "-c:v", "libvpx-vp9",
                                "-b:v", "0", "-crf", "40", "-deadline", "realtime", "-f", "webm"});
     args.push_back(preview_part.string());
     try {
