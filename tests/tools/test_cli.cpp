@@ -380,10 +380,33 @@ TEST_CASE("Every figure a user gets is readable at one column and says what it s
   for (const char* text : {"position", "velocity", "dual", "x from the ego [m]", "over ground",
                            "white free, black static, grey unknown"})
     all("grid", text);
-  for (const char* text : {"w_position", "w_velocity", "alongside_truck", "radial likelihood"})
+  for (const char* text :
+       {"w_position", "w_velocity", "alongside_truck", "This run uses the radial likelihood"})
     all("weights", text);
   all("tracked_share_v", "One run: no confidence interval");
   all("experiment_tracked_share", "whiskers: 95 % confidence interval");
   all("experiment_tracked_share_v", "alongside_truck");
   all("sweep", "error bars: 95 % confidence interval");
+}
+
+// The weights figure explains its shares for the likelihood the run used: with the paper preset
+// (eq. (8) in its vector form) the explanation is the paper's, not the default's.
+TEST_CASE("The weights figure's caption names the run's velocity likelihood", "[cli][figures]") {
+  const auto dir = TempDir("figure_audit", "paper_weights");
+  const auto audit = dir / "audit.jsonl";
+  const Result r =
+      Shell("DUALGRID_FIGURE_AUDIT=" + audit.string() + " " + std::string(DUALGRID_EXE) +
+            " run scenarios/highway.yaml --duration 2 --snapshots 1 --no-record "
+            "--figure-formats svg --set filter.preset=paper -q --out " +
+            (dir / "run").string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  int weights = 0;
+  for (const nlohmann::json& rec : AuditRecords(audit)) {
+    if (fs::path(rec.at("path").get<std::string>()).stem() != "weights") continue;
+    ++weights;
+    CHECK(HasText(rec, "This run uses eq. (8) in its vector form"));
+    CHECK_FALSE(HasText(rec, "This run uses the radial likelihood"));
+  }
+  CHECK(weights == 1);
 }

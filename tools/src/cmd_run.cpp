@@ -213,7 +213,9 @@ int RunFilters(const FilterRunOptions& options) {
     for (std::size_t m = 0; m < modes.size(); ++m)
       clusters.Write(f, pipeline.grid_frame(), mode_names[m], scorers[m], objects, pipeline.ids());
     traces.Add(pipeline, trace_mode);
-    for (std::size_t m = 0; m < modes.size(); ++m) live[m] = counters[m].Count(scorers[m], objects);
+    if (options.record)
+      for (std::size_t m = 0; m < modes.size(); ++m)
+        live[m] = counters[m].Count(scorers[m], objects);
     if (record_now) {
       if (!recorder) {
         record_header = replay::MakeHeader(
@@ -320,7 +322,8 @@ int RunFilters(const FilterRunOptions& options) {
       TryFigures(
           png, options.figure_formats,
           [&](const auto& p) {
-            RenderWeightTrace(traces.by_vehicle.at(focus), focus, mode_names[trace_mode], p);
+            RenderWeightTrace(traces.by_vehicle.at(focus), focus, mode_names[trace_mode],
+                              config.filter.velocity_likelihood, p);
           },
           &warnings);
     }

@@ -217,7 +217,7 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 }
 
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
-                       const std::filesystem::path& path) {
+                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path) {
   viz::LineChart chart;
   chart.title = "Weights on " + object + " (" + mode + " filter, paper Fig. 4)";
   chart.y_label = "share within " + Fixed(WeightTrace::kGoodVelocity, 0) + " m/s";
@@ -229,12 +229,21 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
       "Share of each weight on " + object + " held by its particles within " +
       Fixed(WeightTrace::kGoodVelocity, 0) +
       " m/s of its true velocity. w_position scores positions only; w_velocity also scores the "
-      "Doppler. With the radial likelihood (dualgrid preset, the default) a particle with the "
-      "true velocity always matches the radial speed, even across the line of sight, so "
-      "w_velocity's share sits at or above w_position's. The paper's Fig. 4 (w_velocity drops "
-      "while the Doppler is below the speed) is eq. (8) in its vector form (paper preset), "
-      "which compares the whole velocity with the radial one: there w_velocity's share can "
-      "fall near 0.";
+      "Doppler. ";
+  // The explanation depends on the run's f_v (eq. (8)): say which one this run used.
+  if (likelihood == filter::VelocityLikelihood::kRadial)
+    chart.caption +=
+        "This run uses the radial likelihood (the dualgrid preset, the default): a particle "
+        "with the true velocity always matches the radial speed, even across the line of "
+        "sight, so w_velocity's share sits at or above w_position's. The paper's Fig. 4 "
+        "(w_velocity drops while the Doppler is below the speed) is eq. (8) in its vector form "
+        "(filter.preset=paper), where that share falls near 0.";
+  else
+    chart.caption +=
+        "This run uses eq. (8) in its vector form (the paper preset): it compares the whole "
+        "velocity with the radial one, so where the Doppler is below the speed w_velocity "
+        "favours the wrong particles and its share falls, as in the paper's Fig. 4; the "
+        "default radial likelihood keeps it at or above w_position's.";
   for (const bool v : {false, true}) {
     viz::LineSeries s;
     s.name = v ? "w_velocity" : "w_position";

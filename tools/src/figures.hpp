@@ -67,7 +67,8 @@ struct WeightTrace {
   /// Share of the object's detections whose |compensated Doppler| is below half its speed.
   std::vector<double> tangential_share;
 };
+/// The caption explains the shares for the run's `likelihood` (f_v of eq. (8)).
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
-                       const std::filesystem::path& path);
+                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path);
 
 }  // namespace dualgrid::tools
