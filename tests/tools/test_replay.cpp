@@ -4,6 +4,7 @@
 // errors with exit code 2.
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -130,6 +131,7 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
   for (const auto& row : ReadCsv(run / "clusters.csv"))
     ++clusters[{row.at("time"), row.at("mode")}];
   int boxes_checked = 0;
+  std::size_t clusters_checked = 0;
   for (std::size_t i = 0; i < index["frames"].size(); ++i) {
     const json& f = index["frames"][i];
     CHECK(f["t"].get<double>() == Approx((i + 1) * interval));
@@ -143,9 +145,11 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
       CHECK(b[2].get<double>() == Approx(-std::sin(yaw) * x + std::cos(yaw) * y).margin(0.01));
       ++boxes_checked;
     }
-    for (std::size_t m = 0; m < modes; ++m)
+    for (std::size_t m = 0; m < modes; ++m) {
       CHECK(f["modes"][m]["cl"].size() ==
             static_cast<std::size_t>(clusters[{stamp, index["modes"][m].get<std::string>()}]));
+      clusters_checked += f["modes"][m]["cl"].size();
+    }
     // Dense data: masses of a cell sum to at most one; each is rounded to a whole per cent (the
     // three per cents then sum to at most 101) and then to 1/255 (each byte at most 0.5 above
     // per cent x 2.55): at most 101 x 2.55 + 1.5 = 259. No velocity where the recording says
@@ -160,6 +164,7 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
     }
   }
   CHECK(boxes_checked > 40);
+  CHECK(clusters_checked > 40);
 
   // The live totals of the last frame count every step (not only recorded ones): they are the
   // sums of objects.csv's per-object frame counts.
@@ -279,10 +284,18 @@ TEST_CASE("replay: an H.264 video whose frames show the run, a preview and the v
   }
   CHECK(whites >= 1);
 
-  // The viewer page holds the data (no placeholder left) and every recorded frame.
+  // The viewer page holds the data (no placeholder left) and every recorded frame: the base64
+  // list after the index ("frames":["...","...",...]).
   const std::string html = Slurp(run / "replay.html");
   CHECK(html.find("/*DUALGRID_DATA*/") == std::string::npos);
   CHECK(html.find("\"format\":\"dualgrid-replay\"") != std::string::npos);
+  const std::size_t list = html.find("\"frames\":[\"");
+  REQUIRE(list != std::string::npos);
+  const std::size_t end = html.find("\"]", list);
+  REQUIRE(end != std::string::npos);
+  const std::string b64 = html.substr(list, end - list);
+  CHECK(static_cast<std::size_t>(std::count(b64.begin(), b64.end(), ',')) + 1 ==
+        index["frames"].size());
 }
 
 TEST_CASE("replay: bad input gets one line and exit code 2", "[cli][replay]") {
@@ -314,6 +327,62 @@ TEST_CASE("replay: bad input gets one line and exit code 2", "[cli][replay]") {
   one_line_2(Run("replay " + (d / "copy").string()), "'version'");
   index["version"] = 1;
   std::ofstream(d / "copy" / "replay" / "index.json") << index.dump();
+  json bad = index;
+  bad["cells_x"] = "400";
+  std::ofstream(d / "copy" / "replay" / "index.json") << bad.dump();
+  one_line_2(Run("replay " + (d / "copy").string()), "'cells_x'");
+  bad = index;
+  bad["frames"][3]["blob"] = json::array({0, 1ull << 62});
+  std::ofstream(d / "copy" / "replay" / "index.json") << bad.dump();
+  one_line_2(Run("replay " + (d / "copy").string() + " --html"), "frames[3].blob");
+  bad = index;
+  bad["frames"] = json::array();
+  std::ofstream(d / "copy" / "replay" / "index.json") << bad.dump();
+  one_line_2(Run("replay " + (d / "copy").string()), "'frames'");
+  std::ofstream(d / "copy" / "replay" / "index.json") << index.dump();
   fs::resize_file(d / "copy" / "replay" / "frames.bin", 1000);
   one_line_2(Run("replay " + (d / "copy").string()), "frames.bin");
+  // Options the viewer would ignore, and a video into a folder that does not exist.
+  one_line_2(Run("replay " + run.string() + " --html --width 640"), "--width");
+  one_line_2(Run("replay " + run.string() + " --out " + (d / "nowhere" / "x.mp4").string()),
+             "--out");
+}
+
+TEST_CASE("a run shorter than the record interval still records its last step", "[cli][replay]") {
+  const fs::path d = TempDir("replay", "short");
+  const auto r = Run("run scenarios/highway.yaml --duration 0.05 --figure-formats png -q --out " +
+                     (d / "run").string());
+  INFO(r.output);
+  REQUIRE(r.code == 0);
+  const json index = json::parse(Slurp(d / "run" / "replay" / "index.json"));
+  REQUIRE(index["frames"].size() == 1);
+  CHECK(index["frames"][0]["t"].get<double>() == Approx(0.05));
+}
+
+TEST_CASE("a failing ffmpeg costs the video, never the run's results", "[cli][replay][video]") {
+  const fs::path run = RecordedRun();
+  const fs::path d = TempDir("replay", "bad_ffmpeg");
+  // An ffmpeg that fails at once, first on PATH.
+  std::ofstream(d / "ffmpeg") << "#!/bin/sh\necho 'no encoder here' >&2\nexit 1\n";
+  fs::permissions(d / "ffmpeg", fs::perms::owner_all);
+  const std::string env = "PATH=" + d.string() + ":$PATH ";
+  const auto r =
+      Shell(env + DUALGRID_EXE + " replay " + run.string() + " -q --out " + (d / "v.mp4").string());
+  INFO(r.output);
+  CHECK(r.code == 1);
+  CHECK(r.output.find("no encoder here") != std::string::npos);
+  CHECK_FALSE(fs::exists(d / "v.mp4"));
+  CHECK_FALSE(fs::exists(d / "v.mp4.part"));
+  const auto v = Shell(env + DUALGRID_EXE +
+                       " run scenarios/highway.yaml --duration 1 --figure-formats png -q --video "
+                       "--out " +
+                       (d / "run").string());
+  INFO(v.output);
+  CHECK(v.code == 0);
+  const json summary = json::parse(Slurp(d / "run" / "summary.json"));
+  CHECK(summary["complete"] == true);
+  REQUIRE(summary["warnings"].size() == 1);
+  CHECK(summary["warnings"][0].get<std::string>().find("replay not written") != std::string::npos);
+  CHECK(fs::exists(d / "run" / "metrics.json"));
+  CHECK(fs::exists(d / "run" / "replay" / "index.json"));
 }

@@ -133,7 +133,7 @@ TEST_CASE("replay frame: bad layouts and pictures are refused naming the field",
   ReplayPicture pic;
   pic.panels.resize(1);
   pic.panels[0].raster = r;
-  CHECK_THROWS_WITH(renderer.Render(pic), Catch::Contains("2"));
+  CHECK_THROWS_WITH(renderer.Render(pic), Catch::Contains("panels, the layout has 2"));
   pic.panels.resize(2);
   pic.panels[1].raster = r;
   pic.panels[1].raster.dynamic.pop_back();

@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "output.hpp"
 #include "recording.hpp"
+#include "signals.hpp"
 #include "video.hpp"
 #include "viewer.hpp"
 
@@ -25,8 +26,14 @@ int RunReplay(const ReplayOptions& options) {
     if (!options.quiet) std::cout << "viewer: " << path.string() << "\n";
   }
   if (video) {
-    const auto path = WriteVideo(reader, options);
-    if (!options.quiet) std::cout << "video: " << path.string() << "\n";
+    try {
+      const auto path = WriteVideo(reader, options);
+      if (!options.quiet) std::cout << "video: " << path.string() << "\n";
+    } catch (const Stopped&) {
+      std::cerr << "dualgrid: replay stopped by signal " << StopSignal()
+                << "; the unfinished video was removed\n";
+      return StopExitCode();
+    }
   }
   return 0;
 }

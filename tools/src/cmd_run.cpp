@@ -133,6 +133,7 @@ int RunFilters(const FilterRunOptions& options) {
   const int record_every =
       std::max(1, static_cast<int>(std::lround(options.record_interval / config.sim.step_length)));
   std::unique_ptr<replay::Writer> recorder;
+  bool record_failed = false;
   replay::Header record_header;
   std::vector<replay::LiveCounter> counters(modes.size(),
                                             replay::LiveCounter(config.evaluation.tracking));
@@ -150,7 +151,11 @@ int RunFilters(const FilterRunOptions& options) {
       picture = true;
       ++next_snapshot;
     }
-    const bool record_now = options.record && (steps + 1) % record_every == 0;
+    // Every record_every-th step, and the last one (a run shorter than the interval still has a
+    // frame). Off for good once a recording write failed.
+    const bool record_now =
+        options.record && !record_failed &&
+        ((steps + 1) % record_every == 0 || steps + 1 == config.sim.StepCount());
     const bool with_velocity =
         (picture && (options.figures || options.write_particles)) || record_now;
     // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
@@ -217,14 +222,24 @@ int RunFilters(const FilterRunOptions& options) {
       for (std::size_t m = 0; m < modes.size(); ++m)
         live[m] = counters[m].Count(scorers[m], objects);
     if (record_now) {
-      if (!recorder) {
-        record_header = replay::MakeHeader(
-            pipeline, mode_names, record_every * config.sim.step_length, options.record_particles);
-        recorder = std::make_unique<replay::Writer>(out / "replay", record_header);
+      // The replay must never cost the run: a failed write (a full disk) stops the recording
+      // with a warning; replay/ is then left without index.json, so it reads as unusable.
+      try {
+        if (!recorder) {
+          record_header =
+              replay::MakeHeader(pipeline, mode_names, record_every * config.sim.step_length,
+                                 options.record_particles);
+          recorder = std::make_unique<replay::Writer>(out / "replay", record_header);
+        }
+        recorder->Add(
+            replay::Capture(pipeline, snaps, scorers, counters, live, objects, record_header));
+        for (const auto& o : objects) recorded_ids.insert(o.id);
+      } catch (const std::exception& e) {
+        warnings.push_back(std::string("replay recording stopped: ") + e.what());
+        std::cerr << "dualgrid: warning: " << warnings.back() << "\n";
+        recorder.reset();
+        record_failed = true;
       }
-      recorder->Add(
-          replay::Capture(pipeline, snaps, scorers, counters, live, objects, record_header));
-      for (const auto& o : objects) recorded_ids.insert(o.id);
     }
     if (options.check_invariants) {
       for (std::size_t m = 0; m < modes.size(); ++m)

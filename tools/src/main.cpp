@@ -207,7 +207,9 @@ int main(int argc, char** argv) {
       ->check(NonEmptyPath());
   replay->add_option("--html-out", rep.html_out, "Viewer file (default RUN_DIR/replay.html)")
       ->check(NonEmptyPath());
-  replay->add_option("--modes", rep.modes, "Modes to show, comma-separated (default: all recorded)")
+  replay
+      ->add_option("--modes", rep.modes,
+                   "Video: modes to show, comma-separated (default: all recorded)")
       ->delimiter(',');
   replay->add_flag("--particles", rep.particles, "Video: draw the recorded particles");
   replay->add_flag_callback(
@@ -396,7 +398,17 @@ int main(int argc, char** argv) {
       return RunTangential(tan);
     }
     if (snapshot->parsed()) return RunSnapshot(snap);
-    if (replay->parsed()) return RunReplay(rep);
+    if (replay->parsed()) {
+      // The viewer has its own controls for these: given with --html alone they would be ignored.
+      if (rep.html && !rep.video)
+        for (const char* name : {"--out", "--modes", "--particles", "--no-detections", "--speed",
+                                 "--width", "--preview"})
+          if (replay->count(name) > 0)
+            throw std::invalid_argument(std::string(name) +
+                                        " is a video option; add --video, or leave it out (the "
+                                        "viewer has its own controls)");
+      return RunReplay(rep);
+    }
     if (run->parsed()) {
       run_options.figures = !run_no_figures;
       run_options.record = run_options.figures && !run_no_record;

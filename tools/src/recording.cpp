@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "output.hpp"
 
@@ -182,50 +183,98 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
     throw std::invalid_argument(index_path.string() + ": not JSON (" + e.what() + ")");
   }
   const std::string where = index_path.string();
+  // Every key read through Get names itself in the error (one line, exit code 2).
+  const auto get = [&](const json& j, const std::string& key, auto* out, const std::string& what) {
+    try {
+      *out = j.at(key).get<std::remove_pointer_t<decltype(out)>>();
+    } catch (const json::exception&) {
+      throw std::invalid_argument(where + ": key '" + key + "': expected " + what);
+    }
+  };
+  Header& h = header_;
+  std::string format;
+  get(index_, "format", &format, "\"dualgrid-replay\"");
+  if (format != "dualgrid-replay")
+    throw std::invalid_argument(where + ": key 'format': expected \"dualgrid-replay\"");
+  const json version = index_.value("version", json());
+  if (!version.is_number_integer() || version.get<int>() != kFormatVersion)
+    throw std::invalid_argument(where + ": key 'version': expected " +
+                                std::to_string(kFormatVersion) + ", found " + version.dump() +
+                                " (recorded by another release)");
+  get(index_, "scenario", &h.scenario, "a text");
+  get(index_, "seed", &h.seed, "a whole number");
+  get(index_, "modes", &h.modes, "a list of mode names");
+  get(index_, "sensors", &h.sensors, "a list of sensor names");
+  get(index_, "cells_x", &h.cells_x, "a whole number");
+  get(index_, "cells_y", &h.cells_y, "a whole number");
+  get(index_, "resolution", &h.resolution, "a number [m]");
+  get(index_, "frame_yaw_deg", &h.frame_yaw_deg, "a number [deg]");
+  get(index_, "interval", &h.interval, "a number [s]");
+  get(index_, "particle_unit", &h.particle_unit, "a number [m]");
+  get(index_, "max_particles", &h.max_particles, "a whole number");
+  get(index_, "dynamic_threshold", &h.dynamic_threshold, "a number");
+  get(index_, "names", &h.names, "an object");
+  get(index_, "metrics", &h.metrics, "an object");
+  get(index_, "complete", &h.complete, "true or false");
+  get(index_, "status", &h.status, "a text");
+  // The filter's own bound on cells (FilterParams) keeps the arrays allocatable.
+  if (h.cells_x <= 0 || h.cells_y <= 0 || static_cast<double>(h.cells_x) * h.cells_y > 2e8)
+    throw std::invalid_argument(where +
+                                ": keys 'cells_x', 'cells_y': expected a grid of 1 to "
+                                "2e8 cells");
+  for (const auto& [key, value] : {std::pair<const char*, double>{"resolution", h.resolution},
+                                   {"interval", h.interval},
+                                   {"particle_unit", h.particle_unit}})
+    if (!(value > 0.0) || !std::isfinite(value))
+      throw std::invalid_argument(where + ": key '" + key + "': expected a positive number");
+  if (h.modes.empty())
+    throw std::invalid_argument(where + ": key 'modes': expected at least one mode");
+  if (h.max_particles < 0)
+    throw std::invalid_argument(where + ": key 'max_particles': expected >= 0");
   try {
-    if (index_.value("format", "") != "dualgrid-replay")
-      throw std::invalid_argument(where + ": key 'format': expected \"dualgrid-replay\"");
-    if (index_.at("version").get<int>() != kFormatVersion)
-      throw std::invalid_argument(where + ": key 'version': expected " +
-                                  std::to_string(kFormatVersion) + ", found " +
-                                  index_.at("version").dump() + " (recorded by another release)");
-    Header& h = header_;
-    h.scenario = index_.at("scenario").get<std::string>();
-    h.seed = index_.at("seed").get<std::uint64_t>();
-    h.modes = index_.at("modes").get<std::vector<std::string>>();
-    h.sensors = index_.at("sensors").get<std::vector<std::string>>();
-    h.cells_x = index_.at("cells_x").get<int>();
-    h.cells_y = index_.at("cells_y").get<int>();
-    h.resolution = index_.at("resolution").get<double>();
-    h.frame_yaw_deg = index_.at("frame_yaw_deg").get<double>();
-    h.interval = index_.at("interval").get<double>();
-    h.particle_unit = index_.at("particle_unit").get<double>();
-    h.max_particles = index_.at("max_particles").get<int>();
-    h.dynamic_threshold = index_.at("dynamic_threshold").get<double>();
-    h.names = index_.at("names");
-    h.metrics = index_.at("metrics");
-    h.complete = index_.at("complete").get<bool>();
-    h.status = index_.at("status").get<std::string>();
     for (const json& b : index_.at("parked")) h.parked.push_back(BoxFrom(b));
     for (const json& r : index_.at("rails")) {
       h.rails.emplace_back();
       for (const json& p : r)
         h.rails.back().push_back({p.at(0).get<double>(), p.at(1).get<double>()});
     }
-    if (h.cells_x <= 0 || h.cells_y <= 0 || !(h.resolution > 0.0) || h.modes.empty())
-      throw std::invalid_argument(where +
-                                  ": keys 'cells_x', 'cells_y', 'resolution', 'modes': "
-                                  "expected a non-empty grid and at least one mode");
-    for (const json& f : index_.at("frames")) times_.push_back(f.at("t").get<double>());
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(where + ": " + e.what());
+  } catch (const json::exception&) {
+    throw std::invalid_argument(where + ": keys 'parked', 'rails': expected boxes and polylines");
   }
-  const auto bin_size = fs::exists(dir_ / "frames.bin") ? fs::file_size(dir_ / "frames.bin") : 0;
-  if (!times_.empty()) {
-    const json& last = index_["frames"].back()["blob"];
-    if (last.at(0).get<std::uint64_t>() + last.at(1).get<std::uint64_t>() > bin_size)
-      throw std::invalid_argument((dir_ / "frames.bin").string() +
-                                  ": shorter than index.json says (truncated copy?)");
+  const json& frames = index_.value("frames", json());
+  if (!frames.is_array() || frames.empty())
+    throw std::invalid_argument(where +
+                                ": key 'frames': expected a non-empty list (a run "
+                                "records its first frame after --record-interval)");
+  // Each frame's blob must lie in frames.bin and its sizes be the header's, so that a damaged
+  // index fails here with its key named, not later in the middle of a video.
+  const std::uint64_t bin_size =
+      fs::exists(dir_ / "frames.bin") ? fs::file_size(dir_ / "frames.bin") : 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::string key = "frames[" + std::to_string(i) + "]";
+    const json& f = frames[i];
+    double t = 0.0;
+    get(f, "t", &t, "a time [s] (in " + key + ")");
+    times_.push_back(t);
+    const json blob = f.value("blob", json());
+    if (!blob.is_array() || blob.size() != 2 || !blob[0].is_number_unsigned() ||
+        !blob[1].is_number_unsigned())
+      throw std::invalid_argument(where + ": key '" + key + ".blob': expected [offset, length]");
+    const auto offset = blob[0].get<std::uint64_t>(), length = blob[1].get<std::uint64_t>();
+    if (length > bin_size || offset > bin_size - length)
+      throw std::invalid_argument((dir_ / "frames.bin").string() + ": shorter than " + where +
+                                  "'s " + key + ".blob says (truncated copy?)");
+    const json modes = f.value("modes", json());
+    if (!modes.is_array() || modes.size() != h.modes.size())
+      throw std::invalid_argument(where + ": key '" + key + ".modes': expected " +
+                                  std::to_string(h.modes.size()) + " entries");
+    for (const json& m : modes) {
+      const json np = m.value("np", json());
+      if (!np.is_number_unsigned() ||
+          np.get<std::uint64_t>() > static_cast<std::uint64_t>(h.max_particles))
+        throw std::invalid_argument(where + ": key '" + key +
+                                    ".modes[].np': expected 0 to max_particles");
+    }
   }
 }
 
@@ -237,7 +286,10 @@ std::vector<std::uint8_t> Reader::Compressed(std::size_t i) const {
   in.seekg(static_cast<std::streamoff>(offset));
   std::vector<std::uint8_t> bytes(length);
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(length));
-  if (!in) throw std::runtime_error("cannot read " + (dir_ / "frames.bin").string());
+  // The constructor checked the blob against the file's size: a failure now is a changed file.
+  if (!in)
+    throw std::invalid_argument("cannot read " + (dir_ / "frames.bin").string() +
+                                " (changed since it was opened?)");
   return bytes;
 }
 

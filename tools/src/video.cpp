@@ -20,6 +20,7 @@
 #include "dualgrid/viz/replay_frame.hpp"
 #include "output.hpp"
 #include "progress.hpp"
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 
@@ -85,20 +86,30 @@ class FfmpegPipe {
  public:
   FfmpegPipe(std::vector<std::string> args, const fs::path& log) : log_(log) {
     int fds[2];
-    if (pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+    // Close-on-exec: ffmpeg inherits only its stdin, not this process's other files.
+    if (pipe2(fds, O_CLOEXEC) != 0)
+      throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     const std::string log_path = log.string();
     pid_ = fork();
-    if (pid_ < 0)
-      throw std::runtime_error(std::string("cannot start ffmpeg: ") + std::strerror(errno));
+    if (pid_ < 0) {
+      const int err = errno;
+      close(fds[0]);
+      close(fds[1]);
+      throw std::runtime_error(std::string("cannot start ffmpeg: ") + std::strerror(err));
+    }
     if (pid_ == 0) {
+      // Its own process group: Ctrl-C reaches dualgrid, which stops ffmpeg and removes the
+      // unfinished file, instead of ffmpeg dying first and looking like a failure.
+      setpgid(0, 0);
       prctl(PR_SET_PDEATHSIG, SIGTERM);
       dup2(fds[0], 0);
       close(fds[0]);
       close(fds[1]);
-      const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (fd < 0) fd = open("/dev/null", O_WRONLY);
       if (fd >= 0) {
         dup2(fd, 1);
         dup2(fd, 2);
@@ -117,7 +128,8 @@ class FfmpegPipe {
     fd_ = -1;
     if (pid_ > 0) {
       kill(pid_, SIGTERM);
-      waitpid(pid_, nullptr, 0);
+      while (waitpid(pid_, nullptr, 0) < 0 && errno == EINTR) {
+      }
     }
     pid_ = -1;
   }
@@ -137,10 +149,11 @@ class FfmpegPipe {
     close(fd_);
     fd_ = -1;
     int status = 0;
-    while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    pid_t r;
+    while ((r = waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
     }
     pid_ = -1;
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    if (r < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
       throw std::runtime_error("ffmpeg failed (" + LastLine() + "); its log: " + log_.string());
   }
 
@@ -234,6 +247,9 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   const fs::path out = o.out.empty() ? reader.dir().parent_path() / "replay.mp4" : o.out;
   if (out.extension() != ".mp4")
     throw std::invalid_argument("--out: expected a .mp4 file, got " + out.string());
+  if (!fs::is_directory(fs::absolute(out).parent_path()))
+    throw std::invalid_argument("--out: folder " + fs::absolute(out).parent_path().string() +
+                                " does not exist");
   const auto [first, last] = FrameRange(reader, o);
   const std::vector<std::size_t> modes = SelectModes(reader.header(), o);
   const auto ffmpeg = FindFfmpeg();
@@ -255,7 +271,11 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   try {
     layout.Validate();
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string("--") + e.what());
+    // Name the option a user can change: --width for the width, --modes for the panel count.
+    const std::string what = e.what();
+    throw std::invalid_argument(what.rfind("width", 0) == 0    ? "--" + what
+                                : what.rfind("panels", 0) == 0 ? "--modes: " + what
+                                                               : "replay: " + what);
   }
   viz::ReplayRenderer renderer(layout);
 
@@ -298,6 +318,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   const std::size_t bytes = static_cast<std::size_t>(renderer.width()) * renderer.height() * 4;
   try {
     for (std::size_t i = first; i < last; ++i) {
+      if (StopSignal()) throw Stopped();
       const replay::Frame f = i == first ? first_frame : reader.Load(i);
       const std::uint8_t* raster = renderer.Render(ToPicture(reader, f, modes, o));
       if (!pipe.Write(raster, bytes)) break;  // ffmpeg stopped: Close() reports why

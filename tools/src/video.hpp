@@ -4,12 +4,19 @@
 
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "commands.hpp"
 #include "recording.hpp"
 
 namespace dualgrid::tools {
+
+/// Thrown when SIGINT/SIGTERM stops a video: the unfinished file is removed; RunReplay exits with
+/// StopExitCode().
+struct Stopped : std::runtime_error {
+  Stopped() : std::runtime_error("stopped by a signal") {}
+};
 
 /// `ffmpeg` on PATH, or nullopt.
 std::optional<std::filesystem::path> FindFfmpeg();

@@ -38,17 +38,16 @@ void AppendBase64(const std::vector<std::uint8_t>& in, std::string& out) {
   }
 }
 
-// JSON inside a <script> element: "</" would end the element early (a vehicle named "</script>").
+// JSON inside a <script> element: every '<' as \u003c (still the same JSON), so that no text in it
+// ("</script>", "<!--") can end the element or change how the HTML parser reads it.
 std::string ScriptSafe(const std::string& json) {
   std::string out;
   out.reserve(json.size());
-  for (std::size_t i = 0; i < json.size(); ++i) {
-    if (json[i] == '<' && i + 1 < json.size() && json[i + 1] == '/') {
-      out += "<\\/";
-      ++i;
-    } else {
-      out += json[i];
-    }
+  for (const char c : json) {
+    if (c == '<')
+      out += "\\u003c";
+    else
+      out += c;
   }
   return out;
 }
@@ -59,6 +58,9 @@ fs::path WriteViewer(const replay::Reader& reader, const ReplayOptions& o) {
   const fs::path out = o.html_out.empty() ? reader.dir().parent_path() / "replay.html" : o.html_out;
   if (out.extension() != ".html")
     throw std::invalid_argument("--html-out: expected a .html file, got " + out.string());
+  if (!fs::is_directory(fs::absolute(out).parent_path()))
+    throw std::invalid_argument("--html-out: folder " + fs::absolute(out).parent_path().string() +
+                                " does not exist");
   const auto [first, last] = FrameRange(reader, o);
   nlohmann::json index = reader.index();
   nlohmann::json frames = nlohmann::json::array();

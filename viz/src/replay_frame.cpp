@@ -115,6 +115,13 @@ struct ReplayRenderer::Impl {
   void PrepareCells(const GridRaster& r) {
     if (!cells || r.cells_x != cells_x || r.cells_y != cells_y) {
       cells.reset(cairo_image_surface_create(CAIRO_FORMAT_RGB24, r.cells_x, r.cells_y));
+      // cairo's images end at 32767 px a side: a longer grid cannot be drawn cell by cell.
+      if (cairo_surface_status(cells.get()) != CAIRO_STATUS_SUCCESS) {
+        cells.reset();
+        throw std::invalid_argument("replay frame: a grid of " + std::to_string(r.cells_x) + " x " +
+                                    std::to_string(r.cells_y) +
+                                    " cells is beyond cairo's 32767 px per side");
+      }
       cells_x = r.cells_x;
       cells_y = r.cells_y;
     }
