@@ -292,6 +292,40 @@ TEST_CASE("RenderGridPanels: cell colours, truth outlines, layout", "[viz]") {
   }
 }
 
+TEST_CASE("RenderGridPanels: clusters in their role's colour with estimated velocity arrows",
+          "[viz]") {
+  GridPanel p;
+  p.title = "dual";
+  p.raster = UnknownRaster(80, 20, 0.5, Position(-20.0, -5.0));
+  // A false cluster moving +x at 20 m/s (a 10 m arrow at 0.5 s) and a truth box moving +y.
+  p.clusters.push_back({Position(-15.0, -3.0), Position(-13.0, -1.0), Position(-14.0, -2.0),
+                        Velocity(20.0, 0.0), 2});
+  p.truth_boxes.push_back(OrientedBox{Position(10.0, 0.0), 0.0, 4.0, 2.0});
+  p.truth_velocities.push_back(Velocity(0.0, 8.0));
+  GridFigureOptions opt;
+  opt.image_width = 500;
+  const GridFigureLayout layout = LayoutGridPanels({p}, opt);
+  const fs::path path = TempDir() / "grid_clusters.png";
+  FigureAudit audit;
+  RenderGridPanels({p}, path.string(), opt);
+  const Png png(path);
+  const MapTransform& t = layout.panels[0];
+  // Halfway along each arrow's shaft: the cluster's in magenta, the truth's in black.
+  const Rgb8 shaft = png.At(t.ToPixel(Position(-9.0, -2.0)));
+  INFO("cluster arrow " << Str(shaft));
+  CHECK(Near(shaft, ClusterRoleColor(2), 70));
+  CHECK(Near(png.At(t.ToPixel(Position(10.0, 2.5))), colors::kBlack, 70));
+  // Without the arrows those places are unknown cells.
+  CHECK(Near(png.At(t.ToPixel(Position(-9.0, 2.0))), colors::kUnknown));
+  REQUIRE(audit.records().size() == 1);
+  for (const char* word : {"cluster: matched", "duplicate", "false", "velocity over ground"})
+    CHECK(audit.records()[0].HasText(word));
+  GridPanel bad = p;
+  bad.truth_velocities.push_back(Velocity::Zero());
+  CheckInvalidArgument([&] { RenderGridPanels({bad}, path.string(), opt); },
+                       "panels[0].truth_velocities");
+}
+
 TEST_CASE("RenderGridPanels rejects invalid rasters naming the field", "[viz]") {
   GridPanel ok;
   ok.raster = UnknownRaster(10, 4, 0.5, Position(0, 0));

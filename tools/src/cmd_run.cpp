@@ -255,7 +255,7 @@ int RunFilters(const FilterRunOptions& options) {
       TryFigures(
           grid_png, options.figure_formats,
           [&](const auto& p) {
-            RenderGridFigure(mode_names, snaps, pipeline.grid_frame(), f, f.time, p);
+            RenderGridFigure(mode_names, snaps, scorers, pipeline.grid_frame(), f, f.time, p);
           },
           &warnings);
       const auto scene_png = out / "figures" / ("scene_t" + stamp + ".png");

@@ -137,7 +137,8 @@ viz::GridRaster ToRaster(const GridSnapshot& s) {
 }  // namespace
 
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots, const GridFrame& g,
+                      const std::vector<GridSnapshot>& snapshots,
+                      const std::vector<ModeScorer>& scorers, const GridFrame& g,
                       const sim::Frame& frame, double time, const std::filesystem::path& path) {
   // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
   // not with the network's (often UTM-sized) coordinates.
@@ -152,8 +153,19 @@ void RenderGridFigure(const std::vector<std::string>& modes,
     panel.title = modes[i];
     panel.raster = ToRaster(snapshots[i]);
     panel.raster.origin -= ego;
-    for (const auto& v : frame.vehicles) panel.truth_boxes.push_back(from_ego(g.ToGrid(v.box)));
+    for (const auto& v : frame.vehicles) {
+      panel.truth_boxes.push_back(from_ego(g.ToGrid(v.box)));
+      panel.truth_velocities.push_back(g.VectorToGrid(v.velocity));
+    }
     panel.ego_boxes.push_back(from_ego(g.ToGrid(frame.ego.box)));
+    // The scorer's clusters of this step (grid frame) with their roles: what the mode tracks and
+    // at which estimated velocity.
+    const ModeScorer& sc = scorers[i];
+    for (std::size_t c = 0; c < sc.clusters().size(); ++c) {
+      const eval::Cluster& cl = sc.clusters()[c];
+      panel.clusters.push_back({cl.min - ego, cl.max - ego, cl.position - ego, cl.velocity,
+                                static_cast<int>(sc.association().role[c])});
+    }
     panels.push_back(std::move(panel));
   }
   viz::GridFigureOptions options;
@@ -164,8 +176,10 @@ void RenderGridFigure(const std::vector<std::string>& modes,
       "Cells: white free, black static, grey unknown; dynamic mass in the hue of its direction "
       "of motion over ground (the cell's mean particle velocity, grid frame: wheel), colours "
       "blended by the cell's masses. Black outlines: ground-truth vehicle boxes (SUMO); green: "
-      "the ego. " +
-      AxesNote(g);
+      "the ego. Coloured outlines: the mode's clusters of dynamic particles (blue-violet "
+      "matched to a vehicle, orange duplicate, magenta false) with their estimated velocity; "
+      "black arrows: true velocity. Arrows: motion over ground in " +
+      Fixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
   viz::RenderGridPanels(panels, path.string(), options);
 }
 

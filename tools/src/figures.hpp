@@ -37,8 +37,11 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
 
 /// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined; in the
 /// grid frame, whose axes are the grid's.
+/// `scorers` hold each mode's clusters of this step (drawn with their roles and estimated
+/// velocities beside the true velocities).
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots, const GridFrame& grid_frame,
+                      const std::vector<GridSnapshot>& snapshots,
+                      const std::vector<ModeScorer>& scorers, const GridFrame& grid_frame,
                       const sim::Frame& frame, double time, const std::filesystem::path& path);
 
 /// D per object (name) and mode; NaN where a mode did not score the object.

@@ -57,6 +57,12 @@ std::optional<Mode> ModeFromName(std::string_view name) {
 
 Rgba ModeColor(Mode mode) { return kModeColors[static_cast<int>(mode)]; }
 
+Rgba ClusterRoleColor(int role) {
+  if (role == 0) return {0.20, 0.25, 1.00, 1.0};
+  if (role == 1) return {1.00, 0.55, 0.00, 1.0};
+  return {0.95, 0.00, 0.85, 1.0};
+}
+
 Rgba SensorColor(int index) {
   constexpr int n = static_cast<int>(std::size(kSensorColors));
   return kSensorColors[((index % n) + n) % n];

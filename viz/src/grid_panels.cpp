@@ -139,7 +139,13 @@ void Validate(const std::vector<GridPanel>& panels, const GridFigureOptions& opt
     if (!panels[i].raster.IsValid(&error))
       throw std::invalid_argument("RenderGridPanels: panels[" + std::to_string(i) + "].raster." +
                                   error);
+    if (!panels[i].truth_velocities.empty() &&
+        panels[i].truth_velocities.size() != panels[i].truth_boxes.size())
+      throw std::invalid_argument("RenderGridPanels: panels[" + std::to_string(i) +
+                                  "].truth_velocities: one per truth box, or none");
   }
+  if (!(options.arrow_seconds > 0.0) || !std::isfinite(options.arrow_seconds))
+    throw std::invalid_argument("RenderGridPanels: options.arrow_seconds must be positive");
 }
 
 std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
@@ -156,6 +162,13 @@ std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
     items.push_back({"ground truth", colors::kBlack, Marker::kOutline});
   if (any(&GridPanel::ego_boxes)) items.push_back({"ego", kEgoOutline, Marker::kOutline});
   if (any(&GridPanel::particles)) items.push_back({"particle", colors::kBlack, Marker::kDot});
+  if (any(&GridPanel::clusters)) {
+    items.push_back({"cluster: matched", ClusterRoleColor(0), Marker::kOutline});
+    items.push_back({"duplicate", ClusterRoleColor(1), Marker::kOutline});
+    items.push_back({"false", ClusterRoleColor(2), Marker::kOutline});
+  }
+  if (any(&GridPanel::clusters) || any(&GridPanel::truth_velocities))
+    items.push_back({"velocity over ground", colors::kBlack, Marker::kArrow});
   return items;
 }
 
@@ -345,6 +358,31 @@ void DrawPanel(cairo_t* cr, const GridPanel& panel, const MapTransform& t,
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_MITER);
   for (const OrientedBox& b : panel.ego_boxes) StrokeHaloed(cr, t, b, kEgoOutline, k.u);
   for (const OrientedBox& b : panel.truth_boxes) StrokeHaloed(cr, t, b, colors::kBlack, k.u);
+  // Velocity arrows over ground, on a white halo so they read over any cell colour.
+  const auto arrow = [&](const Position& from, const Velocity& v, const Rgba& color) {
+    const Vector2 a = t.ToPixel(from), b = a + t.VectorToPixel(v * options.arrow_seconds);
+    if ((b - a).norm() < 0.5 * k.u) return;
+    SetColor(cr, colors::kWhite);
+    detail::DrawArrow(cr, a.x(), a.y(), b.x(), b.y(), 1.1 * k.u, 3.0 * k.u);
+    SetColor(cr, color);
+    detail::DrawArrow(cr, a.x(), a.y(), b.x(), b.y(), 0.5 * k.u, 2.4 * k.u);
+  };
+  for (std::size_t i = 0; i < panel.truth_velocities.size(); ++i)
+    arrow(panel.truth_boxes[i].center, panel.truth_velocities[i], colors::kBlack);
+  for (const GridCluster& c : panel.clusters) {
+    const Vector2 a = t.ToPixel({c.min.x(), c.max.y()}), b = t.ToPixel({c.max.x(), c.min.y()});
+    // A little outside the members' box, so that a one-cell cluster still shows an outline.
+    const double pad = 0.6 * k.u;
+    for (const auto& [color, width] :
+         {std::pair{colors::kWhite, 1.3 * k.u}, std::pair{ClusterRoleColor(c.role), 0.6 * k.u}}) {
+      cairo_rectangle(cr, a.x() - pad, a.y() - pad, b.x() - a.x() + 2 * pad,
+                      b.y() - a.y() + 2 * pad);
+      SetColor(cr, color);
+      cairo_set_line_width(cr, width);
+      cairo_stroke(cr);
+    }
+    arrow(c.center, c.velocity, ClusterRoleColor(c.role));
+  }
   cairo_restore(cr);
   detail::MapAxesStyle axes = AxesStyle(k, label_x, label_y);
   axes.label_left_room = left_room;

@@ -19,14 +19,12 @@ using detail::VAlign;
 
 namespace {
 
-// Cluster outlines must stand out from the hue-coloured cells (a highway's cells are mostly red,
-// +x), so they use colours no direction hue is: blue-violet, magenta, orange.
-constexpr Rgba kMatched{0.20, 0.25, 1.00, 1.0};
-constexpr Rgba kDuplicate{1.00, 0.55, 0.00, 1.0};
-constexpr Rgba kFalse{0.95, 0.00, 0.85, 1.0};
+const Rgba kMatched = ClusterRoleColor(0);
+const Rgba kDuplicate = ClusterRoleColor(1);
+const Rgba kFalse = ClusterRoleColor(2);
 constexpr Rgba kOutside{0.93, 0.93, 0.93, 1.0};  // view area the grid does not cover
 
-Rgba RoleColor(int role) { return role == 0 ? kMatched : role == 1 ? kDuplicate : kFalse; }
+Rgba RoleColor(int role) { return ClusterRoleColor(role); }
 
 void BoxPath(cairo_t* cr, const MapTransform& t, const OrientedBox& b) {
   const double c = std::cos(b.yaw), s = std::sin(b.yaw);

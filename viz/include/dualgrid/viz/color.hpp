@@ -41,6 +41,10 @@ Rgba ModeColor(Mode mode);
 
 /// Sensor `index` (0-based) colour; cycles after 8 and avoids the three mode colours.
 Rgba SensorColor(int index);
+/// Outline colour of a cluster by its association role (0 matched, 1 duplicate, 2 false):
+/// blue-violet, orange, magenta: no direction hue is one of them, so outlines stand out from the
+/// cells (a highway's are mostly red, +x).
+Rgba ClusterRoleColor(int role);
 /// General categorical colour for series `index`: the mode colours first, then the sensor ones.
 Rgba CategoryColor(int index);
 

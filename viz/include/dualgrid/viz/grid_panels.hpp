@@ -47,19 +47,32 @@ struct CellColorOptions {
 Rgba CellColor(float free, float static_occ, float dynamic, float vx, float vy,
                const CellColorOptions& options = {});
 
+/// A cluster of dynamic particles (the scorer's, docs/evaluation.md): its members' bounding box
+/// [m], mean position [m] and estimated velocity over ground [m/s], drawn as an outline in its
+/// role's colour (ClusterRoleColor) with a velocity arrow.
+struct GridCluster {
+  Position min = Position::Zero(), max = Position::Zero(), center = Position::Zero();
+  Velocity velocity = Velocity::Zero();
+  int role = 0;  ///< 0 matched to an object, 1 duplicate, 2 false
+};
+
 struct GridPanel {
   std::string title;  ///< e.g. "position", "velocity", "dual"
   GridRaster raster;
   std::vector<OrientedBox> truth_boxes;  ///< ground-truth outlines (black on a white halo)
-  std::vector<Position> particles;       ///< optional, drawn as tiny dots
-  std::vector<OrientedBox> ego_boxes;    ///< optional ego outline(s), drawn green
+  /// Optional: one per truth box, its true velocity [m/s], drawn as a black arrow.
+  std::vector<Velocity> truth_velocities;
+  std::vector<GridCluster> clusters;   ///< optional estimated objects
+  std::vector<Position> particles;     ///< optional, drawn as tiny dots
+  std::vector<OrientedBox> ego_boxes;  ///< optional ego outline(s), drawn green
 };
 
 struct GridFigureOptions {
   /// Whole image width [pt] (PNG: times png_scale): left axis margin + panels; the legend band
   /// and caption go underneath.
   int image_width = static_cast<int>(kSingleColumn);
-  std::string title;  ///< figure title above all panels when not empty
+  std::string title;           ///< figure title above all panels when not empty
+  double arrow_seconds = 0.5;  ///< a velocity arrow is this many seconds of motion [s]
   /// Wrapped under the legend when not empty: what the colours, outlines and axes mean.
   std::string caption;
   CellColorOptions cell;
