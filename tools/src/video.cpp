@@ -26,6 +26,17 @@ namespace dualgrid::tools {
 
 namespace fs = std::filesystem;
 
+const fs::path& CheckOutputFile(const fs::path& path, const std::string& option,
+                                const std::string& extension) {
+  if (path.extension() != extension)
+    throw std::invalid_argument(option + ": expected a " + extension + " file, got " +
+                                path.string());
+  if (!fs::is_directory(fs::absolute(path).parent_path()))
+    throw std::invalid_argument(option + ": folder " + fs::absolute(path).parent_path().string() +
+                                " does not exist");
+  return path;
+}
+
 std::optional<fs::path> FindFfmpeg() {
   const char* path = std::getenv("PATH");
   std::stringstream dirs(path ? path : "/usr/bin:/bin");
@@ -244,12 +255,8 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
     throw std::invalid_argument("--preview: expected gif, webm or none, got '" + o.preview + "'");
   if (!(o.speed >= 0.1 && o.speed <= 20.0))
     throw std::invalid_argument("--speed: expected 0.1 to 20, got " + Fixed(o.speed, 2));
-  const fs::path out = o.out.empty() ? reader.dir().parent_path() / "replay.mp4" : o.out;
-  if (out.extension() != ".mp4")
-    throw std::invalid_argument("--out: expected a .mp4 file, got " + out.string());
-  if (!fs::is_directory(fs::absolute(out).parent_path()))
-    throw std::invalid_argument("--out: folder " + fs::absolute(out).parent_path().string() +
-                                " does not exist");
+  const fs::path out = CheckOutputFile(
+      o.out.empty() ? reader.dir().parent_path() / "replay.mp4" : o.out, "--out", ".mp4");
   const auto [first, last] = FrameRange(reader, o);
   const std::vector<std::size_t> modes = SelectModes(reader.header(), o);
   const auto ffmpeg = FindFfmpeg();

@@ -18,6 +18,12 @@ struct Stopped : std::runtime_error {
   Stopped() : std::runtime_error("stopped by a signal") {}
 };
 
+/// `path` (the value of `option`) ends in `extension` and its folder exists; else
+/// std::invalid_argument naming the option. Returns `path`.
+const std::filesystem::path& CheckOutputFile(const std::filesystem::path& path,
+                                             const std::string& option,
+                                             const std::string& extension);
+
 /// `ffmpeg` on PATH, or nullopt.
 std::optional<std::filesystem::path> FindFfmpeg();
 

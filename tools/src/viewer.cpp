@@ -55,12 +55,9 @@ std::string ScriptSafe(const std::string& json) {
 }  // namespace
 
 fs::path WriteViewer(const replay::Reader& reader, const ReplayOptions& o) {
-  const fs::path out = o.html_out.empty() ? reader.dir().parent_path() / "replay.html" : o.html_out;
-  if (out.extension() != ".html")
-    throw std::invalid_argument("--html-out: expected a .html file, got " + out.string());
-  if (!fs::is_directory(fs::absolute(out).parent_path()))
-    throw std::invalid_argument("--html-out: folder " + fs::absolute(out).parent_path().string() +
-                                " does not exist");
+  const fs::path out =
+      CheckOutputFile(o.html_out.empty() ? reader.dir().parent_path() / "replay.html" : o.html_out,
+                      "--html-out", ".html");
   const auto [first, last] = FrameRange(reader, o);
   nlohmann::json index = reader.index();
   nlohmann::json frames = nlohmann::json::array();

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cell_image.hpp"
 #include "draw.hpp"
 
 namespace dualgrid::viz {
@@ -269,9 +270,18 @@ detail::SurfacePtr RasterSurface(const GridRaster& g, const CellColorOptions& op
   detail::SurfacePtr img(cairo_image_surface_create(CAIRO_FORMAT_RGB24, g.cells_x, g.cells_y));
   if (cairo_surface_status(img.get()) != CAIRO_STATUS_SUCCESS)
     throw std::runtime_error("RenderGridPanels: cannot create the raster surface");
-  cairo_surface_flush(img.get());
-  unsigned char* data = cairo_image_surface_get_data(img.get());
-  const int stride = cairo_image_surface_get_stride(img.get());
+  detail::FillCellImage(img.get(), g, options);
+  return img;
+}
+
+}  // namespace
+
+namespace detail {
+
+void FillCellImage(cairo_surface_t* img, const GridRaster& g, const CellColorOptions& options) {
+  cairo_surface_flush(img);
+  unsigned char* data = cairo_image_surface_get_data(img);
+  const int stride = cairo_image_surface_get_stride(img);
   auto to8 = [](double c) {
     return static_cast<std::uint32_t>(std::lround(std::clamp(c, 0.0, 1.0) * 255.0));
   };
@@ -284,9 +294,23 @@ detail::SurfacePtr RasterSurface(const GridRaster& g, const CellColorOptions& op
       row[x] = 0xFF000000u | (to8(c.r) << 16) | (to8(c.g) << 8) | to8(c.b);
     }
   }
-  cairo_surface_mark_dirty(img.get());
-  return img;
+  cairo_surface_mark_dirty(img);
 }
+
+void PaintCellImage(cairo_t* cr, const MapTransform& t, const GridRaster& g, cairo_surface_t* img) {
+  cairo_save(cr);
+  const Vector2 top_left = t.ToPixel(g.origin + Vector2(0.0, g.cells_y * g.resolution));
+  cairo_translate(cr, top_left.x(), top_left.y());
+  cairo_scale(cr, t.scale() * g.resolution, t.scale() * g.resolution);
+  cairo_set_source_surface(cr, img, 0.0, 0.0);
+  cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
+  cairo_rectangle(cr, 0.0, 0.0, g.cells_x, g.cells_y);
+  cairo_fill(cr);
+  cairo_restore(cr);
+}
+
+}  // namespace detail
+namespace {
 
 void PathBox(cairo_t* cr, const MapTransform& t, const OrientedBox& box) {
   cairo_new_path(cr);
@@ -336,15 +360,7 @@ void DrawPanel(cairo_t* cr, const GridPanel& panel, const MapTransform& t,
   cairo_paint(cr);
   {
     detail::SurfacePtr img = RasterSurface(g, options.cell);
-    cairo_save(cr);
-    const Vector2 top_left = t.ToPixel(g.origin + Vector2(0.0, g.cells_y * g.resolution));
-    cairo_translate(cr, top_left.x(), top_left.y());
-    cairo_scale(cr, t.scale() * g.resolution, t.scale() * g.resolution);
-    cairo_set_source_surface(cr, img.get(), 0.0, 0.0);
-    cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
-    cairo_rectangle(cr, 0.0, 0.0, g.cells_x, g.cells_y);
-    cairo_fill(cr);
-    cairo_restore(cr);
+    detail::PaintCellImage(cr, t, g, img.get());
   }
   if (!panel.particles.empty()) {
     SetColor(cr, WithAlpha(colors::kBlack, 0.5));

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "cell_image.hpp"
 #include "draw.hpp"
 
 namespace dualgrid::viz {
@@ -123,23 +124,8 @@ struct ReplayRenderer::Impl {
       cells_x = r.cells_x;
       cells_y = r.cells_y;
     }
-    cairo_surface_flush(cells.get());
-    unsigned char* data = cairo_image_surface_get_data(cells.get());
-    const int stride = cairo_image_surface_get_stride(cells.get());
-    for (int j = 0; j < r.cells_y; ++j) {
-      // Image rows run down, grid rows up.
-      auto* row = reinterpret_cast<std::uint32_t*>(data + (r.cells_y - 1 - j) * stride);
-      for (int i = 0; i < r.cells_x; ++i) {
-        const std::size_t k = static_cast<std::size_t>(j) * r.cells_x + i;
-        const Rgba c =
-            CellColor(r.free[k], r.static_occ[k], r.dynamic[k], r.mean_vx[k], r.mean_vy[k]);
-        const auto ch = [](double v) {
-          return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-        };
-        row[i] = (ch(c.r) << 16) | (ch(c.g) << 8) | ch(c.b);
-      }
-    }
-    cairo_surface_mark_dirty(cells.get());
+    // The grid figures' colours (CellColor), into the image reused across frames.
+    detail::FillCellImage(cells.get(), r, {});
   }
 
   void DrawAxes(cairo_t* cr, const MapTransform& t) {
@@ -189,15 +175,7 @@ struct ReplayRenderer::Impl {
     // Cells: one pixel per cell scaled up without smoothing (cells are the grid's truth).
     const GridRaster& r = p.raster;
     PrepareCells(r);
-    const Vector2 corner = t.ToPixel(r.origin + Vector2(0.0, r.cells_y * r.resolution));
-    cairo_save(cr);
-    cairo_translate(cr, corner.x(), corner.y());
-    cairo_scale(cr, t.scale() * r.resolution, t.scale() * r.resolution);
-    cairo_set_source_surface(cr, cells.get(), 0, 0);
-    cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
-    cairo_rectangle(cr, 0, 0, r.cells_x, r.cells_y);
-    cairo_fill(cr);
-    cairo_restore(cr);
+    detail::PaintCellImage(cr, t, r, cells.get());
 
     cairo_set_source_rgba(cr, 0.1, 0.1, 0.1, 0.55);
     for (const Position& q : p.particles) {
