@@ -81,14 +81,25 @@ void CheckNetworkFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-std::filesystem::path DefaultNetworkDir() {
-  if (const char* env = std::getenv("DUALGRID_NETWORK_DIR"); env && *env) return env;
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("DUALGRID_NETWORK_DIR"); env && *env)
+    return {env, "DUALGRID_NETWORK_DIR"};
+  std::error_code ec;
+  const fs::path self = anchor.empty() ? fs::read_symlink("/proc/self/exe", ec) : anchor;
+  if (!ec && !self.empty()) {
+    // PREFIX/bin/dualgrid -> PREFIX/share/dualgrid/networks (also PREFIX/lib/... for a library).
+    const fs::path installed =
+        self.parent_path().parent_path() / "share" / "dualgrid" / "networks";
+    if (fs::is_directory(installed, ec)) return {installed, "installed"};
+  }
 #ifdef DUALGRID_NETWORK_DIR
-  return DUALGRID_NETWORK_DIR;
-#else
-  return "networks";
+  if (fs::is_directory(DUALGRID_NETWORK_DIR, ec)) return {DUALGRID_NETWORK_DIR, "build tree"};
 #endif
+  return {"networks", "none"};
 }
+
+std::filesystem::path DefaultNetworkDir() { return FindNetworkDir().dir; }
 
 std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir) {

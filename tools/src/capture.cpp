@@ -34,7 +34,7 @@ constexpr std::uint8_t kVelocityMinDynamic = 13;
 
 }  // namespace
 
-bool LiveCounter::VelocityOk(const ModeScorer& scorer,
+bool LiveCounter::VelocityOk(const cosim::ModeScorer& scorer,
                              const std::vector<eval::TruthObject>& objects, std::size_t c) const {
   const int o = scorer.association().object_of_cluster[c];
   if (o < 0) return false;
@@ -45,7 +45,7 @@ bool LiveCounter::VelocityOk(const ModeScorer& scorer,
   return (scorer.clusters()[c].velocity - obj.velocity).norm() < tolerance;
 }
 
-Live LiveCounter::Count(const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects) {
+Live LiveCounter::Count(const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects) {
   Live l;
   const eval::AssociationResult& a = scorer.association();
   for (std::size_t o = 0; o < objects.size(); ++o) {
@@ -66,7 +66,7 @@ Live LiveCounter::Count(const ModeScorer& scorer, const std::vector<eval::TruthO
   return l;
 }
 
-Header MakeHeader(const Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
+Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
                   int max_particles) {
   const scenario::ScenarioConfig& c = pipeline.config();
   const filter::DynamicGrid& grid = pipeline.grid(0);
@@ -96,8 +96,8 @@ Header MakeHeader(const Pipeline& pipeline, const std::vector<std::string>& mode
   return h;
 }
 
-Frame Capture(const Pipeline& pipeline, const std::vector<GridSnapshot>& snapshots,
-              const std::vector<ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
+Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
+              const std::vector<cosim::ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
               const std::vector<Live>& live, const std::vector<eval::TruthObject>& objects,
               const Header& header) {
   const GridFrame& g = pipeline.grid_frame();
@@ -115,7 +115,7 @@ Frame Capture(const Pipeline& pipeline, const std::vector<GridSnapshot>& snapsho
   }
   f.modes.resize(snapshots.size());
   for (std::size_t m = 0; m < snapshots.size(); ++m) {
-    const GridSnapshot& s = snapshots[m];
+    const cosim::GridSnapshot& s = snapshots[m];
     ModeFrame& mf = f.modes[m];
     const std::size_t n = s.free.size();
     assert(s.mean_vx.size() == n);
@@ -148,7 +148,7 @@ Frame Capture(const Pipeline& pipeline, const std::vector<GridSnapshot>& snapsho
       mf.particles.push_back(static_cast<std::uint16_t>(dx / header.particle_unit));
       mf.particles.push_back(static_cast<std::uint16_t>(dy / header.particle_unit));
     }
-    const ModeScorer& sc = scorers[m];
+    const cosim::ModeScorer& sc = scorers[m];
     const auto& a = sc.association();
     for (std::size_t c = 0; c < sc.clusters().size(); ++c) {
       const eval::Cluster& cl = sc.clusters()[c];

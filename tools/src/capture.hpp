@@ -4,9 +4,9 @@
 
 #include <vector>
 
-#include "pipeline.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
 #include "recording.hpp"
-#include "scoring.hpp"
+#include "dualgrid/cosim/scoring.hpp"
 
 namespace dualgrid::tools::replay {
 
@@ -15,9 +15,9 @@ class LiveCounter {
  public:
   explicit LiveCounter(const eval::TrackingMetricsParams& params) : params_(params) {}
   /// This step's counts for the scorer's last frame; adds them to the totals.
-  Live Count(const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects);
+  Live Count(const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects);
   /// Whether cluster c of the scorer's last frame matches an object within the D_v tolerance.
-  bool VelocityOk(const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+  bool VelocityOk(const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
                   std::size_t c) const;
 
  private:
@@ -26,13 +26,13 @@ class LiveCounter {
 };
 
 /// The header for `pipeline`'s recording (before the first step: geometry from the scenario).
-Header MakeHeader(const Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
+Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
                   int max_particles);
 
 /// One frame from the pipeline's current step. `snapshots` must hold velocities
 /// (TakeSnapshot(..., true, ...)); `live` per mode from LiveCounter::Count for this step.
-Frame Capture(const Pipeline& pipeline, const std::vector<GridSnapshot>& snapshots,
-              const std::vector<ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
+Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
+              const std::vector<cosim::ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
               const std::vector<Live>& live, const std::vector<eval::TruthObject>& objects,
               const Header& header);
 

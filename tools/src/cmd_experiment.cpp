@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.hpp"
 #include "child_process.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -80,7 +81,7 @@ int RunExperiment(const ExperimentOptions& o) {
                                 std::to_string(kMaxSeed));
   ParseModes(o.run.modes);  // fail early on a bad mode
   scenario::ScenarioConfig config = LoadConfig(o.run.run);
-  CheckFilterMemory(config, o.run.modes.size());
+  cosim::CheckFilterMemory(config, o.run.modes.size());
   DetectionPath(o.run.run.out, o.run.detections);  // fail early on a bad format
   const auto& out = o.run.run.out;
   PrepareOutputFolder(out);
@@ -158,7 +159,7 @@ int RunExperiment(const ExperimentOptions& o) {
 
   // Aggregate: per mode, the metrics of every seed; object ids mapped by vehicle name so that
   // per-object results line up across seeds.
-  IdRegistry names;
+  cosim::IdRegistry names;
   std::vector<eval::ModeRuns> runs;
   for (const auto& m : o.run.modes) runs.push_back({m, {}});
   double wall = 0.0;
@@ -246,6 +247,32 @@ int RunExperiment(const ExperimentOptions& o) {
     return kExitSomeSeedsFailed;
   }
   return kExitOk;
+}
+
+Command AddExperimentCommand(CLI::App& app, const CliContext& ctx) {
+  auto o = std::make_shared<ExperimentOptions>();
+  auto no_figures = std::make_shared<bool>(false);
+  o->run.run.network_dir = ctx.network_dir;
+  o->executable = ctx.executable;
+  auto* cmd = app.add_subcommand(
+      "experiment",
+      "`run` over seeds first-seed .. first-seed + seeds - 1 (separate processes) and aggregate "
+      "the tables with 95 % confidence intervals");
+  AddRunOptions(cmd, &o->run.run, "Experiment folder", false);
+  AddFilterOptions(cmd, &o->run, no_figures.get());
+  Opt(cmd, "--seeds", &o->seeds, "Number of seeds")->check(WholeNumber(1, kMaxSeeds));
+  Opt(cmd, "--first-seed", &o->first_seed, "First seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  cmd->add_option("--jobs,-j", o->jobs,
+                  "Seed runs at a time (default: one per core, each with one OpenMP thread)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
+  return {cmd, [o, no_figures] {
+            o->run.figures = !*no_figures;
+            // Parallel runs share the cores: one OpenMP thread each unless told otherwise.
+            const int jobs = o->jobs > 0 ? o->jobs : Cores();
+            if (o->run.threads == 0 && jobs > 1) o->run.threads = 1;
+            return RunExperiment(*o);
+          }};
 }
 
 }  // namespace dualgrid::tools

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/suite.hpp"
@@ -348,6 +349,36 @@ int RunRegress(const RegressOptions& o) {
   if (failed_runs > 0) return kExitSomeSeedsFailed;
   if (failed_checks > 0 || digest_fail) return kExitRunFailed;  // 1: a check failed
   return kExitOk;
+}
+
+Command AddRegressCommand(CLI::App& app, const CliContext& ctx) {
+  auto o = std::make_shared<RegressOptions>();
+  o->network_dir = ctx.network_dir;
+  o->executable = ctx.executable;
+  auto* cmd = app.add_subcommand(
+      "regress",
+      "Run a regression suite (cases = scenario + overrides + seeds, with bands and orderings on "
+      "the metrics) and report pass/fail; exit 0 all pass, 1 a check failed, 2 bad suite, 3 a "
+      "case did not run (docs/regression.md)");
+  cmd->add_option("suite", o->suite, "Suite file (e.g. tests/regression/suite.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  Opt(cmd, "--out,-o", &o->out, "Folder for the case runs and the reports")->check(NonEmptyPath());
+  cmd->add_option("--record", o->record,
+                  "Also write the suite with bands recorded from this run (mean ± max(3 CI, "
+                  "floor)) and the digests to this file")
+      ->check(NonEmptyPath());
+  cmd->add_flag("--require-digests", o->require_digests,
+                "A changed digest (same seed, different outputs) fails the suite");
+  cmd->add_option("--set", o->sets, "Override a scenario key in every case, KEY=VALUE")
+      ->check(OverrideSpec());
+  cmd->add_option("--jobs,-j", o->jobs,
+                  "Seed runs at a time (default: one per core, each with one OpenMP thread)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
+  Opt(cmd, "--network-dir", &o->network_dir, "Folder of the built networks")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
+  return {cmd, [o] { return RunRegress(*o); }};
 }
 
 }  // namespace dualgrid::tools

@@ -3,6 +3,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "output.hpp"
 #include "recording.hpp"
@@ -36,6 +37,48 @@ int RunReplay(const ReplayOptions& options) {
     }
   }
   return 0;
+}
+
+Command AddReplayCommand(CLI::App& app, const CliContext&) {
+  auto o = std::make_shared<ReplayOptions>();
+  auto* cmd = app.add_subcommand(
+      "replay",
+      "Video (MP4 + GIF preview) and/or interactive HTML viewer of a recorded run, without "
+      "rerunning SUMO (docs/replay.md)");
+  cmd->add_option("run_dir", o->run_dir, "Run folder written by `dualgrid run`")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--video", o->video, "Write the video (the default unless --html is given)");
+  cmd->add_flag("--html", o->html, "Write the self-contained interactive viewer");
+  cmd->add_option("--out,-o", o->out, "Video file (default RUN_DIR/replay.mp4)")
+      ->check(NonEmptyPath());
+  cmd->add_option("--html-out", o->html_out, "Viewer file (default RUN_DIR/replay.html)")
+      ->check(NonEmptyPath());
+  cmd->add_option("--modes", o->modes, "Video: modes to show, comma-separated (default: all recorded)")
+      ->delimiter(',');
+  cmd->add_flag("--particles", o->particles, "Video: draw the recorded particles");
+  cmd->add_flag_callback(
+      "--no-detections", [o] { o->detections = false; }, "Video: leave the detections out");
+  Opt(cmd, "--from", &o->from, "First time [s]")->check(Number(0.0, kMaxDuration, false));
+  Opt(cmd, "--to", &o->to, "Last time [s] (0: the end)")->check(Number(0.0, kMaxDuration, false));
+  Opt(cmd, "--speed", &o->speed, "Video playback speed (1: real time)")
+      ->check(Number(0.1, 20.0, false));
+  Opt(cmd, "--width", &o->width, "Video width [px] (even)")->check(WholeNumber(320, 7680));
+  Opt(cmd, "--preview", &o->preview, "Short preview beside the video: gif, webm or none")
+      ->check(CLI::IsMember({"gif", "webm", "none"}));
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
+  return {cmd, [o, cmd] {
+            // The viewer has its own controls for these: given with --html alone they would be
+            // ignored.
+            if (o->html && !o->video)
+              for (const char* name : {"--out", "--modes", "--particles", "--no-detections",
+                                       "--speed", "--width", "--preview"})
+                if (cmd->count(name) > 0)
+                  throw std::invalid_argument(std::string(name) +
+                                              " is a video option; add --video, or leave it out "
+                                              "(the viewer has its own controls)");
+            return RunReplay(*o);
+          }};
 }
 
 }  // namespace dualgrid::tools

@@ -7,10 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "output.hpp"
-#include "pipeline.hpp"
+#include "dualgrid/cosim/cosimulation.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
 
@@ -21,11 +22,13 @@ int RunSim(const SimOptions& sim_options) {
   scenario::ScenarioConfig config = LoadConfig(options);
   const auto detections_path = DetectionPath(options.out, sim_options.detections);
   const sim::ScenarioSpec& spec = config.sim;
+  cosim::CoSimulation cosim(config, {.modes = {}});  // SUMO and the radar, no filter
   PrepareOutputFolder(options.out);
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();
-  Pipeline pipeline(config, options.network_dir, options.out, {});
+  cosim.Start(options.network_dir, options.out);
+  const cosim::Pipeline& pipeline = cosim.pipeline();
   GroundTruthWriter truth(options.out / "ground_truth.csv");
   std::unique_ptr<DetectionWriter> detections;
   if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path);
@@ -39,7 +42,7 @@ int RunSim(const SimOptions& sim_options) {
   Progress progress("sim " + spec.name, spec.StepCount(), !options.quiet);
   int steps = 0;
   std::size_t detection_count = 0, clutter_count = 0;
-  while (!StopSignal() && pipeline.Step()) {
+  while (!StopSignal() && cosim.Step()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
@@ -70,7 +73,8 @@ int RunSim(const SimOptions& sim_options) {
   summary["wall_s"] = wall;
   summary["detections"] = detection_count;
   summary["clutter_detections"] = clutter_count;
-  for (const auto& sensor : pipeline.radar().sensors()) summary["sensors"].push_back(sensor.name);
+  summary["sensors"] = nlohmann::json::array();
+  for (const auto& sensor : config.radar.sensors) summary["sensors"].push_back(sensor.name);
   for (const auto& [id, s] : seen) {
     summary["vehicles"][id] = {{"type", s.type},
                                {"first_s", s.first},
@@ -98,6 +102,18 @@ int RunSim(const SimOptions& sim_options) {
               << options.out.string() << "\n";
   }
   return 0;
+}
+
+Command AddSimCommand(CLI::App& app, const CliContext& ctx) {
+  auto o = std::make_shared<SimOptions>();
+  o->run.network_dir = ctx.network_dir;
+  auto* cmd = app.add_subcommand(
+      "sim", "Run SUMO and the radar model; write ground truth and detections (CSV)");
+  AddRunOptions(cmd, &o->run, "Output folder", true);
+  Opt(cmd, "--detections", &o->detections,
+      "Write the radar detections: none, csv, or csv.gz (gzip, about 3.5x smaller)")
+      ->check(DetectionFormat());
+  return {cmd, [o] { return RunSim(*o); }};
 }
 
 }  // namespace dualgrid::tools

@@ -1,10 +1,11 @@
 // `dualgrid snapshot`: a bird's-eye picture of a scenario at one time.
 #include <iostream>
 
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "figures.hpp"
 #include "output.hpp"
-#include "pipeline.hpp"
+#include "dualgrid/cosim/cosimulation.hpp"
 
 namespace dualgrid::tools {
 
@@ -26,15 +27,38 @@ int RunSnapshot(const SnapshotOptions& options) {
   // SUMO's route file and log are working files of this command only: a temporary folder,
   // removed afterwards (kept, and named, only if SUMO fails, for its log).
   TempDir work("snapshot");
-  Pipeline pipeline(config, run.network_dir, work.path(), {});
-  while (pipeline.Step()) {
+  cosim::CoSimulation cosim(config, {.modes = {}});  // SUMO and the radar, no filter
+  cosim.Start(run.network_dir, work.path());
+  while (cosim.Step()) {
   }
+  const cosim::Pipeline& pipeline = cosim.pipeline();
+  if (!pipeline.has_radar())
+    throw std::runtime_error("the ego never departed before t = " + Fixed(options.time, 2) +
+                             " s: nothing to draw");
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
   RenderScene(pipeline, png, options.behind, options.ahead, options.half_width);
   if (!run.quiet)
     std::cout << "wrote " << png.string() << " (t = " << Fixed(pipeline.frame().time, 2) << " s, "
               << pipeline.detections().size() << " detections)\n";
   return 0;
+}
+
+Command AddSnapshotCommand(CLI::App& app, const CliContext& ctx) {
+  auto o = std::make_shared<SnapshotOptions>();
+  o->run.network_dir = ctx.network_dir;
+  auto* cmd = app.add_subcommand(
+      "snapshot",
+      "Bird's-eye picture (PNG) of a scenario at one time: road, vehicles, radar "
+      "fields of view, detections with radial-velocity arrows");
+  AddRunOptions(cmd, &o->run, "PNG file to write (must end in .png)", true);
+  cmd->add_option("--time,-t", o->time, "Scenario time [s]")
+      ->required()
+      ->check(Number(0.0, kMaxDuration, true));
+  Opt(cmd, "--behind", &o->behind, "View behind the ego [m]")->check(Number(0.0, 2000.0, true));
+  Opt(cmd, "--ahead", &o->ahead, "View ahead of the ego [m]")->check(Number(0.0, 2000.0, true));
+  Opt(cmd, "--half-width", &o->half_width, "View to each side of the ego [m]")
+      ->check(Number(0.0, 1000.0, true));
+  return {cmd, [o] { return RunSnapshot(*o); }};
 }
 
 }  // namespace dualgrid::tools

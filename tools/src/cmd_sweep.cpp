@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.hpp"
 #include "child_process.hpp"
 #include "cli_checks.hpp"
 #include "commands.hpp"
@@ -470,6 +471,54 @@ int RunCollect(const CollectOptions& o) {
     for (const auto& m : missing) std::cerr << "collect: missing " << m << "\n";
   }
   return complete == total ? kExitOk : kExitSomeSeedsFailed;
+}
+
+Command AddSweepCommand(CLI::App& app, const CliContext& ctx) {
+  auto o = std::make_shared<SweepOptions>();
+  o->network_dir = ctx.network_dir;
+  o->executable = ctx.executable;
+  auto* cmd = app.add_subcommand(
+      "sweep",
+      "Run a scenario (or the tangential generator) over a grid of key values and seeds: "
+      "locally, or as a run list / Slurm job array (docs/stress.md)");
+  cmd->add_option("scenario", o->scenario,
+                  "Scenario file, or 'tangential' to sweep the stress-case generator "
+                  "(keys tangential.angle, tangential.sensor, ...)")
+      ->required();
+  cmd->add_option("--out,-o", o->out, "Sweep folder (resumable: finished runs are kept)")
+      ->required()
+      ->check(NonEmptyPath());
+  cmd->add_option("--set", o->sets,
+                  "KEY=LIST to sweep (repeatable): values a,b,c and/or ranges first:step:last, "
+                  "e.g. filter.sigma_v=0.5,1,2 or tangential.angle=0:15:90")
+      ->required();
+  Opt(cmd, "--seeds", &o->seeds, "Seeds per setting")->check(WholeNumber(1, kMaxSeeds));
+  Opt(cmd, "--first-seed", &o->first_seed, "First seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  cmd->add_option("--modes", o->modes, "Weight modes (default: all three)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"position", "velocity", "dual"}));
+  cmd->add_option("--duration", o->duration, "Simulated time per run [s]")
+      ->check(Number(0.0, kMaxDuration, true));
+  cmd->add_option("--jobs,-j", o->jobs, "Runs at a time (default: one per core, 1 thread each)")
+      ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
+  cmd->add_option("--emit", o->emit,
+                  "Do not run: 'list' writes runs.txt (one shell command per run, e.g. for GNU "
+                  "parallel), 'slurm' also slurm.sh (a job array); then `dualgrid collect`")
+      ->check(CLI::IsMember({"list", "slurm"}));
+  Opt(cmd, "--network-dir", &o->network_dir, "Folder of the built networks")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
+  return {cmd, [o] { return RunSweep(*o); }};
+}
+
+Command AddCollectCommand(CLI::App& app, const CliContext&) {
+  auto o = std::make_shared<CollectOptions>();
+  auto* cmd = app.add_subcommand(
+      "collect", "Merge the finished runs of a sweep folder into tables and figures");
+  cmd->add_option("dir", o->dir, "Sweep folder")->required()->check(CLI::ExistingDirectory);
+  cmd->add_flag("--quiet,-q", o->quiet, "No summary output");
+  return {cmd, [o] { return RunCollect(*o); }};
 }
 
 }  // namespace dualgrid::tools

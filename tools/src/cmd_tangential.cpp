@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "cli_options.hpp"
 #include "aspect_case.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
@@ -182,6 +183,69 @@ int RunTangential(const TangentialOptions& o) {
     std::cout << "wrote " << o.out.string() << "; run it with: dualgrid run " << o.out.string()
               << " --out run/" << o.out.stem().string() << "\n";
   return 0;
+}
+
+Command AddTangentialCommand(CLI::App& app, const CliContext&) {
+  auto o = std::make_shared<TangentialOptions>();
+  auto* cmd =
+      app.add_subcommand("tangential",
+                         "Write a tangential-motion stress scenario (traffic crossing ahead of the "
+                         "ego, or driving alongside it), to run with `dualgrid run`");
+  Opt(cmd, "--kind", &o->kind,
+      "crossing (ahead, across the front radar), parallel (alongside, across the corner "
+      "radars), or aspect (any --angle to any --sensor's line of sight; docs/stress.md)")
+      ->check(CLI::IsMember({"crossing", "parallel", "aspect"}));
+  Opt(cmd, "--sensor", &o->sensor, "aspect: the radar whose line of sight the angle refers to")
+      ->check(CLI::IsMember({"front", "front_left", "front_right", "rear_left", "rear_right"}));
+  Opt(cmd, "--angle", &o->angle,
+      "aspect: angle between the targets' velocity over ground and the line of sight [deg] "
+      "(0 receding, 90 across, 180 approaching)")
+      ->check(Number(0.0, 180.0, false));
+  Opt(cmd, "--range", &o->range,
+      "aspect: distance sensor -> target centre when on the sensor's boresight [m]")
+      ->check(Number(1.0, 200.0, false));
+  Opt(cmd, "--target", &o->target, "aspect: car, truck or cyclist")
+      ->check(CLI::IsMember({"car", "truck", "cyclist"}));
+  Opt(cmd, "--interval", &o->interval, "aspect: seconds between the targets")
+      ->check(Number(1.0, 60.0, false));
+  cmd->add_option("--grid-width", o->grid_width,
+                  "aspect: the grid's width (filter.width_y) [m] (default: the paper's 25, "
+                  "widened when a target would not be scored in it)")
+      ->check(Number(5.0, 400.0, false));
+  Opt(cmd, "--count", &o->count, "Number of stress vehicles")->check(WholeNumber(1, 12));
+  Opt(cmd, "--ego-speed", &o->ego_speed, "Ego speed [m/s] (0, a parked ego: aspect only)")
+      ->check(Number(0.0, 40.0, false));
+  cmd->add_option("--speed", o->speed,
+                  "Stress vehicles' speed over ground [m/s] (default: crossing 15; parallel "
+                  "ego speed + 0.3, so they stay alongside)")
+      ->check(Number(0.0, 40.0, true));
+  Opt(cmd, "--first-distance", &o->first_distance,
+      "crossing: distance ahead of the ego of the first crossing [m]")
+      ->check(Number(10.0, 600.0, false));
+  cmd->add_option("--spacing", o->spacing,
+                  "crossing: distance between crossings (default 20 m); parallel: distance "
+                  "between vehicles of one lane (default 40 m) [m]")
+      ->check(Number(0.0, 600.0, true));
+  Opt(cmd, "--seed", &o->seed, "Scenario seed")
+      ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
+  cmd->add_option("--out,-o", o->out, "Scenario file to write (.yaml)")
+      ->required()
+      ->check(NonEmptyPath());
+  cmd->add_flag("--quiet,-q", o->quiet, "No summary");
+  return {cmd, [o, cmd] {
+            // The aspect options imply --kind aspect; with another kind they would be ignored.
+            bool aspect_options = false;
+            for (const char* name :
+                 {"--sensor", "--angle", "--range", "--target", "--interval", "--grid-width"})
+              aspect_options = aspect_options || cmd->count(name) > 0;
+            if (aspect_options && cmd->count("--kind") == 0) o->kind = "aspect";
+            if (aspect_options && o->kind != "aspect")
+              throw std::invalid_argument(
+                  "--sensor, --angle, --range, --target, --interval and "
+                  "--grid-width are options of --kind aspect, not " +
+                  o->kind);
+            return RunTangential(*o);
+          }};
 }
 
 }  // namespace dualgrid::tools

@@ -58,7 +58,7 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
   return all;
 }
 
-void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
+void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width) {
   const sim::Frame& f = pipeline.frame();
   const GridFrame& g = pipeline.grid_frame();
@@ -129,7 +129,7 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
 
 namespace {
 
-viz::GridRaster ToRaster(const GridSnapshot& s) {
+viz::GridRaster ToRaster(const cosim::GridSnapshot& s) {
   return {s.cells_x,    s.cells_y, s.resolution, s.origin, s.free,
           s.static_occ, s.dynamic, s.mean_vx,    s.mean_vy};
 }
@@ -137,8 +137,8 @@ viz::GridRaster ToRaster(const GridSnapshot& s) {
 }  // namespace
 
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots,
-                      const std::vector<ModeScorer>& scorers, const GridFrame& g,
+                      const std::vector<cosim::GridSnapshot>& snapshots,
+                      const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
                       const sim::Frame& frame, double time, const std::filesystem::path& path) {
   // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
   // not with the network's (often UTM-sized) coordinates.
@@ -160,7 +160,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
     panel.ego_boxes.push_back(from_ego(g.ToGrid(frame.ego.box)));
     // The scorer's clusters of this step (grid frame) with their roles: what the mode tracks and
     // at which estimated velocity.
-    const ModeScorer& sc = scorers[i];
+    const cosim::ModeScorer& sc = scorers[i];
     for (std::size_t c = 0; c < sc.clusters().size(); ++c) {
       const eval::Cluster& cl = sc.clusters()[c];
       panel.clusters.push_back({cl.min - ego, cl.max - ego, cl.position - ego, cl.velocity,
@@ -184,7 +184,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
 }
 
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
-                               const IdRegistry& ids, bool velocity_aware) {
+                               const cosim::IdRegistry& ids, bool velocity_aware) {
   std::map<int, std::vector<double>> per_object;  // by id: order of first appearance
   for (std::size_t m = 0; m < metrics.size(); ++m) {
     for (const auto& o : metrics[m].objects) {

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "dualgrid/eval/metrics.hpp"
-#include "pipeline.hpp"
-#include "scoring.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/cosim/scoring.hpp"
 
 namespace dualgrid::tools {
 
@@ -32,7 +32,7 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
 /// fields of view and the step's detections with their radial-velocity arrows, drawn in the grid
 /// frame (pipeline.grid_frame(): the world turned so that the grid's axes are the picture's). The
 /// view spans [ego.x - behind, ego.x + ahead] x [ego.y - half_width, ego.y + half_width] there.
-void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, double behind,
+void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
                  double ahead, double half_width);
 
 /// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined; in the
@@ -40,8 +40,8 @@ void RenderScene(const Pipeline& pipeline, const std::filesystem::path& path, do
 /// `scorers` hold each mode's clusters of this step (drawn with their roles and estimated
 /// velocities beside the true velocities).
 void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<GridSnapshot>& snapshots,
-                      const std::vector<ModeScorer>& scorers, const GridFrame& grid_frame,
+                      const std::vector<cosim::GridSnapshot>& snapshots,
+                      const std::vector<cosim::ModeScorer>& scorers, const GridFrame& grid_frame,
                       const sim::Frame& frame, double time, const std::filesystem::path& path);
 
 /// D per object (name) and mode; NaN where a mode did not score the object.
@@ -57,7 +57,7 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 /// The scored objects' D (or D_v, `velocity_aware`) of one run, per mode (object ids named
 /// through `ids`).
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
-                               const IdRegistry& ids, bool velocity_aware);
+                               const cosim::IdRegistry& ids, bool velocity_aware);
 
 /// Particle weights on one object over time (paper Fig. 4). The filter normalises both weights
 /// per cell, so their sums over an object are equal; what differs is *which* particles carry

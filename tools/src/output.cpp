@@ -230,7 +230,7 @@ DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(path)
       "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter\n";
 }
 
-void DetectionWriter::Write(const Pipeline& p) {
+void DetectionWriter::Write(const cosim::Pipeline& p) {
   const auto& f = p.frame();
   std::ostringstream os;
   os.precision(10);

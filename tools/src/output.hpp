@@ -11,7 +11,7 @@
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
-#include "pipeline.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
 
 namespace dualgrid::tools {
 
@@ -68,7 +68,7 @@ class GroundTruthWriter {
 class DetectionWriter {
  public:
   explicit DetectionWriter(const std::filesystem::path& path);
-  void Write(const Pipeline& pipeline);
+  void Write(const cosim::Pipeline& pipeline);
   void Close() { out_.Close(); }
 
  private:

@@ -10,8 +10,8 @@ ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
 }
 
 void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::string& mode,
-                          const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
-                          const IdRegistry& ids) {
+                          const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+                          const cosim::IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
   std::ostringstream os;
@@ -32,7 +32,7 @@ void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::st
   out_.MaybeFlush();
 }
 
-void WeightTraces::Add(const Pipeline& pipeline, std::size_t mode) {
+void WeightTraces::Add(const cosim::Pipeline& pipeline, std::size_t mode) {
   const sim::Frame& f = pipeline.frame();
   const auto& grid = pipeline.grid(mode);
   const auto& p = grid.particles();
@@ -93,7 +93,7 @@ std::string WeightTraces::Focus() const {
   return focus;
 }
 
-void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot& snapshot,
+void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m, const cosim::GridSnapshot& snapshot,
                     const std::filesystem::path& path) {
   OutputFile pc(path);
   pc.buffer() += "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
@@ -119,7 +119,7 @@ void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot&
 }
 
 void WriteObjects(const std::vector<std::string>& modes,
-                  const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
+                  const std::vector<eval::ScenarioMetrics>& metrics, const cosim::IdRegistry& ids,
                   const std::filesystem::path& path) {
   std::ostringstream os;
   os << "mode,id,name,frames_in_grid,frames_tracked,frames_tracked_v,scored,D,D_v,t_d,delta_x,"
@@ -155,7 +155,7 @@ void WriteTables(const eval::ComparisonTable& table, const std::filesystem::path
 }
 
 std::vector<std::string> UnscoredNotes(const std::vector<eval::ScenarioMetrics>& metrics,
-                                       const IdRegistry& ids, int min_frames_in_grid) {
+                                       const cosim::IdRegistry& ids, int min_frames_in_grid) {
   // Every mode sees the same vehicles in the same grid: the first mode's objects suffice.
   if (metrics.empty()) return {};
   std::string list;

@@ -13,8 +13,8 @@
 #include "dualgrid/eval/aggregate.hpp"
 #include "figures.hpp"
 #include "output.hpp"
-#include "pipeline.hpp"
-#include "scoring.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/cosim/scoring.hpp"
 
 namespace dualgrid::tools {
 
@@ -25,8 +25,8 @@ class ClusterWriter {
   /// The clusters of `scorer`'s last frame, for mode `mode`; `objects` as given to the scorer.
   /// Clusters are scored in the grid frame and written in the world frame.
   void Write(const sim::Frame& frame, const GridFrame& grid_frame, const std::string& mode,
-             const ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
-             const IdRegistry& ids);
+             const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+             const cosim::IdRegistry& ids);
   void Close() { out_.Close(); }
 
  private:
@@ -46,19 +46,19 @@ struct WeightTraces {
   std::map<std::string, int> frames_in_grid;
   std::set<std::string> dropped;
   /// Adds the current step of `pipeline` for filter `mode`.
-  void Add(const Pipeline& pipeline, std::size_t mode);
+  void Add(const cosim::Pipeline& pipeline, std::size_t mode);
   /// The requested focus object if it was in the grid, else the candidate longest in the grid;
   /// empty when no vehicle was.
   std::string Focus() const;
 };
 
 /// figures/particles_<mode>_t<time>.csv: every particle of filter `m` with its cell's P(dynamic).
-void WriteParticles(const Pipeline& pipeline, std::size_t m, const GridSnapshot& snapshot,
+void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m, const cosim::GridSnapshot& snapshot,
                     const std::filesystem::path& path);
 
 /// objects.csv: one row per (mode, object ever in the grid).
 void WriteObjects(const std::vector<std::string>& modes,
-                  const std::vector<eval::ScenarioMetrics>& metrics, const IdRegistry& ids,
+                  const std::vector<eval::ScenarioMetrics>& metrics, const cosim::IdRegistry& ids,
                   const std::filesystem::path& path);
 
 /// weights.csv of one vehicle's trace.
@@ -70,6 +70,6 @@ void WriteTables(const eval::ComparisonTable& table, const std::filesystem::path
 
 /// Notes for the table: the objects that were in the grid but too briefly to be scored.
 std::vector<std::string> UnscoredNotes(const std::vector<eval::ScenarioMetrics>& metrics,
-                                       const IdRegistry& ids, int min_frames_in_grid);
+                                       const cosim::IdRegistry& ids, int min_frames_in_grid);
 
 }  // namespace dualgrid::tools

@@ -16,8 +16,21 @@
 
 namespace dualgrid::sim {
 
-/// Default folder of the generated networks (the build's networks/ folder), overridden by the
-/// environment variable DUALGRID_NETWORK_DIR.
+/// Where the built SUMO networks were found, and why there.
+struct NetworkDirLocation {
+  std::filesystem::path dir;
+  /// "DUALGRID_NETWORK_DIR" (the environment), "installed" (share/dualgrid/networks beside the
+  /// program or library), "build tree" (the build's networks/ folder, compiled in), or "none".
+  std::string source;
+};
+/// The first of: the environment variable DUALGRID_NETWORK_DIR; `PREFIX/share/dualgrid/networks`
+/// where PREFIX is the parent of the folder holding `anchor` (the running program by default,
+/// /proc/self/exe: an installed bin/dualgrid finds its own tree wherever it was moved); the build
+/// tree's networks/ folder compiled into this library. Only folders that exist count (the
+/// environment variable excepted: it is the user's explicit choice); source "none" with the
+/// relative path "networks" when none does.
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {});
+/// FindNetworkDir().dir.
 std::filesystem::path DefaultNetworkDir();
 
 /// Resolves a scenario's network to an existing .net.xml file: a name ("highway") is looked up

@@ -1,5 +1,5 @@
-// Glue between one filter and the scoring library: picks the particles of dynamic cells,
-// clusters them, scores clusters against the ground truth and classifies cells (paper Sec. V).
+// Scoring one filter cycle (paper Sec. V): picks the particles of dynamic cells, clusters them,
+// scores the clusters against the ground truth and classifies cells. Everything in the grid frame.
 #pragma once
 
 #include <string>
@@ -13,14 +13,14 @@
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::cosim {
 
 /// Per-cell snapshot of a grid in logical row-major order (index = y * cells_x + x).
 struct GridSnapshot {
   int cells_x = 0, cells_y = 0;
   double resolution = 0.0;                    ///< [m]
   std::int64_t origin_ix = 0, origin_iy = 0;  ///< global index of cell (0, 0)
-  Position origin = Position::Zero();         ///< lower-left corner of cell (0, 0), world [m]
+  Position origin = Position::Zero();  ///< lower-left corner of cell (0, 0), grid frame [m]
   std::vector<float> free, static_occ, dynamic;
   std::vector<std::uint8_t> observed;
   /// Mean velocity over ground [m/s] per cell; empty unless taken `with_velocity`.
@@ -62,4 +62,4 @@ class ModeScorer {
   std::vector<std::uint8_t> predicted_;
 };
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::cosim

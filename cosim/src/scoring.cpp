@@ -1,8 +1,8 @@
-#include "scoring.hpp"
+#include "dualgrid/cosim/scoring.hpp"
 
 #include <cmath>
 
-namespace dualgrid::tools {
+namespace dualgrid::cosim {
 
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s) {
   s.cells_x = grid.cells_x();
@@ -127,4 +127,4 @@ eval::ScenarioMetrics ModeScorer::Result() const {
   return m;
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::cosim

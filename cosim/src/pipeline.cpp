@@ -1,4 +1,4 @@
-#include "pipeline.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
 
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-namespace dualgrid::tools {
+namespace dualgrid::cosim {
 
 int IdRegistry::Id(const std::string& name) {
   auto [it, inserted] = ids_.try_emplace(name, static_cast<int>(names_.size()));
@@ -25,8 +25,7 @@ const std::string& IdRegistry::Name(int id) const {
   return names_[id];
 }
 
-const scenario::ScenarioConfig& CheckFilterMemory(const scenario::ScenarioConfig& config,
-                                                  std::size_t modes) {
+void CheckFilterMemory(const scenario::ScenarioConfig& config, std::size_t modes) {
   const double need = static_cast<double>(modes) * config.filter.MemoryBytes();
   const double have =
       static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
@@ -41,15 +40,18 @@ const scenario::ScenarioConfig& CheckFilterMemory(const scenario::ScenarioConfig
                   need / 1e9, have / 1e9);
     throw std::invalid_argument(buf);
   }
-  return config;
 }
 
-Pipeline::Pipeline(const scenario::ScenarioConfig& config, const std::filesystem::path& network_dir,
-                   const std::filesystem::path& work_dir, std::vector<filter::WeightMode> modes)
-    : config_(CheckFilterMemory(config, modes.size())),
-      simulation_(config.sim, sim::ResolveNetwork(config.sim.network, network_dir), work_dir),
-      radar_(config.radar.sensors, config.radar.options, config.sim.seed),
-      modes_(std::move(modes)) {
+Pipeline::Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::WeightMode> modes)
+    : config_(config), modes_(std::move(modes)) {
+  CheckFilterMemory(config_, modes_.size());
+  // The loader validated the sensors; a caller that built its configuration by hand learns of a
+  // bad one here rather than at the ego's departure, when the radar is built.
+  for (const radar::SensorParams& s : config_.radar.sensors) {
+    std::string error;
+    if (!s.IsValid(&error))
+      throw std::invalid_argument("sensor '" + s.name + "': " + error);
+  }
   for (filter::WeightMode m : modes_) {
     filter::FilterParams p = config_.FilterFor(m);
     // The same seed for every mode: birth and prediction noise are identical across modes until
@@ -62,17 +64,18 @@ Pipeline::Pipeline(const scenario::ScenarioConfig& config, const std::filesystem
     static_scene_.targets.push_back({ids_.Id(p.id), p.box, Velocity::Zero(), 0.0, p.rcs_dbsm});
 }
 
+void Pipeline::Start(const std::filesystem::path& network_dir,
+                     const std::filesystem::path& work_dir) {
+  if (simulation_) throw std::logic_error("Pipeline::Start called twice");
+  simulation_ = std::make_unique<sim::SumoSimulation>(
+      config_.sim, sim::ResolveNetwork(config_.sim.network, network_dir), work_dir);
+}
+
 radar::Scene Pipeline::BuildScene() {
   radar::Scene scene = static_scene_;
   for (const sim::VehicleState& v : frame().vehicles)
     scene.targets.push_back({ids_.Id(v.id), v.box, v.velocity, v.yaw_rate, v.rcs_dbsm});
   return scene;
-}
-
-bool Pipeline::Step() {
-  if (!Advance()) return false;
-  for (std::size_t i = 0; i < filters_.size(); ++i) UpdateFilter(i);
-  return true;
 }
 
 void Pipeline::UpdateFilter(std::size_t i) {
@@ -84,31 +87,34 @@ void Pipeline::UpdateFilter(std::size_t i) {
       measurements_, coverage_, dt_);
 }
 
+void Pipeline::FixFrameAndRig(const sim::Frame& f) {
+  // Whole degrees: a road along a world axis keeps an exactly world-aligned grid (SUMO's
+  // headings carry ~1e-6 deg of rounding), and 0.5 deg is 0.9 m across at 100 m.
+  const double yaw = config_.grid.frame == scenario::GridPlacement::Frame::kHeading
+                         ? DegToRad(std::round(RadToDeg(ego_.pose.yaw)))
+                         : 0.0;
+  grid_frame_ = GridFrame(WrapAngle(yaw) == 0.0 ? 0.0 : yaw);
+  centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
+  // The default radars sit on the ego's box as SUMO simulates it: an ego of the user's route
+  // files may not have the scenario type's box (a 5 m SUMO car put the front radar inside it).
+  scenario::RadarConfig rig = config_.radar;
+  scenario::PlaceRigOn(&rig, f.ego.box.length, f.ego.box.width);
+  radar_.emplace(rig.sensors, rig.options, config_.sim.seed);
+}
+
 bool Pipeline::Advance() {
-  if (!simulation_.Step()) return false;
+  if (!simulation_) throw std::logic_error("Pipeline::Advance before Start");
+  if (!simulation_->Step()) return false;
   const sim::Frame& f = frame();
   ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
   // The first filter cycle (the ego may depart late) predicts over one step.
   dt_ = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
-  if (!frame_fixed_) {
-    // Whole degrees: a road along a world axis keeps an exactly world-aligned grid (SUMO's
-    // headings carry ~1e-6 deg of rounding), and 0.5 deg is 0.9 m across at 100 m.
-    const double yaw = config_.grid.frame == scenario::GridPlacement::Frame::kHeading
-                           ? DegToRad(std::round(RadToDeg(ego_.pose.yaw)))
-                           : 0.0;
-    grid_frame_ = GridFrame(WrapAngle(yaw) == 0.0 ? 0.0 : yaw);
-    centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
-    // The default radars sit on the ego's box as SUMO simulates it: an ego of the user's route
-    // files may not have the scenario type's box (a 5 m SUMO car put the front radar inside it).
-    if (scenario::PlaceRigOn(&config_.radar, f.ego.box.length, f.ego.box.width))
-      radar_ = radar::RadarModel(config_.radar.sensors, config_.radar.options, config_.sim.seed);
-    frame_fixed_ = true;
-  }
+  if (!radar_) FixFrameAndRig(f);
   last_time_ = f.time;
 
-  detections_ = radar_.Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
+  detections_ = radar_->Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
                             config_.sim.step_length);
-  scanned_ = radar_.SensorsDue(f.time, config_.sim.step_length);
+  scanned_ = radar_->SensorsDue(f.time, config_.sim.step_length);
 
   if (filters_.empty()) return true;
   measurements_.clear();
@@ -124,17 +130,17 @@ bool Pipeline::Advance() {
   }
   coverage_.clear();
   for (int s : scanned_) {
-    const radar::SensorParams& p = radar_.sensors()[s];
-    const Pose2 pose = radar_.SensorPose(s, ego_.pose);
+    const radar::SensorParams& p = radar_->sensors()[s];
+    const Pose2 pose = radar_->SensorPose(s, ego_.pose);
     coverage_.push_back(
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
   return true;
 }
 
-std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) {
+std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) const {
   std::vector<eval::TruthObject> out;
-  const auto poses = radar_.SensorPoses(ego_.pose);
+  const auto poses = radar_->SensorPoses(ego_.pose);
   // Sources of this step's detections inside the grid: the t_d clock starts at a vehicle's first.
   std::vector<int> detected;
   const GridFrame& g = grid_frame_;
@@ -150,7 +156,7 @@ std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid&
     o.velocity = g.VectorToGrid(v.velocity);
     o.in_grid = grid.CellOf(o.box.center).has_value();
     for (std::size_t s = 0; s < poses.size() && !o.in_coverage; ++s) {
-      const radar::SensorParams& p = radar_.sensors()[s];
+      const radar::SensorParams& p = radar_->sensors()[s];
       const Position local = poses[s].ToLocal(v.box.center);
       const double r = local.norm();
       o.in_coverage = r >= p.min_range && r <= p.max_range &&
@@ -161,4 +167,4 @@ std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid&
   return out;
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::cosim

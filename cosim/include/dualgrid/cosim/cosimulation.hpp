@@ -1,0 +1,105 @@
+// The co-simulation step: SUMO -> radar -> one grid filter per weight mode -> scoring, with hooks
+// (StepObserver) for what a caller does after each step (writers, a replay recorder, figures).
+// The data's way: scenario -> CoSimulation::Step() -> observers; results by Metrics().
+//
+//   cosim::CoSimulation cs(config, {.modes = {filter::WeightMode::kDual}});
+//   cs.Start(sim::DefaultNetworkDir(), work_dir);   // SUMO
+//   MyWriter w;  cs.AddObserver(&w);
+//   while (cs.Step()) {}
+//   const auto metrics = cs.Metrics();              // one eval::ScenarioMetrics per mode
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/cosim/scoring.hpp"
+#include "dualgrid/eval/metrics.hpp"
+
+namespace dualgrid::cosim {
+
+struct CoSimOptions {
+  /// Weight modes run side by side on the same detections; empty: SUMO and the radar only.
+  std::vector<filter::WeightMode> modes = {filter::WeightMode::kPosition,
+                                           filter::WeightMode::kVelocity,
+                                           filter::WeightMode::kDual};
+  /// OpenMP threads; 0: the OpenMP default. The modes run as concurrent tasks (one thread each);
+  /// threads beyond one per mode go to each filter's own loops. Results do not depend on it.
+  int threads = 0;
+};
+
+/// What observers see after a step. Every reference is valid during OnStep() only.
+struct StepView {
+  int step = 0;  ///< 0 for the first step of the run
+  const sim::Frame& frame;
+  const Pipeline& pipeline;  ///< detections, radar, grids, grid frame, ids
+  const std::vector<std::string>& mode_names;
+  /// Per mode: the cell masses (and mean velocities if some observer asked, see
+  /// StepObserver::WantsVelocities) after this step's filter cycle.
+  const std::vector<GridSnapshot>& snapshots;
+  /// Per mode: this step's clusters and their association (ModeScorer::clusters()).
+  const std::vector<ModeScorer>& scorers;
+  /// Ground-truth objects in the grid frame, as scored (the same for every mode).
+  const std::vector<eval::TruthObject>& objects;
+  bool with_velocities = false;
+};
+
+/// A hook run after every step, on the calling thread, in the order added. Exceptions thrown by
+/// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then).
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  /// Asked after SUMO and the radar advanced, before the filters run: whether OnStep of this
+  /// step needs the cells' mean velocities in the snapshots (a pass over every particle, so only
+  /// when drawn or recorded).
+  virtual bool WantsVelocities(int /*step*/, double /*time*/) { return false; }
+  virtual void OnStep(const StepView& view) = 0;
+};
+
+class CoSimulation {
+ public:
+  /// Validates (memory, sensors; std::invalid_argument) and allocates the filters. SUMO is not
+  /// started: nothing is written until Start().
+  CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options = {});
+
+  /// Starts SUMO (Pipeline::Start): `work_dir` receives sumo.log.
+  void Start(const std::filesystem::path& network_dir, const std::filesystem::path& work_dir);
+  /// `observer` is not owned and must outlive the run.
+  void AddObserver(StepObserver* observer);
+
+  /// One step: SUMO, radar, every mode's filter cycle, the shared ground truth and every mode's
+  /// scoring, then the observers. False at the end of the run (nothing done then).
+  bool Step();
+
+  const Pipeline& pipeline() const { return pipeline_; }
+  const scenario::ScenarioConfig& config() const { return pipeline_.config(); }
+  const std::vector<std::string>& mode_names() const { return mode_names_; }
+  const std::vector<ModeScorer>& scorers() const { return scorers_; }
+  /// Steps done so far.
+  int steps() const { return steps_; }
+  /// Simulated time of the steps done [s].
+  double simulated() const { return steps_ * config().sim.step_length; }
+  /// All steps of the scenario's duration were done.
+  bool finished() const { return steps_ == config().sim.StepCount(); }
+  std::size_t total_detections() const { return total_detections_; }
+  /// Per mode, the paper's metrics over the steps done so far.
+  std::vector<eval::ScenarioMetrics> Metrics() const;
+
+ private:
+  void FilterAndScore(bool with_velocities);
+
+  Pipeline pipeline_;
+  std::vector<std::string> mode_names_;
+  std::vector<ModeScorer> scorers_;
+  std::vector<GridSnapshot> snapshots_;  // storage reused every step
+  std::vector<eval::TruthObject> objects_;
+  std::vector<std::uint8_t> truth_classes_;
+  std::vector<StepObserver*> observers_;
+  int threads_ = 0;
+  int steps_ = 0;
+  std::size_t total_detections_ = 0;
+};
+
+}  // namespace dualgrid::cosim

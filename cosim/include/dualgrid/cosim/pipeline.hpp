@@ -1,0 +1,120 @@
+// One co-simulation's data path: SUMO steps, the radar model scans the ground truth, and the
+// detections become the inputs of any number of grid filters (one per weight mode), in the grid
+// frame. CoSimulation (cosimulation.hpp) runs the filters and the scoring on top of it.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dualgrid/core/grid_frame.hpp"
+#include "dualgrid/eval/association.hpp"
+#include "dualgrid/filter/dynamic_grid.hpp"
+#include "dualgrid/radar_model/radar_model.hpp"
+#include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
+
+namespace dualgrid::cosim {
+
+/// Stable integer ids for named things (radar source ids, evaluation object ids): static
+/// obstacles first, vehicles in order of first appearance (deterministic: frames are sorted).
+class IdRegistry {
+ public:
+  int Id(const std::string& name);
+  /// The id of a name already registered.
+  std::optional<int> Find(const std::string& name) const;
+  const std::string& Name(int id) const;  ///< "clutter" for -1
+
+ private:
+  std::map<std::string, int> ids_;
+  std::vector<std::string> names_;
+};
+
+/// Throws std::invalid_argument, naming the scenario file and its filter keys, when `modes`
+/// filters of `config` would need more than 80 % of this machine's physical memory
+/// (FilterParams::MemoryBytes). Called once, by the Pipeline constructor, before anything is
+/// allocated or written.
+void CheckFilterMemory(const scenario::ScenarioConfig& config, std::size_t modes);
+
+/// Lifetime: construct (validates and allocates the filters; SUMO not started), Start() (SUMO),
+/// then Advance() / UpdateFilter() per step. Not copyable; one SUMO instance per process
+/// (libsumo is a process-wide singleton), so one started Pipeline at a time.
+class Pipeline {
+ public:
+  /// Throws std::invalid_argument for a configuration that cannot run (memory, sensors).
+  Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::WeightMode> modes);
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  /// Starts SUMO on the scenario's network, looked up in `network_dir` (a network named by a
+  /// path is read relative to the scenario file). `work_dir` receives SUMO's route file and log
+  /// (sumo.log). Throws std::invalid_argument for a missing network, std::runtime_error for a
+  /// SUMO error. Call once.
+  void Start(const std::filesystem::path& network_dir, const std::filesystem::path& work_dir);
+  bool started() const { return simulation_ != nullptr; }
+
+  /// Advances SUMO one step, scans the due radars and prepares the filters' inputs. False at the
+  /// end (the duration reached, or the ego left the network). Needs Start().
+  bool Advance();
+  /// Updates filter `i` with the inputs of the last Advance(). Independent per filter, so callers
+  /// may run the filters concurrently (each with a one-thread team inside;
+  /// docs/performance.md).
+  void UpdateFilter(std::size_t i);
+
+  /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
+  const scenario::ScenarioConfig& config() const { return config_; }
+  /// Ground truth of the last Advance(). Needs Start().
+  const sim::Frame& frame() const { return simulation_->frame(); }
+  const sim::SumoSimulation& simulation() const { return *simulation_; }
+  /// The radars as mounted on the ego's box as SUMO simulates it: built once, at the ego's
+  /// departure (the first Advance()). Needs one Advance().
+  const radar::RadarModel& radar() const { return *radar_; }
+  bool has_radar() const { return radar_.has_value(); }
+  /// Detections of the last step (only sensors that were due), world frame.
+  const std::vector<radar::Detection>& detections() const { return detections_; }
+  /// Sensors that scanned in the last step.
+  const std::vector<int>& scanned() const { return scanned_; }
+  const radar::EgoMotion& ego_motion() const { return ego_; }
+  std::size_t num_filters() const { return filters_.size(); }
+  filter::WeightMode mode(std::size_t i) const { return modes_[i]; }
+  const filter::DynamicGrid& grid(std::size_t i) const { return *filters_[i]; }
+  IdRegistry& ids() { return ids_; }
+  const IdRegistry& ids() const { return ids_; }
+
+  /// The grid frame (docs/algorithm.md, "Grid frame"): fixed at the first Advance() from the
+  /// scenario's `filter.frame` and the ego's heading then; identity before.
+  const GridFrame& grid_frame() const { return grid_frame_; }
+
+  /// Ground-truth vehicles (ego excluded) as evaluation objects for a grid, in the grid frame
+  /// (boxes and velocities: the clusters' frame): in_grid when the centre lies in the grid,
+  /// in_coverage when the centre lies in some radar's field of view. Reads only: safe to call
+  /// from several threads once Advance() returned.
+  std::vector<eval::TruthObject> TruthObjects(const filter::DynamicGrid& grid) const;
+
+ private:
+  radar::Scene BuildScene();
+  // At the ego's departure: the grid frame and the radars on the ego's simulated box.
+  void FixFrameAndRig(const sim::Frame& f);
+
+  scenario::ScenarioConfig config_;
+  IdRegistry ids_;
+  std::unique_ptr<sim::SumoSimulation> simulation_;
+  std::optional<radar::RadarModel> radar_;
+  std::vector<filter::WeightMode> modes_;
+  std::vector<std::unique_ptr<filter::DynamicGrid>> filters_;
+  radar::Scene static_scene_;
+  radar::EgoMotion ego_;
+  std::vector<radar::Detection> detections_;
+  std::vector<int> scanned_;
+  std::vector<filter::Measurement> measurements_;
+  std::vector<filter::SensorCoverage> coverage_;
+  double last_time_ = 0.0;
+  double dt_ = 0.0;  // of the last Advance() [s]
+  GridFrame grid_frame_;
+  Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
+};
+
+}  // namespace dualgrid::cosim
