@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/prctl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -12,6 +13,8 @@
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
+
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 
@@ -40,6 +43,38 @@ pid_t StartChild(std::vector<std::string> args, const std::filesystem::path& log
     _exit(127);
   }
   return pid;
+}
+
+bool ChildPool::Free() const {
+  return !StopSignal() && static_cast<int>(running_.size()) < jobs_;
+}
+
+void ChildPool::Start(std::size_t tag, std::vector<std::string> args,
+                      const std::filesystem::path& log) {
+  running_[StartChild(std::move(args), log)] = tag;
+}
+
+std::optional<ChildPool::Ended> ChildPool::Wait() {
+  while (true) {
+    if (StopSignal() && !forwarded_) {
+      for (const auto& [pid, tag] : running_) kill(pid, StopSignal());
+      forwarded_ = true;
+    }
+    if (running_.empty()) return std::nullopt;
+    int status = 0;
+    const pid_t pid = wait(&status);
+    if (pid < 0) {
+      if (errno == EINTR) continue;  // a signal: forwarded above
+      throw std::runtime_error("lost track of " + what_ + ": " + std::strerror(errno));
+    }
+    const auto it = running_.find(pid);
+    if (it == running_.end()) continue;  // not one of ours (e.g. an ffmpeg of this process)
+    Ended e{it->second, 0, 0};
+    running_.erase(it);
+    e.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+    e.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + e.signal;
+    return e;
+  }
 }
 
 bool RunComplete(const std::filesystem::path& dir) {

@@ -34,9 +34,8 @@ std::filesystem::path LogPath(const std::filesystem::path& seed_dir) {
   return seed_dir.parent_path() / (seed_dir.filename().string() + ".log");
 }
 
-pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesystem::path& dir,
-               bool figures, int threads) {
-  std::filesystem::create_directories(dir.parent_path());
+std::vector<std::string> RunArgs(const ExperimentOptions& o, std::uint64_t seed,
+                                 const std::filesystem::path& dir, bool figures, int threads) {
   std::vector<std::string> args = {o.executable,
                                    "run",
                                    o.run.run.scenario.string(),
@@ -65,8 +64,7 @@ pid_t StartRun(const ExperimentOptions& o, std::uint64_t seed, const std::filesy
   if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.check_invariants) args.push_back("--check-invariants");
   args.insert(args.end(), {"--threads", std::to_string(threads)});
-  // Beside the run folder, which the run itself prepares (docs/output.md).
-  return StartChild(std::move(args), LogPath(dir));
+  return args;
 }
 
 }  // namespace
@@ -96,41 +94,32 @@ int RunExperiment(const ExperimentOptions& o) {
 
   // Run the seeds, `jobs` at a time; seed `first_seed` also draws its figures.
   Progress progress("experiment " + config.sim.name, o.seeds, !o.run.run.quiet);
-  std::map<pid_t, std::uint64_t> running;
+  ChildPool pool(jobs, "the seed runs");
   std::vector<std::uint64_t> finished;
   std::vector<std::pair<std::uint64_t, std::string>> failed;  // seed, its error
   int next = 0, done = 0;
   std::vector<std::uint64_t> cut_short;  // stopped by a signal: partial, not aggregated
-  bool forwarded = false;
-  while (done < o.seeds) {
-    while (!StopSignal() && next < o.seeds && static_cast<int>(running.size()) < jobs) {
+  while (true) {
+    while (pool.Free() && next < o.seeds) {
       const std::uint64_t seed = o.first_seed + next++;
-      running[StartRun(o, seed, seed_dir(seed), o.run.figures && seed == o.first_seed,
-                       split.threads)] = seed;
+      const auto dir = seed_dir(seed);
+      std::filesystem::create_directories(dir.parent_path());
+      // The log beside the run folder, which the run itself prepares (docs/output.md).
+      pool.Start(seed, RunArgs(o, seed, dir, o.run.figures && seed == o.first_seed, split.threads),
+                 LogPath(dir));
     }
-    if (StopSignal() && !forwarded) {
-      // Each run stops at the end of its step and writes its part, marked incomplete.
-      for (const auto& [pid, seed] : running) kill(pid, StopSignal());
-      forwarded = true;
-    }
-    if (running.empty()) break;  // stopped before every seed was started
-    int status = 0;
-    const pid_t pid = wait(&status);
-    if (pid < 0) {
-      if (errno == EINTR) continue;  // a signal: forward it above
-      throw std::runtime_error("lost track of the seed runs: " + std::string(std::strerror(errno)));
-    }
-    const std::uint64_t seed = running.at(pid);
-    running.erase(pid);
+    const auto ended = pool.Wait();
+    if (!ended) break;  // all done, or stopped before every seed was started
+    const std::uint64_t seed = ended->tag;
     ++done;
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    const int code = ended->code;
     if (code == 0 && RunComplete(seed_dir(seed))) {
       finished.push_back(seed);
     } else if (StopSignal() && (code == 130 || code == 143)) {
       cut_short.push_back(seed);
     } else {
       std::string why = LastLine(LogPath(seed_dir(seed)));
-      if (WIFSIGNALED(status)) why = "killed by signal " + std::to_string(WTERMSIG(status));
+      if (ended->signal) why = "killed by signal " + std::to_string(ended->signal);
       if (why.empty()) why = "exit code " + std::to_string(code);
       failed.emplace_back(seed, why);
       std::cerr << "dualgrid: seed " << seed << " failed: " << why << "\n";

@@ -272,30 +272,18 @@ int RunSweep(const SweepOptions& o) {
   if (!o.quiet && todo.size() < runs.size())
     std::cerr << "sweep: " << runs.size() - todo.size() << " runs finished earlier, skipped\n";
   Progress progress("sweep", static_cast<int>(todo.size()), !o.quiet);
-  std::map<pid_t, std::size_t> running;
+  ChildPool pool(jobs, "the sweep's runs");
   std::size_t next = 0;
   int done = 0, failed = 0;
-  bool forwarded = false;
   while (true) {
-    while (!StopSignal() && next < todo.size() && static_cast<int>(running.size()) < jobs) {
-      const auto& [args, folder] = runs[todo[next++]];
+    while (pool.Free() && next < todo.size()) {
+      const auto& [args, folder] = runs[todo[next]];
       fs::create_directories(folder.parent_path());
-      running[StartChild(args, folder.string() + ".log")] = todo[next - 1];
+      pool.Start(todo[next++], args, folder.string() + ".log");
     }
-    if (StopSignal() && !forwarded) {
-      for (const auto& [pid, i] : running) kill(pid, StopSignal());
-      forwarded = true;
-    }
-    if (running.empty()) break;
-    int status = 0;
-    const pid_t pid = wait(&status);
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      throw std::runtime_error("lost track of the sweep's runs: " +
-                               std::string(std::strerror(errno)));
-    }
-    const std::size_t i = running.at(pid);
-    running.erase(pid);
+    const auto ended = pool.Wait();
+    if (!ended) break;
+    const std::size_t i = ended->tag;
     ++done;
     if (!RunComplete(runs[i].second)) {
       ++failed;

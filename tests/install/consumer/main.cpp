@@ -1,5 +1,5 @@
 // A user's program: the filter on its own, then a short co-simulation through dualgrid::cosim.
-// Prints "filter ok", then one line per mode "MODE objects=N matches=M", then "steps=N".
+// Prints "filter ok", then one line per mode "MODE objects=N matches=M", then "steps=N of M".
 #include <cstdio>
 #include <filesystem>
 
@@ -27,6 +27,6 @@ int main() {
   for (std::size_t m = 0; m < metrics.size(); ++m)
     std::printf("%s objects=%d matches=%lld\n", cs.mode_names()[m].c_str(),
                 metrics[m].objects_scored, static_cast<long long>(metrics[m].matches));
-  std::printf("steps=%d\n", cs.steps());
+  std::printf("steps=%d of %d\n", cs.steps(), cs.config().sim.StepCount());
   return cs.finished() ? 0 : 1;
 }
