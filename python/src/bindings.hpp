@@ -9,6 +9,8 @@ namespace py = pybind11;
 
 /// FilterParams, presets, DynamicGrid (filter_bindings.cpp).
 void BindFilter(py::module_& m);
+/// SensorParams, default rigs, ModelOptions, EgoMotion, Scene, RadarModel (radar_bindings.cpp).
+void BindRadar(py::module_& m);
 
 /// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
 /// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel

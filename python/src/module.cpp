@@ -52,6 +52,7 @@ PYBIND11_MODULE(_dualgrid, m) {
       "Threads the next parallel C++ stage will use.");
 
   BindFilter(m);
+  BindRadar(m);
 
   // TODO(cosim): run_scenario(path, seed=None, duration=None, modes=("position", "velocity",
   // "dual"), overrides=[...]) -> results. The co-simulation loop (SUMO + radar + filters, now in
