@@ -1,4 +1,4 @@
-"""dualgrid: radar-only dynamic occupancy grid with dual-weight particle filter, and its radar model.
+"""dualgrid: radar-only dual-weight particle-filter dynamic occupancy grid and its radar model.
 
 The compiled extension ``dualgrid._dualgrid`` does the work; this package re-exports it and adds
 small pure-Python conveniences. Units: metres, seconds, m/s, radians; angles counter-clockwise
