@@ -7,6 +7,7 @@
 # under an interpreter that has it; /usr/bin/python3 is also the one whose dist-packages
 # `cmake --install` targets.
 set(DUALGRID_PYTHON_DEPS_FOUND OFF)
+set(numpy_status "not checked")
 if(NOT Python3_EXECUTABLE)
   find_program(DUALGRID_PATH_PYTHON3 NAMES python3)
   foreach(candidate ${DUALGRID_PATH_PYTHON3} /usr/bin/python3)
@@ -24,6 +25,11 @@ find_package(Python3 COMPONENTS Interpreter Development.Module QUIET)
 if(Python3_FOUND)
   execute_process(COMMAND "${Python3_EXECUTABLE}" -c "import numpy" RESULT_VARIABLE numpy_rc
                   OUTPUT_QUIET ERROR_QUIET)
+  if(numpy_rc EQUAL 0)
+    set(numpy_status "yes")
+  else()
+    set(numpy_status "no")
+  endif()
   # After Python3: pybind11's config then uses FindPython's results (its "new" mode).
   find_package(pybind11 CONFIG QUIET)
   if(pybind11_FOUND AND numpy_rc EQUAL 0)
@@ -34,5 +40,5 @@ if(NOT DUALGRID_PYTHON_DEPS_FOUND)
   message(STATUS "Python module: needs Python3 (Interpreter, Development.Module), pybind11 and "
                  "numpy (Debian: python3-dev pybind11-dev python3-numpy); "
                  "Python3 found: ${Python3_FOUND} (${Python3_EXECUTABLE}), "
-                 "pybind11 found: ${pybind11_FOUND}")
+                 "numpy importable: ${numpy_status}, pybind11 found: ${pybind11_FOUND}")
 endif()
