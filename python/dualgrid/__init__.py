@@ -4,13 +4,15 @@ The compiled extension ``dualgrid._dualgrid`` does the work; this package re-exp
 small pure-Python conveniences. Units: metres, seconds, m/s, radians; angles counter-clockwise
 from +x. See docs/python.md for the API, frames and a worked example.
 
-    import dualgrid, numpy as np
+    import dualgrid
     grid = dualgrid.DynamicGrid(dualgrid.preset("dualgrid"), seed=1)
     radar = dualgrid.RadarModel(dualgrid.default_rig(4.5, 1.8), seed=1)
-    dets = radar.scan(ego, scene, step=0, time=0.0, step_length=0.05)
-    grid.update(ego_pose=(0, 0, 0), ego_velocity=(0, 0),
-                detections=dualgrid.detections_to_measurements(dets),
-                coverage=radar.coverage((0, 0, 0), radar.sensors_due(0.0, 0.05)), dt=0.05)
+    ego = dualgrid.EgoMotion(pose=(0.0, 0.0, 0.0), velocity=(10.0, 0.0), length=4.5, width=1.8)
+    car = dict(id=1, x=30.0, y=0.0, yaw=0.0, length=4.5, width=1.8, vx=15.0, vy=0.0)
+    dets = radar.scan(ego, {"targets": [car]}, step=0, time=0.0, step_length=0.05)
+    grid.update(ego_pose=ego.pose, ego_velocity=ego.velocity,
+                detections=dualgrid.detections_to_measurements(dets, ego_box=ego),
+                coverage=radar.coverage(ego.pose, radar.sensors_due(0.0, 0.05)), dt=0.05)
     grid.masses()["dynamic"]   # (cells_y, cells_x) float32
 """
 
