@@ -1,8 +1,8 @@
 // Conversions between Python inputs (numpy arrays, dicts of columns, lists of dicts, tuples) and
 // dualgrid's C++ types for the `_dualgrid` extension. Every conversion copies: no C++ object keeps
-// a pointer into Python memory. Bad input raises ValueError naming the argument, the expected
-// shape or columns and what was given (pybind11 maps std::invalid_argument... to ValueError; we
-// throw py::value_error directly so the message is exactly ours).
+// a pointer into Python memory. Bad input throws py::value_error (Python's ValueError) naming the
+// argument, the expected shape or columns and what was given. Errors of the C++ libraries
+// (std::invalid_argument) reach Python as ValueError through pybind11's own translation.
 #pragma once
 
 #include <cstddef>
