@@ -1,0 +1,110 @@
+"""dualgrid: radar-only dual-weight particle-filter dynamic occupancy grid and its radar model.
+
+The compiled extension ``dualgrid._dualgrid`` does the work; this package re-exports it and adds
+small pure-Python conveniences. Units: metres, seconds, m/s, radians; angles counter-clockwise
+from +x. See docs/python.md for the API, frames and a worked example.
+
+    import dualgrid
+    grid = dualgrid.DynamicGrid(dualgrid.preset("dualgrid"), seed=1)
+    radar = dualgrid.RadarModel(dualgrid.default_rig(4.5, 1.8), seed=1)
+    ego = dualgrid.EgoMotion(pose=(0.0, 0.0, 0.0), velocity=(10.0, 0.0), length=4.5, width=1.8)
+    car = dict(id=1, x=30.0, y=0.0, yaw=0.0, length=4.5, width=1.8, vx=15.0, vy=0.0)
+    dets = radar.scan(ego, {"targets": [car]}, step=0, time=0.0, step_length=0.05)
+    grid.update(ego_pose=ego.pose, ego_velocity=ego.velocity,
+                detections=dualgrid.detections_to_measurements(dets, ego_box=ego),
+                coverage=radar.coverage(ego.pose, radar.sensors_due(0.0, 0.05)), dt=0.05)
+    grid.masses()["dynamic"]   # (cells_y, cells_x) float32
+"""
+
+import numpy as _np
+
+from ._dualgrid import (
+    DynamicGrid,
+    EgoMotion,
+    FilterParams,
+    ModelOptions,
+    RadarModel,
+    Scene,
+    SensorParams,
+    __version__,
+    default_long_range_radar,
+    default_rig,
+    default_short_range_radar,
+    get_num_threads,
+    preset,
+    preset_names,
+    set_num_threads,
+)
+
+# TODO(cosim): re-export run_scenario once _dualgrid binds dualgrid::cosim (see module.cpp).
+
+#: Columns of DynamicGrid.update()'s detections array, in order.
+MEASUREMENT_COLUMNS = ("x", "y", "v_rx", "v_ry", "sensor_x", "sensor_y")
+#: Columns of DynamicGrid.update()'s coverage array, in order.
+COVERAGE_COLUMNS = ("origin_x", "origin_y", "boresight", "half_fov", "min_range", "max_range")
+#: Columns of a target table (Scene), in order.
+TARGET_COLUMNS = ("id", "x", "y", "yaw", "length", "width", "vx", "vy", "yaw_rate", "rcs_dbsm")
+
+
+def detections_to_measurements(detections, ego_box=None, include_clutter=True):
+    """The (N, 6) float64 array DynamicGrid.update() takes, from RadarModel.scan()'s dict.
+
+    detections: the dict of columns of RadarModel.scan()/scan_sensor() (or a pandas.DataFrame of
+        it); the result's columns are MEASUREMENT_COLUMNS: x, y [m], v_rx, v_ry [m/s] (paper
+        eq. (1): compensated radial speed times the line of sight), sensor_x, sensor_y [m].
+    ego_box: optional ego body to drop detections inside of, as the co-simulation does (nothing
+        but the ego can be there; clutter drawn down to the sensors' minimum range would feed
+        particles riding along with the ego): an EgoMotion with length and width > 0, or
+        (x, y, yaw, length, width) [m, m, rad, m, m].
+    include_clutter: False drops the model's false alarms (is_clutter), e.g. for a clean test.
+    Returns a new array (a copy).
+    """
+    missing = [c for c in MEASUREMENT_COLUMNS if c not in detections]
+    if missing:
+        raise ValueError(
+            f"detections: missing column(s) {missing} (expected RadarModel.scan()'s dict)")
+    cols = [_np.asarray(detections[c], dtype=_np.float64).ravel() for c in MEASUREMENT_COLUMNS]
+    keep = _np.ones(cols[0].shape[0], dtype=bool)
+    if not include_clutter:
+        if "is_clutter" not in detections:
+            raise ValueError("detections: include_clutter=False needs the column 'is_clutter'")
+        keep &= ~_np.asarray(detections["is_clutter"], dtype=bool).ravel()
+    if ego_box is not None:
+        if isinstance(ego_box, EgoMotion):
+            (bx, by, byaw), length, width = ego_box.pose, ego_box.length, ego_box.width
+        else:
+            box = _np.asarray(ego_box, dtype=_np.float64).ravel()
+            if box.shape != (5,):
+                raise ValueError(
+                    "ego_box: expected an EgoMotion or (x, y, yaw, length, width) "
+                    f"[m, m, rad, m, m], got {ego_box!r}")
+            bx, by, byaw, length, width = box
+        # The inside test of core/types.hpp's BoxTest: |R^T (p - c)| <= (L/2, W/2).
+        c, s = _np.cos(byaw), _np.sin(byaw)
+        dx, dy = cols[0] - bx, cols[1] - by
+        along, across = c * dx + s * dy, -s * dx + c * dy
+        keep &= ~((_np.abs(along) <= 0.5 * length) & (_np.abs(across) <= 0.5 * width))
+    return _np.column_stack(cols)[keep] if cols[0].size else _np.empty((0, 6))
+
+
+__all__ = [
+    "COVERAGE_COLUMNS",
+    "DynamicGrid",
+    "EgoMotion",
+    "FilterParams",
+    "MEASUREMENT_COLUMNS",
+    "ModelOptions",
+    "RadarModel",
+    "Scene",
+    "SensorParams",
+    "TARGET_COLUMNS",
+    "__version__",
+    "default_long_range_radar",
+    "default_rig",
+    "default_short_range_radar",
+    "detections_to_measurements",
+    "get_num_threads",
+    "preset",
+    "preset_names",
+    "set_num_threads",
+]

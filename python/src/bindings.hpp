@@ -1,0 +1,20 @@
+// Entry points of the `_dualgrid` extension's parts (module.cpp calls them in order).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace dualgrid::python {
+
+namespace py = pybind11;
+
+/// FilterParams, presets, DynamicGrid (filter_bindings.cpp).
+void BindFilter(py::module_& m);
+/// SensorParams, default rigs, ModelOptions, EgoMotion, Scene, RadarModel (radar_bindings.cpp).
+void BindRadar(py::module_& m);
+
+/// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
+/// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel
+/// C++ stage (grid update, radar scan) applies it first, on the thread doing the work.
+void ApplyThreadCount();
+
+}  // namespace dualgrid::python

@@ -1,0 +1,69 @@
+// Conversions between Python inputs (numpy arrays, dicts of columns, lists of dicts, tuples) and
+// dualgrid's C++ types for the `_dualgrid` extension. Every conversion copies: no C++ object keeps
+// a pointer into Python memory. Bad input throws py::value_error (Python's ValueError) naming the
+// argument, the expected shape or columns and what was given. Errors of the C++ libraries
+// (std::invalid_argument) reach Python as ValueError through pybind11's own translation.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include "dualgrid/core/types.hpp"
+
+namespace dualgrid::python {
+
+namespace py = pybind11;
+
+/// One column of a table argument: its name and, for optional columns, the value used when a
+/// dict / record omits it.
+struct ColumnSpec {
+  const char* name;
+  std::optional<double> fallback = std::nullopt;
+};
+
+/// A row-major table of doubles: rows x columns.size(), values[row * cols + col].
+struct Table {
+  std::size_t rows = 0;
+  std::size_t cols = 0;
+  std::vector<double> values;
+  double at(std::size_t row, std::size_t col) const { return values[row * cols + col]; }
+};
+
+/// Reads table argument `arg` with the given columns from any of:
+///  - None or an empty sequence: no rows;
+///  - a float array (or nested sequence) of shape (N, columns.size()), columns in that order;
+///  - a dict of 1-D columns, a pandas.DataFrame or a numpy structured array, looked up by name
+///    (extra columns ignored, so a whole radar detections dict can be passed; optional columns
+///    take their fallback when missing);
+///  - a list of dicts, one per row (unknown keys are an error: hand-typed records, catch typos).
+/// Every value must be finite (ValueError naming the row and column otherwise).
+Table ReadTable(py::handle obj, const char* arg, const std::vector<ColumnSpec>& columns);
+
+/// "[a, b, c]" of the column names, for messages.
+std::string ColumnList(const std::vector<ColumnSpec>& columns);
+
+/// Reads a fixed-length float vector `arg` (tuple, list or array of `n` finite numbers);
+/// `what` describes the entries with units for the error message, e.g. "(x, y, yaw) [m, m, rad]".
+std::vector<double> ReadFixed(py::handle obj, const char* arg, std::size_t n, const char* what);
+/// (x, y, yaw) [m, m, rad] -> Pose2.
+Pose2 ReadPose(py::handle obj, const char* arg);
+/// (x, y) -> Vector2, `unit` for the message (e.g. "[m/s]").
+Vector2 ReadVector2(py::handle obj, const char* arg, const char* unit);
+
+/// A 1-D numpy array holding a copy of `v`.
+template <typename T>
+py::array_t<T> ToArray(const std::vector<T>& v) {
+  py::array_t<T> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+/// Python's repr of `obj` shortened to ~60 characters, for error messages.
+std::string ShortRepr(py::handle obj);
+
+}  // namespace dualgrid::python

@@ -1,0 +1,62 @@
+// The `_dualgrid` extension module: the filter and the radar model for Python (docs/python.md).
+// The pure-Python package dualgrid/ (python/dualgrid/__init__.py) re-exports everything here.
+#include <atomic>
+#include <string>
+
+#include <omp.h>
+
+#include <pybind11/pybind11.h>
+
+#include "bindings.hpp"
+
+namespace dualgrid::python {
+namespace {
+
+// 0: leave OpenMP's own choice (OMP_NUM_THREADS or all cores).
+std::atomic<int> g_num_threads{0};
+
+}  // namespace
+
+void ApplyThreadCount() {
+  const int n = g_num_threads.load();
+  if (n > 0) omp_set_num_threads(n);
+}
+
+}  // namespace dualgrid::python
+
+PYBIND11_MODULE(_dualgrid, m) {
+  namespace py = pybind11;
+  using namespace dualgrid::python;
+  m.doc() =
+      "dualgrid: radar-only dual-weight particle-filter dynamic occupancy grid and the radar "
+      "model (compiled part; import the package `dualgrid`).";
+  m.attr("__version__") = DUALGRID_VERSION;
+
+  m.def(
+      "set_num_threads",
+      [](int n) {
+        if (n < 0)
+          throw py::value_error("set_num_threads: n must be >= 0, got " + std::to_string(n));
+        g_num_threads = n;
+      },
+      py::arg("n"),
+      "Threads of the parallel C++ stages (grid update, radar scan) for every later call from any "
+      "Python thread; 0 restores OpenMP's default (OMP_NUM_THREADS or all cores). Results do not "
+      "depend on it.");
+  m.def(
+      "get_num_threads",
+      []() {
+        const int n = g_num_threads.load();
+        return n > 0 ? n : omp_get_max_threads();
+      },
+      "Threads the next parallel C++ stage will use.");
+
+  BindFilter(m);
+  BindRadar(m);
+
+  // TODO(cosim): run_scenario(path, seed=None, duration=None, modes=("position", "velocity",
+  // "dual"), overrides=[...]) -> results. The co-simulation loop (SUMO + radar + filters, now in
+  // tools/) is being extracted into the library dualgrid::cosim by another change; bind it here
+  // once it exists (link dualgrid::cosim, release the GIL for the run, return the per-step scores
+  // and tracks as numpy columns). Do not bind tools/ code directly.
+}
