@@ -35,8 +35,40 @@ from ._dualgrid import (
     preset_names,
     set_num_threads,
 )
+from ._dualgrid import run_scenario as _run_scenario
 
-# TODO(cosim): re-export run_scenario once _dualgrid binds dualgrid::cosim (see module.cpp).
+import os as _os
+
+
+def installed_network_dir():
+    """The built SUMO networks of the installation this package belongs to.
+
+    An installed package lives in PREFIX/lib/python3/dist-packages/dualgrid; its networks in
+    PREFIX/share/dualgrid/networks. None when that folder does not exist (a build-tree package:
+    run_scenario then uses the build tree's networks, or $DUALGRID_NETWORK_DIR).
+    """
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    prefix = _os.path.normpath(_os.path.join(here, "..", "..", "..", ".."))
+    candidate = _os.path.join(prefix, "share", "dualgrid", "networks")
+    return candidate if _os.path.isdir(candidate) else None
+
+
+def run_scenario(path, seed=None, duration=None, modes=("position", "velocity", "dual"),
+                 overrides=(), network_dir=None, work_dir=None, threads=0):
+    """Runs a scenario file as `dualgrid run` does and returns its results as a dict.
+
+    The same scenario and seed give the command line's numbers (metrics, objects, clusters).
+    network_dir defaults to $DUALGRID_NETWORK_DIR, else this installation's networks
+    (installed_network_dir()), else the build tree's. Full description:
+    help(dualgrid._dualgrid.run_scenario) and docs/python.md.
+    """
+    if network_dir is None and not _os.environ.get("DUALGRID_NETWORK_DIR"):
+        network_dir = installed_network_dir()
+    return _run_scenario(str(path), seed=seed, duration=duration, modes=list(modes),
+                         overrides=list(overrides), network_dir=network_dir, work_dir=work_dir,
+                         threads=threads)
+
+
 
 #: Columns of DynamicGrid.update()'s detections array, in order.
 MEASUREMENT_COLUMNS = ("x", "y", "v_rx", "v_ry", "sensor_x", "sensor_y")
@@ -104,7 +136,9 @@ __all__ = [
     "default_short_range_radar",
     "detections_to_measurements",
     "get_num_threads",
+    "installed_network_dir",
     "preset",
     "preset_names",
+    "run_scenario",
     "set_num_threads",
 ]

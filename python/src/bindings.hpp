@@ -12,6 +12,9 @@ void BindFilter(py::module_& m);
 /// SensorParams, default rigs, ModelOptions, EgoMotion, Scene, RadarModel (radar_bindings.cpp).
 void BindRadar(py::module_& m);
 
+/// run_scenario on dualgrid::cosim (cosim_bindings.cpp).
+void BindCosim(py::module_& m);
+
 /// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
 /// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel
 /// C++ stage (grid update, radar scan) applies it first, on the thread doing the work.

@@ -54,9 +54,5 @@ PYBIND11_MODULE(_dualgrid, m) {
   BindFilter(m);
   BindRadar(m);
 
-  // TODO(cosim): run_scenario(path, seed=None, duration=None, modes=("position", "velocity",
-  // "dual"), overrides=[...]) -> results. The co-simulation loop (SUMO + radar + filters, now in
-  // tools/) is being extracted into the library dualgrid::cosim by another change; bind it here
-  // once it exists (link dualgrid::cosim, release the GIL for the run, return the per-step scores
-  // and tracks as numpy columns). Do not bind tools/ code directly.
+  BindCosim(m);
 }
