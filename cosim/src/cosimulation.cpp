@@ -29,10 +29,11 @@ bool CoSimulation::Step() {
   total_detections_ += pipeline_.detections().size();
   bool with_velocities = false;
   // Every observer is asked (no short cut): each may keep its own schedule.
-  for (StepObserver* o : observers_) with_velocities = o->WantsVelocities(steps_, f.time) || with_velocities;
+  for (StepObserver* o : observers_)
+    with_velocities = o->WantsVelocities(steps_, f.time) || with_velocities;
   FilterAndScore(with_velocities);
-  const StepView view{steps_,      f,        pipeline_,       mode_names_, snapshots_,
-                      scorers_,    objects_, with_velocities};
+  const StepView view{steps_,     f,        pipeline_, mode_names_,
+                      snapshots_, scorers_, objects_,  with_velocities};
   ++steps_;
   for (StepObserver* o : observers_) o->OnStep(view);
   return true;

@@ -49,8 +49,7 @@ Pipeline::Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::W
   // bad one here rather than at the ego's departure, when the radar is built.
   for (const radar::SensorParams& s : config_.radar.sensors) {
     std::string error;
-    if (!s.IsValid(&error))
-      throw std::invalid_argument("sensor '" + s.name + "': " + error);
+    if (!s.IsValid(&error)) throw std::invalid_argument("sensor '" + s.name + "': " + error);
   }
   for (filter::WeightMode m : modes_) {
     filter::FilterParams p = config_.FilterFor(m);
@@ -113,7 +112,7 @@ bool Pipeline::Advance() {
   last_time_ = f.time;
 
   detections_ = radar_->Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
-                            config_.sim.step_length);
+                             config_.sim.step_length);
   scanned_ = radar_->SensorsDue(f.time, config_.sim.step_length);
 
   if (filters_.empty()) return true;

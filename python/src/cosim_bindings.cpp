@@ -104,9 +104,8 @@ py::dict ObjectColumns(const std::vector<std::string>& modes,
 
 py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
                      std::optional<double> duration, const std::vector<std::string>& modes,
-                     const std::vector<std::string>& overrides,
-                     std::optional<fs::path> network_dir, std::optional<fs::path> work_dir,
-                     int threads) {
+                     const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
+                     std::optional<fs::path> work_dir, int threads) {
   std::vector<scenario::Override> sets;
   for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
   scenario::ScenarioConfig config = scenario::LoadScenario(path, sets);

@@ -89,8 +89,7 @@ NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
   const fs::path self = anchor.empty() ? fs::read_symlink("/proc/self/exe", ec) : anchor;
   if (!ec && !self.empty()) {
     // PREFIX/bin/dualgrid -> PREFIX/share/dualgrid/networks (also PREFIX/lib/... for a library).
-    const fs::path installed =
-        self.parent_path().parent_path() / "share" / "dualgrid" / "networks";
+    const fs::path installed = self.parent_path().parent_path() / "share" / "dualgrid" / "networks";
     if (fs::is_directory(installed, ec)) return {installed, "installed"};
   }
 #ifdef DUALGRID_NETWORK_DIR

@@ -1,8 +1,8 @@
 // dualgrid::cosim linked directly: the step's observers see every step in order, get the cell
 // velocities exactly when one asks, errors surface where documented, SUMO can be run again in
 // the same process, and the metrics do not depend on the thread count.
-#include <catch2/catch.hpp>
 #include <omp.h>
+#include <catch2/catch.hpp>
 
 #include <cmath>
 #include <filesystem>

@@ -45,7 +45,8 @@ bool LiveCounter::VelocityOk(const cosim::ModeScorer& scorer,
   return (scorer.clusters()[c].velocity - obj.velocity).norm() < tolerance;
 }
 
-Live LiveCounter::Count(const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects) {
+Live LiveCounter::Count(const cosim::ModeScorer& scorer,
+                        const std::vector<eval::TruthObject>& objects) {
   Live l;
   const eval::AssociationResult& a = scorer.association();
   for (std::size_t o = 0; o < objects.size(); ++o) {
@@ -66,8 +67,8 @@ Live LiveCounter::Count(const cosim::ModeScorer& scorer, const std::vector<eval:
   return l;
 }
 
-Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
-                  int max_particles) {
+Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes,
+                  double interval, int max_particles) {
   const scenario::ScenarioConfig& c = pipeline.config();
   const filter::DynamicGrid& grid = pipeline.grid(0);
   const GridFrame& g = pipeline.grid_frame();
@@ -97,9 +98,9 @@ Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string
 }
 
 Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
-              const std::vector<cosim::ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
-              const std::vector<Live>& live, const std::vector<eval::TruthObject>& objects,
-              const Header& header) {
+              const std::vector<cosim::ModeScorer>& scorers,
+              const std::vector<LiveCounter>& counters, const std::vector<Live>& live,
+              const std::vector<eval::TruthObject>& objects, const Header& header) {
   const GridFrame& g = pipeline.grid_frame();
   const sim::Frame& sf = pipeline.frame();
   Frame f;

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "dualgrid/cosim/pipeline.hpp"
-#include "recording.hpp"
 #include "dualgrid/cosim/scoring.hpp"
+#include "recording.hpp"
 
 namespace dualgrid::tools::replay {
 
@@ -26,14 +26,14 @@ class LiveCounter {
 };
 
 /// The header for `pipeline`'s recording (before the first step: geometry from the scenario).
-Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes, double interval,
-                  int max_particles);
+Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes,
+                  double interval, int max_particles);
 
 /// One frame from the pipeline's current step. `snapshots` must hold velocities
 /// (TakeSnapshot(..., true, ...)); `live` per mode from LiveCounter::Count for this step.
 Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
-              const std::vector<cosim::ModeScorer>& scorers, const std::vector<LiveCounter>& counters,
-              const std::vector<Live>& live, const std::vector<eval::TruthObject>& objects,
-              const Header& header);
+              const std::vector<cosim::ModeScorer>& scorers,
+              const std::vector<LiveCounter>& counters, const std::vector<Live>& live,
+              const std::vector<eval::TruthObject>& objects, const Header& header);
 
 }  // namespace dualgrid::tools::replay

@@ -45,9 +45,7 @@ pid_t StartChild(std::vector<std::string> args, const std::filesystem::path& log
   return pid;
 }
 
-bool ChildPool::Free() const {
-  return !StopSignal() && static_cast<int>(running_.size()) < jobs_;
-}
+bool ChildPool::Free() const { return !StopSignal() && static_cast<int>(running_.size()) < jobs_; }
 
 void ChildPool::Start(std::size_t tag, std::vector<std::string> args,
                       const std::filesystem::path& log) {

@@ -31,8 +31,8 @@ class ChildPool {
   void Start(std::size_t tag, std::vector<std::string> args, const std::filesystem::path& log);
   struct Ended {
     std::size_t tag = 0;
-    int code = 0;     ///< the exit code, or 128 + the signal that killed it
-    int signal = 0;   ///< the signal that killed it, 0 if it exited
+    int code = 0;    ///< the exit code, or 128 + the signal that killed it
+    int signal = 0;  ///< the signal that killed it, 0 if it exited
   };
   /// Waits for the next child to end; std::nullopt when none is running. Throws
   /// std::runtime_error if the children cannot be waited for.

@@ -13,9 +13,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_options.hpp"
 #include "child_process.hpp"
 #include "cli_checks.hpp"
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
 #include "exit_codes.hpp"

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli_options.hpp"
 #include "cli_checks.hpp"
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/suite.hpp"
 #include "exit_codes.hpp"

@@ -54,7 +54,8 @@ Command AddReplayCommand(CLI::App& app, const CliContext&) {
       ->check(NonEmptyPath());
   cmd->add_option("--html-out", o->html_out, "Viewer file (default RUN_DIR/replay.html)")
       ->check(NonEmptyPath());
-  cmd->add_option("--modes", o->modes, "Video: modes to show, comma-separated (default: all recorded)")
+  cmd->add_option("--modes", o->modes,
+                  "Video: modes to show, comma-separated (default: all recorded)")
       ->delimiter(',');
   cmd->add_flag("--particles", o->particles, "Video: draw the recorded particles");
   cmd->add_flag_callback(

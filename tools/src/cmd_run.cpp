@@ -218,10 +218,10 @@ int RunFilters(const FilterRunOptions& options) {
   summary["sensors_mounted"] = nlohmann::json::array();
   if (cosim.pipeline().has_radar())  // mounted at the ego's departure
     for (const auto& s : cosim.pipeline().radar().sensors())
-    summary["sensors_mounted"].push_back({{"name", s.name},
-                                          {"x", s.mount.position.x()},
-                                          {"y", s.mount.position.y()},
-                                          {"yaw_deg", RadToDeg(s.mount.yaw)}});
+      summary["sensors_mounted"].push_back({{"name", s.name},
+                                            {"x", s.mount.position.x()},
+                                            {"y", s.mount.position.y()},
+                                            {"yaw_deg", RadToDeg(s.mount.yaw)}});
   summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!status.empty())

@@ -9,9 +9,9 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/cosim/cosimulation.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "output.hpp"
-#include "dualgrid/cosim/cosimulation.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
 

@@ -3,9 +3,9 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/cosim/cosimulation.hpp"
 #include "figures.hpp"
 #include "output.hpp"
-#include "dualgrid/cosim/cosimulation.hpp"
 
 namespace dualgrid::tools {
 

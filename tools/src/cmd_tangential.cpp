@@ -8,8 +8,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "cli_options.hpp"
 #include "aspect_case.hpp"
+#include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "output.hpp"

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "dualgrid/eval/metrics.hpp"
 #include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/cosim/scoring.hpp"
+#include "dualgrid/eval/metrics.hpp"
 
 namespace dualgrid::tools {
 

@@ -85,10 +85,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", VersionText(data));
   const CliContext ctx{data.dir, SelfPath(argv[0])};
   const std::vector<Command> commands = {
-      AddSimCommand(app, ctx),        AddSnapshotCommand(app, ctx), AddRunCommand(app, ctx),
-      AddReplayCommand(app, ctx),     AddExperimentCommand(app, ctx),
-      AddTangentialCommand(app, ctx), AddRegressCommand(app, ctx),  AddSweepCommand(app, ctx),
-      AddCollectCommand(app, ctx)};
+      AddSimCommand(app, ctx),     AddSnapshotCommand(app, ctx),   AddRunCommand(app, ctx),
+      AddReplayCommand(app, ctx),  AddExperimentCommand(app, ctx), AddTangentialCommand(app, ctx),
+      AddRegressCommand(app, ctx), AddSweepCommand(app, ctx),      AddCollectCommand(app, ctx)};
 
   try {
     app.parse(argc, argv);

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
-#include "dualgrid/cosim/pipeline.hpp"
 
 namespace dualgrid::tools {
 

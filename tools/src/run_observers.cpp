@@ -149,8 +149,8 @@ void PictureObserver::OnStep(const cosim::StepView& v) {
     TryFigures(
         out_ / "figures" / ("grid_t" + stamp + ".png"), formats_,
         [&](const auto& p) {
-          RenderGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f,
-                           f.time, p);
+          RenderGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f, f.time,
+                           p);
         },
         warnings_);
     TryFigures(

@@ -10,7 +10,8 @@ ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
 }
 
 void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::string& mode,
-                          const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
+                          const cosim::ModeScorer& scorer,
+                          const std::vector<eval::TruthObject>& objects,
                           const cosim::IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
@@ -93,8 +94,8 @@ std::string WeightTraces::Focus() const {
   return focus;
 }
 
-void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m, const cosim::GridSnapshot& snapshot,
-                    const std::filesystem::path& path) {
+void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m,
+                    const cosim::GridSnapshot& snapshot, const std::filesystem::path& path) {
   OutputFile pc(path);
   pc.buffer() += "x,y,vx,vy,w_position,w_velocity,weight,p_dynamic\n";
   const auto& grid = pipeline.grid(m);

@@ -10,11 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/cosim/scoring.hpp"
 #include "dualgrid/eval/aggregate.hpp"
 #include "figures.hpp"
 #include "output.hpp"
-#include "dualgrid/cosim/pipeline.hpp"
-#include "dualgrid/cosim/scoring.hpp"
 
 namespace dualgrid::tools {
 
@@ -53,8 +53,8 @@ struct WeightTraces {
 };
 
 /// figures/particles_<mode>_t<time>.csv: every particle of filter `m` with its cell's P(dynamic).
-void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m, const cosim::GridSnapshot& snapshot,
-                    const std::filesystem::path& path);
+void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m,
+                    const cosim::GridSnapshot& snapshot, const std::filesystem::path& path);
 
 /// objects.csv: one row per (mode, object ever in the grid).
 void WriteObjects(const std::vector<std::string>& modes,

@@ -20,7 +20,7 @@ struct GridSnapshot {
   int cells_x = 0, cells_y = 0;
   double resolution = 0.0;                    ///< [m]
   std::int64_t origin_ix = 0, origin_iy = 0;  ///< global index of cell (0, 0)
-  Position origin = Position::Zero();  ///< lower-left corner of cell (0, 0), grid frame [m]
+  Position origin = Position::Zero();         ///< lower-left corner of cell (0, 0), grid frame [m]
   std::vector<float> free, static_occ, dynamic;
   std::vector<std::uint8_t> observed;
   /// Mean velocity over ground [m/s] per cell; empty unless taken `with_velocity`.
