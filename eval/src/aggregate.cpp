@@ -4,9 +4,10 @@
 #include <array>
 #include <cctype>
 #include <cmath>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
+
+#include "dualgrid/core/text.hpp"
 
 namespace dualgrid::eval {
 
@@ -53,17 +54,8 @@ std::string NormaliseScenario(std::string_view name) {
   return out;
 }
 
-std::string Format(double v, int decimals) {
-  std::ostringstream os;
-  os << std::fixed << std::setprecision(decimals) << v;
-  return os.str();
-}
-
-std::string FormatCsv(double v) {
-  std::ostringstream os;
-  os << std::setprecision(10) << v;
-  return os.str();
-}
+// CSV cells: 10 significant digits.
+std::string FormatCsv(double v) { return FormatSignificant(v, 10); }
 
 }  // namespace
 
@@ -185,14 +177,14 @@ std::string ComparisonTable::ToMarkdown() const {
       if (!s || s->n == 0) {
         os << " — |";
       } else {
-        os << ' ' << Format(s->mean * m.display_scale, m.decimals);
-        if (s->half_width) os << " ± " << Format(*s->half_width * m.display_scale, m.decimals);
+        os << ' ' << FormatFixed(s->mean * m.display_scale, m.decimals);
+        if (s->half_width) os << " ± " << FormatFixed(*s->half_width * m.display_scale, m.decimals);
         if (s->n < max_n) os << " (n=" << s->n << ')';
         os << " |";
       }
       if (has_paper[c]) {
         const std::optional<double>& p = paper_[r][c];
-        os << ' ' << (p ? Format(*p * m.display_scale, m.decimals) : "—") << " |";
+        os << ' ' << (p ? FormatFixed(*p * m.display_scale, m.decimals) : "—") << " |";
       }
     }
     os << '\n';

@@ -5,18 +5,15 @@
 #include <limits>
 #include <stdexcept>
 
+#include "dualgrid/core/validation.hpp"
+
 namespace dualgrid::eval {
 
 bool AssociationParams::IsValid(std::string* error) const {
-  auto fail = [&](const char* msg) {
-    if (error != nullptr) *error = msg;
-    return false;
-  };
-  if (!(std::isfinite(box_margin) && box_margin >= 0.0))
-    return fail("box_margin must be finite and >= 0");
-  if (!(std::isfinite(center_gate) && center_gate > 0.0))
-    return fail("center_gate must be finite and > 0");
-  return true;
+  FieldCheck c;
+  c.NonNegative("box_margin", box_margin, "m");
+  c.Positive("center_gate", center_gate, "m");
+  return c.Done(error);
 }
 
 void to_json(nlohmann::json& j, const AssociationParams& p) {

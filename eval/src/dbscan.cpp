@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "dualgrid/core/validation.hpp"
+
 namespace dualgrid::eval {
 
 namespace {
@@ -23,15 +25,11 @@ bool LexLess(const Position& a, const Position& b) {
 }  // namespace
 
 bool DbscanParams::IsValid(std::string* error) const {
-  auto fail = [&](const char* msg) {
-    if (error != nullptr) *error = msg;
-    return false;
-  };
-  if (!(std::isfinite(eps) && eps > 0.0)) return fail("eps must be finite and > 0");
-  if (min_points < 1) return fail("min_points must be >= 1");
-  if (!(std::isfinite(min_weight) && min_weight >= 0.0))
-    return fail("min_weight must be finite and >= 0");
-  return true;
+  FieldCheck c;
+  c.Positive("eps", eps, "m");
+  c.AtLeast("min_points", min_points, 1);
+  c.NonNegative("min_weight", min_weight);
+  return c.Done(error);
 }
 
 void to_json(nlohmann::json& j, const DbscanParams& p) {

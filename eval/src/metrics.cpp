@@ -4,6 +4,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "dualgrid/core/validation.hpp"
 #include "json_util.hpp"
 
 namespace dualgrid::eval {
@@ -12,20 +13,15 @@ using detail::OptFromJson;
 using detail::OptToJson;
 
 bool TrackingMetricsParams::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& msg) {
-    if (error != nullptr) *error = msg;
-    return false;
-  };
-  std::string inner;
-  if (!association.IsValid(&inner)) return fail("association." + inner);
-  if (window < 1) return fail("window must be >= 1");
-  if (required < 1 || required > window) return fail("required must be in [1, window]");
-  if (min_frames_in_grid < 1) return fail("min_frames_in_grid must be >= 1");
-  if (!(velocity_tolerance > 0.0 && std::isfinite(velocity_tolerance)))
-    return fail("velocity_tolerance must be finite and > 0");
-  if (!(velocity_tolerance_fraction >= 0.0 && velocity_tolerance_fraction <= 1.0))
-    return fail("velocity_tolerance_fraction must be in [0, 1]");
-  return true;
+  FieldCheck c;
+  c.Member("association.", association);
+  c.AtLeast("window", window, 1);
+  c.Expect(required >= 1 && required <= window, "required", std::to_string(required),
+           "in [1, window = " + std::to_string(window) + "]");
+  c.AtLeast("min_frames_in_grid", min_frames_in_grid, 1);
+  c.Positive("velocity_tolerance", velocity_tolerance, "m/s");
+  c.InRange("velocity_tolerance_fraction", velocity_tolerance_fraction, 0.0, 1.0);
+  return c.Done(error);
 }
 
 TrackingMetricsAccumulator::TrackingMetricsAccumulator(const TrackingMetricsParams& params)

@@ -2,18 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
+
+#include "dualgrid/core/text.hpp"
 
 namespace dualgrid::eval {
 
 namespace {
 
-std::string Number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+// Numbers in the verdict tables: 4 significant digits.
+std::string Number(double v) { return FormatSignificant(v, 4); }
 
 std::string Trim(const std::string& s) {
   const auto a = s.find_first_not_of(" \t");
@@ -78,7 +76,8 @@ MetricRef ParseMetricRef(const std::string& text) {
 
 std::string Band::Describe() const {
   if (reference && tolerance) return Number(*reference) + " ± " + Number(*tolerance);
-  if (min && max) return "[" + Number(*min) + ", " + Number(*max) + "]";
+  // std::string first: "[" + a temporary trips GCC 12's -Wrestrict (a false positive).
+  if (min && max) return std::string("[") + Number(*min) + ", " + Number(*max) + "]";
   if (min) return ">= " + Number(*min);
   if (max) return "<= " + Number(*max);
   return "any";

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <utility>
 
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/validation.hpp"
+
 namespace dualgrid::filter {
 
 std::string_view ToString(WeightMode mode) {
@@ -90,73 +93,63 @@ int FilterParams::CellsY() const {
   return std::max(1, static_cast<int>(std::lround(width_y / resolution)));
 }
 
-namespace {
-
-bool Fail(std::string* error, const std::string& msg) {
-  if (error) *error = msg;
-  return false;
-}
-
-}  // namespace
-
 double FilterParams::MemoryBytes() const {
   const double cells = static_cast<double>(CellsX()) * CellsY();
   return 93.0 * cells + 88.0 * num_particles + 44.0 * num_birth;
 }
 
 bool FilterParams::IsValid(std::string* error) const {
-  const auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
-  const auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
-  const auto prob = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
-  if (!finite_pos(resolution)) return Fail(error, "resolution must be finite and > 0");
-  if (!finite_pos(length_x) || length_x < resolution)
-    return Fail(error, "length_x must be finite and >= resolution");
-  if (!finite_pos(width_y) || width_y < resolution)
-    return Fail(error, "width_y must be finite and >= resolution");
-  if (static_cast<double>(CellsX()) * CellsY() > 2.0e8)
-    return Fail(error, "length_x/width_y/resolution give more than 2e8 cells");
-  if (num_particles < 1) return Fail(error, "num_particles must be >= 1");
-  if (num_birth < 0) return Fail(error, "num_birth must be >= 0");
-  if (!finite_nonneg(process_noise_position))
-    return Fail(error, "process_noise_position must be finite and >= 0");
-  if (!finite_nonneg(process_noise_velocity))
-    return Fail(error, "process_noise_velocity must be finite and >= 0");
-  if (!prob(persistence) || persistence == 0.0) return Fail(error, "persistence must be in (0, 1]");
-  if (!prob(birth_probability)) return Fail(error, "birth_probability must be in [0, 1]");
-  if (!finite_nonneg(birth_max_tangential_speed))
-    return Fail(error, "birth_max_tangential_speed must be finite and >= 0");
-  if (!finite_pos(max_speed)) return Fail(error, "max_speed must be finite and > 0");
-  if (!finite_nonneg(birth_sigma_radial))
-    return Fail(error, "birth_sigma_radial must be finite and >= 0");
-  if (!finite_pos(sigma_f)) return Fail(error, "sigma_f must be finite and > 0");
-  if (!finite_pos(sigma_static_distance))
-    return Fail(error, "sigma_static_distance must be finite and > 0");
-  if (!finite_pos(sigma_static_velocity))
-    return Fail(error, "sigma_static_velocity must be finite and > 0");
-  if (!finite_pos(sigma_v)) return Fail(error, "sigma_v must be finite and > 0");
-  if (!finite_pos(cutoff_sigmas)) return Fail(error, "cutoff_sigmas must be finite and > 0");
+  FieldCheck c;
+  c.Positive("resolution", resolution, "m");
+  c.Expect(std::isfinite(length_x) && length_x >= resolution, "length_x", length_x,
+           "finite and >= resolution = " + FormatShort(resolution) + " m");
+  c.Expect(std::isfinite(width_y) && width_y >= resolution, "width_y", width_y,
+           "finite and >= resolution = " + FormatShort(resolution) + " m");
+  if (c.ok()) {
+    const double cells = static_cast<double>(CellsX()) * CellsY();
+    c.Expect(cells <= 2.0e8, "length_x/width_y/resolution",
+             FormatShort(length_x) + "/" + FormatShort(width_y) + "/" + FormatShort(resolution) +
+                 " m (" + FormatShort(cells) + " cells)",
+             "at most 2e8 cells");
+  }
+  c.AtLeast("num_particles", num_particles, 1);
+  c.AtLeast("num_birth", num_birth, 0);
+  c.NonNegative("process_noise_position", process_noise_position);
+  c.NonNegative("process_noise_velocity", process_noise_velocity);
+  c.InRange("persistence", persistence, 0.0, 1.0, Interval::kLeftOpen);
+  c.InRange("birth_probability", birth_probability, 0.0, 1.0);
+  c.NonNegative("birth_max_tangential_speed", birth_max_tangential_speed, "m/s");
+  c.Positive("max_speed", max_speed, "m/s");
+  c.NonNegative("birth_sigma_radial", birth_sigma_radial, "m/s");
+  c.Positive("sigma_f", sigma_f, "m");
+  c.Positive("sigma_static_distance", sigma_static_distance, "m");
+  c.Positive("sigma_static_velocity", sigma_static_velocity, "m/s");
+  c.Positive("sigma_v", sigma_v, "m/s");
+  c.Positive("cutoff_sigmas", cutoff_sigmas);
   // Masses of 1 would allow total conflict (1 - K = 0) in the Dempster-Shafer fusion.
-  if (!prob(occupied_mass) || occupied_mass >= 1.0)
-    return Fail(error, "occupied_mass must be in [0, 1)");
-  if (!prob(free_mass) || free_mass >= 1.0) return Fail(error, "free_mass must be in [0, 1)");
-  if (!prob(free_mass_no_return) || free_mass_no_return > free_mass)
-    return Fail(error, "free_mass_no_return must be in [0, free_mass]");
-  if (!finite_pos(free_angle_bin) || free_angle_bin > 1.0)
-    return Fail(error, "free_angle_bin must be in (0, 1] rad");
-  if (free_bin_dilation < 0) return Fail(error, "free_bin_dilation must be >= 0");
-  if (!prob(free_decay)) return Fail(error, "free_decay must be in [0, 1]");
-  if (!prob(static_persistence)) return Fail(error, "static_persistence must be in [0, 1]");
-  if (!finite_nonneg(static_gain)) return Fail(error, "static_gain must be finite and >= 0");
-  if (!finite_nonneg(static_speed)) return Fail(error, "static_speed must be finite and >= 0");
-  if (!prob(decay_eps) || decay_eps >= 1.0) return Fail(error, "decay_eps must be in [0, 1)");
-  if (mode != WeightMode::kPosition && mode != WeightMode::kVelocity && mode != WeightMode::kDual)
-    return Fail(error, "mode is not a WeightMode");
-  if (ToString(birth_velocity) == "unknown") return Fail(error, "birth_velocity is not a value");
-  if (ToString(zero_likelihood) == "unknown") return Fail(error, "zero_likelihood is not a value");
-  if (ToString(velocity_likelihood) == "unknown")
-    return Fail(error, "velocity_likelihood is not a value");
-  if (ToString(normalisation) == "unknown") return Fail(error, "normalisation is not a value");
-  return true;
+  c.InRange("occupied_mass", occupied_mass, 0.0, 1.0, Interval::kRightOpen);
+  c.InRange("free_mass", free_mass, 0.0, 1.0, Interval::kRightOpen);
+  c.Expect(free_mass_no_return >= 0.0 && free_mass_no_return <= free_mass, "free_mass_no_return",
+           free_mass_no_return, "in [0, free_mass = " + FormatShort(free_mass) + "]");
+  c.InRange("free_angle_bin", free_angle_bin, 0.0, 1.0, Interval::kLeftOpen, "rad");
+  c.AtLeast("free_bin_dilation", free_bin_dilation, 0);
+  c.InRange("free_decay", free_decay, 0.0, 1.0);
+  c.InRange("static_persistence", static_persistence, 0.0, 1.0);
+  c.NonNegative("static_gain", static_gain);
+  c.NonNegative("static_speed", static_speed, "m/s");
+  c.InRange("decay_eps", decay_eps, 0.0, 1.0, Interval::kRightOpen);
+  const auto check_enum = [&](std::string_view field, auto value, std::string_view name,
+                              std::string_view expected) {
+    c.Expect(name != "unknown", field, std::to_string(static_cast<int>(value)), expected);
+  };
+  check_enum("mode", mode, ToString(mode), "position, velocity or dual");
+  check_enum("birth_velocity", birth_velocity, ToString(birth_velocity), "doppler or uniform");
+  check_enum("zero_likelihood", zero_likelihood, ToString(zero_likelihood),
+             "keep_prediction or literal");
+  check_enum("velocity_likelihood", velocity_likelihood, ToString(velocity_likelihood),
+             "vector or radial");
+  check_enum("normalisation", normalisation, ToString(normalisation), "per_cell or literal");
+  return c.Done(error);
 }
 
 }  // namespace dualgrid::filter

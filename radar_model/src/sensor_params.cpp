@@ -3,74 +3,73 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/validation.hpp"
+
 namespace dualgrid::radar {
 namespace {
 
 // Resolution-cell indices are packed 20 bits per dimension (radar_model.cpp).
 constexpr double kMaxBins = 1 << 20;
 
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
-}
-
 }  // namespace
 
 bool SensorParams::IsValid(std::string* error) const {
-  const auto finite = [](double v) { return std::isfinite(v); };
-  if (name.empty()) return Fail(error, "name: must not be empty");
-  if (!finite(mount.position.x()) || !finite(mount.position.y()) || !finite(mount.yaw))
-    return Fail(error, "mount: must be finite");
-  if (!finite(fov) || fov <= 0.0 || fov > 2.0 * kPi)
-    return Fail(error, "fov: must be in (0, 2 pi] rad (full azimuth field of view)");
-  if (!finite(min_range) || min_range < 0.0) return Fail(error, "min_range: must be >= 0 m");
-  if (!finite(max_range) || max_range <= min_range)
-    return Fail(error, "max_range: must be finite and > min_range");
-  if (!finite(min_range_rate)) return Fail(error, "min_range_rate: must be finite");
-  if (!finite(max_range_rate) || max_range_rate <= min_range_rate)
-    return Fail(error, "max_range_rate: must be finite and > min_range_rate");
-  if (!finite(range_resolution) || range_resolution <= 0.0 ||
-      max_range / range_resolution >= kMaxBins)
-    return Fail(error, "range_resolution: must be > 0 and give fewer than 2^20 range cells");
-  if (!finite(azimuth_resolution) || azimuth_resolution <= 0.0 ||
-      fov / azimuth_resolution >= kMaxBins - 4)  // + the partial cells at the edges
-    return Fail(error, "azimuth_resolution: must be > 0 and give fewer than 2^20 azimuth cells");
-  if (!finite(range_rate_resolution) || range_rate_resolution <= 0.0 ||
-      (max_range_rate - min_range_rate) / range_rate_resolution >= kMaxBins)
-    return Fail(error,
-                "range_rate_resolution: must be > 0 and give fewer than 2^20 range-rate cells");
-  if (!finite(range_accuracy) || range_accuracy < 0.0)
-    return Fail(error, "range_accuracy: must be >= 0 m");
-  if (!finite(azimuth_accuracy) || azimuth_accuracy < 0.0)
-    return Fail(error, "azimuth_accuracy: must be >= 0");
-  if (!finite(range_rate_accuracy) || range_rate_accuracy < 0.0)
-    return Fail(error, "range_rate_accuracy: must be >= 0 m/s");
-  if (off_boresight_resolution.size() != off_boresight.size() ||
-      off_boresight_accuracy.size() != off_boresight.size())
-    return Fail(error,
-                "off_boresight: off_boresight_deg, off_boresight_resolution and "
-                "off_boresight_accuracy must have the same length");
-  for (std::size_t k = 0; k < off_boresight.size(); ++k) {
-    if (!finite(off_boresight[k]) || off_boresight[k] < 0.0 || off_boresight[k] > kPi ||
-        (k > 0 && off_boresight[k] <= off_boresight[k - 1]))
-      return Fail(error, "off_boresight: angles must increase within [0, 180] deg");
-    if (!finite(off_boresight_resolution[k]) || off_boresight_resolution[k] < 1.0 ||
-        off_boresight_resolution[k] > 100.0)
-      return Fail(error, "off_boresight_resolution: factors must be in [1, 100]");
-    if (!finite(off_boresight_accuracy[k]) || off_boresight_accuracy[k] < 1.0 ||
-        off_boresight_accuracy[k] > 1000.0)
-      return Fail(error, "off_boresight_accuracy: factors must be in [1, 1000]");
+  using std::isfinite;
+  FieldCheck c;
+  c.Expect(!name.empty(), "name", "''", "a non-empty name");
+  c.Expect(mount.position.allFinite() && isfinite(mount.yaw), "mount",
+           FormatTuple({mount.position.x(), mount.position.y(), mount.yaw}),
+           "finite (x, y [m], yaw [rad])");
+  c.Expect(fov > 0.0 && fov <= 2.0 * kPi, "fov", fov,
+           "in (0, 2 pi] rad (the full azimuth field of view)");
+  c.NonNegative("min_range", min_range, "m");
+  c.Expect(isfinite(max_range) && max_range > min_range, "max_range", max_range,
+           "finite and > min_range = " + FormatShort(min_range) + " m");
+  c.Finite("min_range_rate", min_range_rate, "m/s");
+  c.Expect(isfinite(max_range_rate) && max_range_rate > min_range_rate, "max_range_rate",
+           max_range_rate, "finite and > min_range_rate = " + FormatShort(min_range_rate) + " m/s");
+  c.Expect(isfinite(range_resolution) && range_resolution > 0.0 &&
+               max_range / range_resolution < kMaxBins,
+           "range_resolution", range_resolution,
+           "> 0 m with fewer than 2^20 range cells up to max_range");
+  c.Expect(isfinite(azimuth_resolution) && azimuth_resolution > 0.0 &&
+               fov / azimuth_resolution < kMaxBins - 4,  // + the partial cells at the edges
+           "azimuth_resolution", azimuth_resolution,
+           "> 0 rad with fewer than 2^20 azimuth cells over the fov");
+  c.Expect(isfinite(range_rate_resolution) && range_rate_resolution > 0.0 &&
+               (max_range_rate - min_range_rate) / range_rate_resolution < kMaxBins,
+           "range_rate_resolution", range_rate_resolution,
+           "> 0 m/s with fewer than 2^20 range-rate cells over the range-rate window");
+  c.NonNegative("range_accuracy", range_accuracy, "m");
+  c.NonNegative("azimuth_accuracy", azimuth_accuracy, "rad");
+  c.NonNegative("range_rate_accuracy", range_rate_accuracy, "m/s");
+  c.Expect(off_boresight_resolution.size() == off_boresight.size() &&
+               off_boresight_accuracy.size() == off_boresight.size(),
+           "off_boresight",
+           std::to_string(off_boresight.size()) + " angles, " +
+               std::to_string(off_boresight_resolution.size()) + " resolution and " +
+               std::to_string(off_boresight_accuracy.size()) + " accuracy factors",
+           "off_boresight_deg, off_boresight_resolution and off_boresight_accuracy of the same "
+           "length");
+  for (std::size_t k = 0; c.ok() && k < off_boresight.size(); ++k) {
+    const double a = off_boresight[k];
+    if (k == 0)
+      c.Expect(a >= 0.0 && a <= kPi, Indexed("off_boresight", k), a, "in [0, pi] rad");
+    else
+      c.Expect(a > off_boresight[k - 1] && a <= kPi, Indexed("off_boresight", k), a,
+               "in (" + Indexed("off_boresight", k - 1) + " = " +
+                   FormatShort(off_boresight[k - 1]) + ", pi] rad (increasing)");
+    c.InRange(Indexed("off_boresight_resolution", k), off_boresight_resolution[k], 1.0, 100.0);
+    c.InRange(Indexed("off_boresight_accuracy", k), off_boresight_accuracy[k], 1.0, 1000.0);
   }
-  if (!finite(reference_range) || reference_range <= 0.0)
-    return Fail(error, "reference_range: must be > 0 m");
-  if (!finite(reference_rcs_dbsm)) return Fail(error, "reference_rcs_dbsm: must be finite");
-  if (!finite(false_alarm_rate) || false_alarm_rate <= 0.0 || false_alarm_rate >= 0.5)
-    return Fail(error, "false_alarm_rate: must be in (0, 0.5)");
-  if (!finite(reference_pd) || reference_pd <= false_alarm_rate || reference_pd >= 1.0)
-    return Fail(error, "reference_pd: must be in (false_alarm_rate, 1)");
-  if (!finite(update_period) || update_period <= 0.0)
-    return Fail(error, "update_period: must be > 0 s");
-  return true;
+  c.Positive("reference_range", reference_range, "m");
+  c.Finite("reference_rcs_dbsm", reference_rcs_dbsm, "dBsm");
+  c.InRange("false_alarm_rate", false_alarm_rate, 0.0, 0.5, Interval::kOpen);
+  c.Expect(reference_pd > false_alarm_rate && reference_pd < 1.0, "reference_pd", reference_pd,
+           "in (false_alarm_rate = " + FormatShort(false_alarm_rate) + ", 1)");
+  c.Positive("update_period", update_period, "s");
+  return c.Done(error);
 }
 
 namespace {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <type_traits>
 
+#include "dualgrid/core/validation.hpp"
 #include "dualgrid/sim/sumo_files.hpp"
 #include "yaml_reader.hpp"
 
@@ -310,18 +311,28 @@ void WriteSensorProfile(const radar::SensorParams& s, nlohmann::json* j) {
   (*j)["off_boresight_accuracy"] = s.off_boresight_accuracy;
 }
 
-// Turns "field: message" from an IsValid into a ConfigError under `section`.
+// Turns an IsValid message into a ConfigError naming the key under `section`. FieldCheck
+// messages, "field = value: expected what", read as the parser's own: "key '<section>.field'
+// expected what, got value"; other validators write "field: message" or "field message".
 [[noreturn]] void Invalid(const std::string& file, const std::string& section,
                           const std::string& error) {
-  // Validators write "field: message" or "field message".
+  const auto key = [&](const std::string& field) {
+    return file + ": key '" + (section.empty() ? field : section + "." + field) + "' ";
+  };
   auto colon = error.find(": ");
+  const auto equals = error.find(" = ");
+  if (equals != std::string::npos && equals < colon) {
+    const auto expected = error.find(": expected ", equals);
+    if (expected != std::string::npos)
+      throw ConfigError(key(error.substr(0, equals)) + "expected " + error.substr(expected + 11) +
+                        ", got " + error.substr(equals + 3, expected - equals - 3));
+  }
   std::size_t skip = 2;
   if (colon == std::string::npos) colon = error.find(' '), skip = 1;
   const std::string field = colon == std::string::npos ? error : error.substr(0, colon);
   const std::string message =
       colon == std::string::npos ? "is invalid" : error.substr(colon + skip);
-  throw ConfigError(file + ": key '" + (section.empty() ? field : section + "." + field) + "' " +
-                    message);
+  throw ConfigError(key(field) + message);
 }
 
 void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* radar) {
@@ -522,24 +533,12 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
 void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out);
 
 bool EvaluationConfig::IsValid(std::string* error) const {
-  if (!(dynamic_threshold > 0.0 && dynamic_threshold < 1.0)) {
-    if (error) *error = "dynamic_threshold: must be in (0, 1)";
-    return false;
-  }
-  if (!(min_cluster_mass >= 0.0)) {
-    if (error) *error = "min_cluster_mass: must be >= 0";
-    return false;
-  }
-  std::string e;
-  if (!dbscan.IsValid(&e)) {
-    if (error) *error = "dbscan_" + e;
-    return false;
-  }
-  if (!tracking.IsValid(&e)) {
-    if (error) *error = e;
-    return false;
-  }
-  return true;
+  FieldCheck c;
+  c.InRange("dynamic_threshold", dynamic_threshold, 0.0, 1.0, Interval::kOpen);
+  c.Expect(min_cluster_mass >= 0.0, "min_cluster_mass", min_cluster_mass, ">= 0");
+  c.Member("dbscan_", dbscan);
+  c.Member("", tracking);
+  return c.Done(error);
 }
 
 Vector2 GridPlacement::CentreOffset(double length_x, double width_y) const {

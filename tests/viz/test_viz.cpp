@@ -782,10 +782,10 @@ TEST_CASE("bar charts draw confidence whiskers and validate them", "[viz]") {
   CHECK(Near(at(a.left + 0.1 * a.width + 0.1 * bar_w, 0.4), ModeColor(Mode::kDual), 3));
   chart.series[0].errors = {0.1, 0.2};
   CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
-                       "series[0].errors has 2 values, expected 0 or 1");
+                       "series[0].errors = 2 values: expected none or 1 value");
   chart.series[0].errors = {-0.1};
   CheckInvalidArgument([&] { RenderBarChart(chart, path.string()); },
-                       "series[0].errors must be finite and >= 0");
+                       "series[0].errors[0] = -0.1: expected finite and >= 0");
 }
 
 TEST_CASE("line charts draw 95 % CI error bars and validate them", "[viz]") {
@@ -816,10 +816,10 @@ TEST_CASE("line charts draw 95 % CI error bars and validate them", "[viz]") {
   CHECK(Near(at(8.0, 0.62), colors::kWhite, 2));
   chart.series[0].errors = {0.1};
   CheckInvalidArgument([&] { RenderLineChart(chart, path.string()); },
-                       "series[0].errors has 1 values, expected 0 or 2");
+                       "series[0].errors = 1 value: expected none or 2 values");
   chart.series[0].errors = {0.1, -1.0};
   CheckInvalidArgument([&] { RenderLineChart(chart, path.string()); },
-                       "series[0].errors must be finite and >= 0");
+                       "series[0].errors[1] = -1: expected finite and >= 0");
 }
 
 TEST_CASE("bar charts turn category names that do not fit, and wrap long captions", "[viz]") {

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "draw.hpp"
+#include "dualgrid/core/validation.hpp"
 
 namespace dualgrid::viz {
 
@@ -17,15 +18,12 @@ using detail::SetColor;
 using detail::VAlign;
 
 bool BirdsEyeOptions::IsValid(std::string* error) const {
-  auto fail = [&](const char* msg) {
-    if (error) *error = msg;
-    return false;
-  };
-  if (pixel_width < 100 || pixel_width > 20000) return fail("pixel_width must be in [100, 20000]");
-  if (!(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0)))
-    return fail("font_size must be 0 (automatic) or in [2, 200]");
-  if (!(png_scale > 0.0 && png_scale <= 32.0)) return fail("png_scale must be in (0, 32]");
-  return true;
+  FieldCheck c;
+  c.InRange("pixel_width", pixel_width, 100, 20000);
+  c.Expect(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0), "font_size", font_size,
+           "0 (automatic) or in [2, 200] pt");
+  c.InRange("png_scale", png_scale, 0.0, 32.0, Interval::kLeftOpen);
+  return c.Done(error);
 }
 
 double BirdsEyeOptions::BaseFont() const {
@@ -33,15 +31,11 @@ double BirdsEyeOptions::BaseFont() const {
 }
 
 bool DetectionStyle::IsValid(std::string* error) const {
-  auto fail = [&](const char* msg) {
-    if (error) *error = msg;
-    return false;
-  };
-  if (!(max_speed > 0.0) || !std::isfinite(max_speed)) return fail("max_speed must be positive");
-  if (!(arrow_scale >= 0.0) || !std::isfinite(arrow_scale))
-    return fail("arrow_scale must be non-negative");
-  if (!(radius_px > 0.0 && radius_px <= 50.0)) return fail("radius_px must be in (0, 50]");
-  return true;
+  FieldCheck c;
+  c.Positive("max_speed", max_speed, "m/s");
+  c.NonNegative("arrow_scale", arrow_scale, "s");
+  c.InRange("radius_px", radius_px, 0.0, 50.0, Interval::kLeftOpen);
+  return c.Done(error);
 }
 
 namespace {

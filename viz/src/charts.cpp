@@ -8,7 +8,9 @@
 
 #include "chart_frame.hpp"
 #include "draw.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/core/validation.hpp"
 
 namespace dualgrid::viz {
 
@@ -24,27 +26,21 @@ using detail::VAlign;
 
 namespace {
 
-bool Fail(std::string* error, const std::string& msg) {
-  if (error) *error = msg;
-  return false;
+std::string Values(std::size_t n) { return std::to_string(n) + (n == 1 ? " value" : " values"); }
+
+void CheckSize(FieldCheck& c, int width, int height, double png_scale) {
+  c.InRange("width", width, 100, 5000);
+  c.InRange("height", height, 80, 5000);
+  c.InRange("png_scale", png_scale, 0.0, 32.0, Interval::kLeftOpen);
 }
 
-bool ValidSize(int width, int height, double png_scale, std::string* error) {
-  if (width < 100 || width > 5000) return Fail(error, "width must be in [100, 5000] pt");
-  if (height < 80 || height > 5000) return Fail(error, "height must be in [80, 5000] pt");
-  if (!(png_scale > 0.0 && png_scale <= 32.0)) return Fail(error, "png_scale must be in (0, 32]");
-  return true;
-}
-
-bool ValidErrors(const std::vector<double>& errors, std::size_t n, const std::string& name,
-                 std::string* error) {
-  if (!errors.empty() && errors.size() != n)
-    return Fail(error, name + ".errors has " + std::to_string(errors.size()) +
-                           " values, expected 0 or " + std::to_string(n));
-  for (double e : errors)
-    if (!std::isnan(e) && !(e >= 0.0 && std::isfinite(e)))
-      return Fail(error, name + ".errors must be finite and >= 0");
-  return true;
+// Error bars of a series `name` with n values: none, or one per value (NaN: no bar there).
+void CheckErrors(FieldCheck& c, const std::vector<double>& errors, std::size_t n,
+                 const std::string& name) {
+  c.Expect(errors.empty() || errors.size() == n, name + ".errors", Values(errors.size()),
+           "none or " + Values(n));
+  for (std::size_t i = 0; i < errors.size(); ++i)
+    if (!std::isnan(errors[i])) c.NonNegative(Indexed(name + ".errors", i), errors[i]);
 }
 
 Rgba SeriesColor(const std::string& name, const std::optional<Rgba>& color, int index) {
@@ -171,41 +167,42 @@ PlotArea ChartPlotArea(int width, int height) {
 }
 
 bool BarChart::IsValid(std::string* error) const {
-  if (!ValidSize(width, height, png_scale, error)) return false;
+  FieldCheck c;
+  CheckSize(c, width, height, png_scale);
   for (std::size_t i = 0; i < series.size(); ++i) {
-    const std::string name = "series[" + std::to_string(i) + "]";
-    if (series[i].values.size() != categories.size())
-      return Fail(error, name + ".values has " + std::to_string(series[i].values.size()) +
-                             " values, expected " + std::to_string(categories.size()) +
-                             " (one per category)");
-    for (double v : series[i].values)
-      if (std::isinf(v)) return Fail(error, name + ".values has inf");
-    if (!ValidErrors(series[i].errors, categories.size(), name, error)) return false;
+    const std::string name = Indexed("series", i);
+    const std::vector<double>& values = series[i].values;
+    c.Expect(values.size() == categories.size(), name + ".values", Values(values.size()),
+             Values(categories.size()) + " (one per category)");
+    for (std::size_t k = 0; k < values.size(); ++k)  // NaN: no bar
+      c.Expect(!std::isinf(values[k]), Indexed(name + ".values", k), values[k],
+               "finite or nan (no bar)");
+    CheckErrors(c, series[i].errors, categories.size(), name);
   }
-  if (!std::isfinite(y_min)) return Fail(error, "y_min must be finite");
-  if (!std::isnan(y_max) && !(y_max > y_min)) return Fail(error, "y_max must exceed y_min");
-  return true;
+  c.Finite("y_min", y_min);
+  c.Expect(std::isnan(y_max) || y_max > y_min, "y_max", y_max,
+           "nan (automatic) or > y_min = " + FormatShort(y_min));
+  return c.Done(error);
 }
 
 bool LineChart::IsValid(std::string* error) const {
-  if (!ValidSize(width, height, png_scale, error)) return false;
+  FieldCheck c;
+  CheckSize(c, width, height, png_scale);
   for (std::size_t i = 0; i < series.size(); ++i) {
     const LineSeries& s = series[i];
-    const std::string name = "series[" + std::to_string(i) + "]";
-    if (s.x.size() != s.y.size())
-      return Fail(error, name + ".y has " + std::to_string(s.y.size()) + " values, expected " +
-                             std::to_string(s.x.size()) + " (size of x)");
-    if (!(s.line_width > 0.0 && s.line_width <= 20.0))
-      return Fail(error, name + ".line_width must be in (0, 20]");
-    if (!ValidErrors(s.errors, s.x.size(), name, error)) return false;
+    const std::string name = Indexed("series", i);
+    c.Expect(s.x.size() == s.y.size(), name + ".y", Values(s.y.size()),
+             Values(s.x.size()) + " (the size of x)");
+    c.InRange(name + ".line_width", s.line_width, 0.0, 20.0, Interval::kLeftOpen, "pt");
+    CheckErrors(c, s.errors, s.x.size(), name);
   }
-  if (log_y && !std::isnan(y_min) && !(y_min > 0.0))
-    return Fail(error, "y_min must be positive with log_y");
-  if (!std::isnan(x_min) && !std::isnan(x_max) && !(x_max > x_min))
-    return Fail(error, "x_max must exceed x_min");
-  if (!std::isnan(y_min) && !std::isnan(y_max) && !(y_max > y_min))
-    return Fail(error, "y_max must exceed y_min");
-  return true;
+  c.Expect(!log_y || std::isnan(y_min) || y_min > 0.0, "y_min", y_min,
+           "nan (automatic) or > 0 with log_y");
+  c.Expect(std::isnan(x_min) || std::isnan(x_max) || x_max > x_min, "x_max", x_max,
+           "> x_min = " + FormatShort(x_min));
+  c.Expect(std::isnan(y_min) || std::isnan(y_max) || y_max > y_min, "y_max", y_max,
+           "> y_min = " + FormatShort(y_min));
+  return c.Done(error);
 }
 
 ChartLayout LayoutBarChart(const BarChart& chart) {

@@ -8,6 +8,8 @@
 
 #include "cell_image.hpp"
 #include "draw.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/validation.hpp"
 
 namespace dualgrid::viz {
 
@@ -23,48 +25,37 @@ WorldRect GridRaster::Extent() const {
 }
 
 bool GridRaster::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& msg) {
-    if (error) *error = msg;
-    return false;
-  };
-  if (cells_x <= 0) return fail("cells_x must be positive");
-  if (cells_y <= 0) return fail("cells_y must be positive");
-  if (!(resolution > 0.0) || !std::isfinite(resolution)) return fail("resolution must be positive");
-  if (!origin.allFinite()) return fail("origin must be finite");
-  const std::size_t n = static_cast<std::size_t>(cells_x) * static_cast<std::size_t>(cells_y);
+  FieldCheck c;
+  c.AtLeast("cells_x", cells_x, 1);
+  c.AtLeast("cells_y", cells_y, 1);
+  c.Positive("resolution", resolution, "m");
+  c.Expect(origin.allFinite(), "origin", FormatTuple({origin.x(), origin.y()}), "finite");
+  const std::size_t n = static_cast<std::size_t>(std::max(cells_x, 0)) *
+                        static_cast<std::size_t>(std::max(cells_y, 0));
   const std::pair<const char*, const std::vector<float>*> arrays[] = {
       {"free", &free},       {"static_occ", &static_occ}, {"dynamic", &dynamic},
       {"mean_vx", &mean_vx}, {"mean_vy", &mean_vy},
   };
   for (const auto& [name, values] : arrays) {
-    if (values->size() != n)
-      return fail(std::string(name) + " has " + std::to_string(values->size()) +
-                  " values, expected cells_x * cells_y = " + std::to_string(n));
+    c.Expect(values->size() == n, name, std::to_string(values->size()) + " values",
+             "cells_x * cells_y = " + std::to_string(n) + " values");
   }
-  return true;
+  return c.Done(error);
 }
 
 bool CellColorOptions::IsValid(std::string* error) const {
-  if (!(dynamic_threshold >= 0.0 && dynamic_threshold <= 1.0)) {
-    if (error) *error = "dynamic_threshold must be in [0, 1]";
-    return false;
-  }
-  return true;
+  return FieldCheck().InRange("dynamic_threshold", dynamic_threshold, 0.0, 1.0).Done(error);
 }
 
 bool GridFigureOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& msg) {
-    if (error) *error = msg;
-    return false;
-  };
-  if (image_width < 100 || image_width > 5000) return fail("image_width must be in [100, 5000] pt");
-  if (!(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0)))
-    return fail("font_size must be 0 (automatic) or in [2, 200] pt");
-  if (columns < 0) return fail("columns must be >= 0 (0: automatic)");
-  if (!(png_scale > 0.0 && png_scale <= 32.0)) return fail("png_scale must be in (0, 32]");
-  std::string sub;
-  if (!cell.IsValid(&sub)) return fail("cell." + sub);
-  return true;
+  FieldCheck c;
+  c.InRange("image_width", image_width, 100, 5000);
+  c.Expect(font_size == 0.0 || (font_size >= 2.0 && font_size <= 200.0), "font_size", font_size,
+           "0 (automatic) or in [2, 200] pt");
+  c.AtLeast("columns", columns, 0);
+  c.InRange("png_scale", png_scale, 0.0, 32.0, Interval::kLeftOpen);
+  c.Member("cell.", cell);
+  return c.Done(error);
 }
 
 double GridFigureOptions::BaseFont() const {

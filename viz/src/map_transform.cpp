@@ -4,18 +4,17 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/validation.hpp"
 namespace dualgrid::viz {
 
 bool WorldRect::IsValid(std::string* error) const {
-  auto fail = [&](const char* msg) {
-    if (error) *error = msg;
-    return false;
-  };
-  if (!min.allFinite()) return fail("min must be finite");
-  if (!max.allFinite()) return fail("max must be finite");
-  if (!(max.x() > min.x())) return fail("max.x must exceed min.x");
-  if (!(max.y() > min.y())) return fail("max.y must exceed min.y");
-  return true;
+  FieldCheck c;
+  c.Expect(min.allFinite(), "min", FormatTuple({min.x(), min.y()}), "finite");
+  c.Expect(max.allFinite(), "max", FormatTuple({max.x(), max.y()}), "finite");
+  c.Expect(max.x() > min.x(), "max.x", max.x(), "> min.x = " + FormatShort(min.x()));
+  c.Expect(max.y() > min.y(), "max.y", max.y(), "> min.y = " + FormatShort(min.y()));
+  return c.Done(error);
 }
 
 MapTransform::MapTransform(const WorldRect& world, int pixel_width, const Vector2& pixel_offset)

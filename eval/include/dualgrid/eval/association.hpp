@@ -28,7 +28,8 @@
 
 namespace dualgrid::eval {
 
-/// A ground-truth vehicle at one frame, world frame.
+/// A ground-truth vehicle at one time step, in the clusters' frame (in dualgrid the grid frame,
+/// docs/algorithm.md: the scorer maps the truth into it).
 struct TruthObject {
   int id = 0;                            ///< stable over frames (e.g. SUMO vehicle index)
   OrientedBox box;                       ///< footprint; box.center is the reference point

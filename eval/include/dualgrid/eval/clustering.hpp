@@ -11,14 +11,14 @@
 namespace dualgrid::eval {
 
 /// One particle handed over by the filter (the caller passes only particles of cells with
-/// P(dynamic) > 0.6). World frame.
+/// P(dynamic) > 0.6), in the filter's frame (in dualgrid the grid frame, docs/algorithm.md).
 struct WeightedParticle {
   Position position = Position::Zero();
   Velocity velocity = Velocity::Zero();
   double weight = 0.0;  ///< >= 0; any scale (only ratios within a cluster matter)
 };
 
-/// A cluster of particles, world frame.
+/// A cluster of particles, in its particles' frame.
 struct Cluster {
   Position position = Position::Zero();  ///< weighted mean position [m]
   Velocity velocity = Velocity::Zero();  ///< weighted mean velocity [m/s]

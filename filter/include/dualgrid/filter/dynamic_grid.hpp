@@ -1,6 +1,10 @@
 // Radar-only dynamic occupancy grid with position, velocity and dual particle weights
 // (Ronecker, Stolz, Watzenig 2023) on a Nuss-style random-finite-set particle grid.
 // Pipeline and choices: docs/algorithm.md.
+//
+// Frame: the filter is frame-agnostic. Every input and output is in one Cartesian frame, the
+// caller's (in dualgrid the grid frame, docs/algorithm.md "Grid frame"), and the grid's cells are
+// axis-aligned with it.
 #pragma once
 
 #include <array>
@@ -18,7 +22,7 @@
 
 namespace dualgrid::filter {
 
-/// One radar detection in the world frame, the paper's eq. (1) [x, y, v_rx, v_ry].
+/// One radar detection, the paper's eq. (1) [x, y, v_rx, v_ry], in the caller's frame (above).
 struct Measurement {
   Position position;
   /// Ego-motion-compensated radial speed over ground times the line-of-sight unit vector.
@@ -26,7 +30,7 @@ struct Measurement {
   Position sensor_position;
 };
 
-/// Field of view of one sensor that scanned this cycle (world frame).
+/// Field of view of one sensor that scanned this cycle, in the caller's frame.
 struct SensorCoverage {
   Position origin;
   double boresight = 0.0;  ///< [rad]
@@ -35,12 +39,14 @@ struct SensorCoverage {
   double max_range = 0.0;  ///< [m]
 };
 
+/// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
+/// elsewhere in the grid offsets it, as dualgrid's filter.ahead / filter.left do).
 struct EgoInput {
   Pose2 pose;
   Velocity velocity = Velocity::Zero();
 };
 
-/// Logical cell index: x along world +x, y along world +y, 0..cells-1, independent of storage.
+/// Logical cell index: x along the frame's +x, y along its +y, 0..cells-1, independent of storage.
 struct CellIndex {
   int x = 0;
   int y = 0;
@@ -76,7 +82,7 @@ class DynamicGrid {
   std::uint64_t step() const { return step_; }
   bool initialized() const { return initialized_; }
 
-  /// World position of a logical cell's centre.
+  /// Position of a logical cell's centre in the caller's frame [m].
   Position CellCenter(CellIndex c) const;
   /// Logical cell holding `p`, std::nullopt outside the grid (or before the first Update).
   /// Inline: the scorer calls it for every particle.
@@ -133,7 +139,7 @@ class DynamicGrid {
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                       std::int64_t k_hi, double mass, double r, double vmax);
   void Resample();
-  // Detection bucket (clamped to the bucket grid) of a world point.
+  // Detection bucket (clamped to the bucket grid) of a point.
   std::pair<int, int> BucketOf(double px, double py) const;
 
   FilterParams params_;

@@ -61,9 +61,10 @@ std::optional<Normalisation> ParseNormalisation(std::string_view name);
 /// All tuning of DynamicGrid. Defaults: the paper's configuration (200 m x 25 m at 0.5 m, 10,000
 /// particles) and a nominal cycle of 0.05 s; per-cycle factors assume that cycle.
 struct FilterParams {
-  // Grid (axis-aligned with the world frame, centred on the ego).
-  double length_x = 200.0;  ///< Extent along world x [m].
-  double width_y = 25.0;    ///< Extent along world y [m].
+  // Grid, axis-aligned with the filter's frame (the caller's; in dualgrid the grid frame,
+  // docs/algorithm.md) and centred on EgoInput's position.
+  double length_x = 200.0;  ///< Extent along the frame's x [m].
+  double width_y = 25.0;    ///< Extent along the frame's y [m].
   double resolution = 0.5;  ///< Cell edge [m].
 
   // Particles.

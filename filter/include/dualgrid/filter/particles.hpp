@@ -9,12 +9,13 @@
 
 namespace dualgrid::filter {
 
-/// Particles in world metres and m/s. Positions are double (world coordinates can be far from the
-/// origin); velocities and weights are float, which halves the memory traffic of the particle
-/// loops at 1e6+ particles. All weights are dynamic-mass units (see docs/algorithm.md): `weight` is
-/// the resample weight (w_resample, eq. 14, or the single weight of the selected mode); w_position
-/// / w_velocity are the per-cell normalised weights of eqs. (7)/(8), carried through resampling
-/// with their ratio to `weight` preserved.
+/// Particles in the filter's frame (the caller's; in dualgrid the grid frame, docs/algorithm.md)
+/// [m], [m/s]. Positions are double (coordinates can be far from the origin: the grid frame only
+/// turns the world's, keeping their magnitude); velocities and weights are float, which halves the
+/// memory traffic of the particle loops at 1e6+ particles. All weights are dynamic-mass units (see
+/// docs/algorithm.md): `weight` is the resample weight (w_resample, eq. 14, or the single weight of
+/// the selected mode); w_position / w_velocity are the per-cell normalised weights of eqs. (7)/(8),
+/// carried through resampling with their ratio to `weight` preserved.
 struct ParticleSet {
   std::vector<double> x, y;
   std::vector<float> vx, vy;
