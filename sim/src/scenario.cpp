@@ -4,36 +4,36 @@
 #include <set>
 #include <sstream>
 
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/validation.hpp"
+
 namespace dualgrid::sim {
 namespace {
-
-// Sets *error to "<field>: <message>" and returns false; keeps IsValid readable.
-bool Fail(std::string* error, const std::string& field, const std::string& message) {
-  if (error) *error = field + ": " + message;
-  return false;
-}
 
 // SUMO refuses ids with these characters (whitespace and XML or list separators).
 bool ValidSumoId(const std::string& id) {
   return !id.empty() && id.find_first_of(" \t\n\r|\\'\";,<>&") == std::string::npos;
 }
-constexpr const char* kIdRule = "must be non-empty without spaces or any of | \\ ' \" ; , < > &";
+constexpr const char* kIdRule = "non-empty, without spaces or any of | \\ ' \" ; , < > &";
 
-bool CheckVehicle(const VehicleSpec& v, const std::string& field, const ScenarioSpec& s,
-                  std::string* error) {
-  if (!ValidSumoId(v.id)) return Fail(error, field + ".id", kIdRule);
-  if (!s.vehicle_types.count(v.type))
-    return Fail(error, field + ".type", "unknown vehicle type '" + v.type + "'");
-  if (!s.routes.count(v.route))
-    return Fail(error, field + ".route", "unknown route '" + v.route + "'");
-  if (!(v.depart >= 0.0)) return Fail(error, field + ".depart", "must be >= 0 s");
-  if (v.lane < 0) return Fail(error, field + ".lane", "must be a lane index >= 0");
-  if (!(v.position >= 0.0)) return Fail(error, field + ".position", "must be >= 0 m");
-  if (!(v.speed >= kMinTrafficSpeed && v.speed <= kMaxTrafficSpeed))
-    return Fail(error, field + ".speed", "must be in [0, 70] m/s");
-  if (v.desired_speed && !(*v.desired_speed > 0.0 && *v.desired_speed <= kMaxTrafficSpeed))
-    return Fail(error, field + ".desired_speed", "must be in (0, 70] m/s");
-  return true;
+// A name's text for messages.
+std::string Quoted(const std::string& s) { return "'" + s + "'"; }
+
+void CheckVehicle(FieldCheck& c, const VehicleSpec& v, const std::string& field,
+                  const ScenarioSpec& s) {
+  c.Expect(ValidSumoId(v.id), field + ".id", Quoted(v.id), kIdRule);
+  c.Expect(s.vehicle_types.count(v.type) > 0, field + ".type", Quoted(v.type),
+           "a vehicle type of the scenario");
+  c.Expect(s.routes.count(v.route) > 0, field + ".route", Quoted(v.route),
+           "a route of the scenario");
+  c.NonNegative(field + ".depart", v.depart, "s");
+  c.AtLeast(field + ".lane", v.lane, 0);
+  c.NonNegative(field + ".position", v.position, "m");
+  c.InRange(field + ".speed", v.speed, kMinTrafficSpeed, kMaxTrafficSpeed, Interval::kClosed,
+            "m/s");
+  if (v.desired_speed)
+    c.InRange(field + ".desired_speed", *v.desired_speed, 0.0, kMaxTrafficSpeed,
+              Interval::kLeftOpen, "m/s");
 }
 
 }  // namespace
@@ -53,107 +53,101 @@ double VClassRcs(const std::string& vclass) {
 }
 
 bool ScenarioSpec::IsValid(std::string* error) const {
-  if (network.empty()) return Fail(error, "network", "must name a network");
-  if (!(duration > 0.0 && duration <= 3600.0))
-    return Fail(error, "duration", "must be in (0, 3600] s");
-  if (!(step_length >= 0.001 && step_length <= 1.0))
-    return Fail(error, "step_length", "must be in [0.001, 1] s");
-  if (std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) > 1e-6)
-    return Fail(error, "step_length", "must be a whole number of milliseconds (SUMO's resolution)");
-  if (!(lane_change_duration >= 0.0)) return Fail(error, "lane_change_duration", "must be >= 0 s");
+  FieldCheck c;
+  c.Expect(!network.empty(), "network", "''", "the name or path of a network");
+  c.InRange("duration", duration, 0.0, 3600.0, Interval::kLeftOpen, "s");
+  c.InRange("step_length", step_length, 0.001, 1.0, Interval::kClosed, "s");
+  c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6,
+           "step_length", step_length, "a whole number of milliseconds (SUMO's resolution)");
+  c.NonNegative("lane_change_duration", lane_change_duration, "s");
   for (const auto& [name, t] : vehicle_types) {
     const std::string f = "vehicle_types." + name;
-    if (!ValidSumoId(name)) return Fail(error, f, std::string("(the type's name) ") + kIdRule);
-    if (!(t.length > 0.0 && t.length <= 30.0))
-      return Fail(error, f + ".length", "must be in (0, 30] m");
-    if (!(t.width > 0.0 && t.width <= 4.0)) return Fail(error, f + ".width", "must be in (0, 4] m");
-    if (!(t.max_speed > 0.0 && t.max_speed <= kMaxTrafficSpeed))
-      return Fail(error, f + ".max_speed", "must be in (0, 70] m/s");
-    if (!(t.accel > 0.0)) return Fail(error, f + ".accel", "must be > 0 m/s^2");
-    if (!(t.decel > 0.0)) return Fail(error, f + ".decel", "must be > 0 m/s^2");
-    if (!std::isfinite(t.rcs_dbsm)) return Fail(error, f + ".rcs_dbsm", "must be finite");
+    c.Expect(ValidSumoId(name), f, Quoted(name), std::string("a type name ") + kIdRule);
+    c.InRange(f + ".length", t.length, 0.0, 30.0, Interval::kLeftOpen, "m");
+    c.InRange(f + ".width", t.width, 0.0, 4.0, Interval::kLeftOpen, "m");
+    c.InRange(f + ".max_speed", t.max_speed, 0.0, kMaxTrafficSpeed, Interval::kLeftOpen, "m/s");
+    c.Positive(f + ".accel", t.accel, "m/s^2");
+    c.Positive(f + ".decel", t.decel, "m/s^2");
+    c.Finite(f + ".rcs_dbsm", t.rcs_dbsm, "dBsm");
   }
   for (const auto& [name, edges] : routes) {
-    if (!ValidSumoId(name))
-      return Fail(error, "routes." + name, std::string("(the route's name) ") + kIdRule);
-    if (edges.empty()) return Fail(error, "routes." + name, "must list at least one edge");
+    c.Expect(ValidSumoId(name), "routes." + name, Quoted(name),
+             std::string("a route name ") + kIdRule);
+    c.Expect(!edges.empty(), "routes." + name, "[]", "at least one edge");
   }
-  if (!(duration >= step_length))
-    return Fail(error, "duration", "must be at least one step_length");
-  if (ego_from_routes) {
-    if (route_files.empty())
-      return Fail(error, "ego.from_routes",
-                  "needs SUMO route files (traffic.route_files or sumo_config)");
-  } else if (!CheckVehicle(ego, "ego", *this, error)) {
-    return false;
-  }
-  if (!(ego.depart < duration))
-    return Fail(error, "ego.depart", "must be before the end (duration)");
-  if (!(ego_speed.speed >= 0.0 && ego_speed.speed <= kMaxTrafficSpeed))
-    return Fail(error, "ego.speed_policy.speed", "must be in [0, 70] m/s");
+  c.Expect(duration >= step_length, "duration", duration,
+           ">= step_length = " + FormatShort(step_length) + " s (at least one step)");
+  if (ego_from_routes)
+    c.Expect(!route_files.empty(), "ego.from_routes", Quoted(ego.id),
+             "SUMO route files to take it from (traffic.route_files or sumo_config)");
+  else
+    CheckVehicle(c, ego, "ego", *this);
+  c.Expect(ego.depart < duration, "ego.depart", ego.depart,
+           "< duration = " + FormatShort(duration) + " s (a departure within the run)");
+  c.InRange("ego.speed_policy.speed", ego_speed.speed, 0.0, kMaxTrafficSpeed, Interval::kClosed,
+            "m/s");
   // A parked ego (speed 0) is held by the fixed policy; cruising at 0 would be no policy at all.
-  if (ego_speed.speed == 0.0 && ego_speed.mode != SpeedPolicy::Mode::kFixed)
-    return Fail(error, "ego.speed_policy.speed", "0 (a parked ego) needs mode: fixed");
-  if (ego_speed.speed == 0.0 && ego.speed != 0.0)
-    return Fail(error, "ego.speed", "must be 0 for a parked ego (speed_policy.speed 0)");
+  c.Expect(!(ego_speed.speed == 0.0 && ego_speed.mode != SpeedPolicy::Mode::kFixed),
+           "ego.speed_policy.speed", 0.0, "> 0, or mode: fixed for a parked ego");
+  c.Expect(!(ego_speed.speed == 0.0 && ego.speed != 0.0), "ego.speed", ego.speed,
+           "0 for a parked ego (speed_policy.speed 0)");
   std::set<std::string> ids{ego.id};
   for (std::size_t i = 0; i < vehicles.size(); ++i) {
-    const std::string f = "traffic.vehicles[" + std::to_string(i) + "]";
-    if (!CheckVehicle(vehicles[i], f, *this, error)) return false;
-    if (!ids.insert(vehicles[i].id).second)
-      return Fail(error, f + ".id", "duplicate vehicle id '" + vehicles[i].id + "'");
+    const std::string f = Indexed("traffic.vehicles", i);
+    CheckVehicle(c, vehicles[i], f, *this);
+    c.Expect(ids.insert(vehicles[i].id).second, f + ".id", Quoted(vehicles[i].id),
+             "an id no other vehicle has");
   }
   for (std::size_t i = 0; i < flows.size(); ++i) {
     const FlowSpec& fl = flows[i];
-    const std::string f = "traffic.flows[" + std::to_string(i) + "]";
-    if (!ValidSumoId(fl.id)) return Fail(error, f + ".id", kIdRule);
-    if (!ids.insert(fl.id).second) return Fail(error, f + ".id", "duplicate id '" + fl.id + "'");
-    if (!vehicle_types.count(fl.type))
-      return Fail(error, f + ".type", "unknown vehicle type '" + fl.type + "'");
-    if (!routes.count(fl.route))
-      return Fail(error, f + ".route", "unknown route '" + fl.route + "'");
-    if (!(fl.begin >= 0.0)) return Fail(error, f + ".begin", "must be >= 0 s");
-    if (!(fl.end > fl.begin)) return Fail(error, f + ".end", "must be after begin");
-    if (!(fl.period > 0.0)) return Fail(error, f + ".period", "must be > 0 s");
-    if (!(fl.position >= 0.0)) return Fail(error, f + ".position", "must be >= 0 m");
-    if (!(fl.speed_min > 0.0 && fl.speed_min <= fl.speed_max && fl.speed_max <= kMaxTrafficSpeed))
-      return Fail(error, f + ".speed_min", "need 0 < speed_min <= speed_max <= 70 m/s");
+    const std::string f = Indexed("traffic.flows", i);
+    c.Expect(ValidSumoId(fl.id), f + ".id", Quoted(fl.id), kIdRule);
+    c.Expect(ids.insert(fl.id).second, f + ".id", Quoted(fl.id), "an id no other vehicle has");
+    c.Expect(vehicle_types.count(fl.type) > 0, f + ".type", Quoted(fl.type),
+             "a vehicle type of the scenario");
+    c.Expect(routes.count(fl.route) > 0, f + ".route", Quoted(fl.route), "a route of the scenario");
+    c.NonNegative(f + ".begin", fl.begin, "s");
+    c.Expect(fl.end > fl.begin, f + ".end", fl.end, "> begin = " + FormatShort(fl.begin) + " s");
+    c.Positive(f + ".period", fl.period, "s");
+    c.NonNegative(f + ".position", fl.position, "m");
+    c.Expect(fl.speed_min > 0.0 && fl.speed_min <= fl.speed_max && fl.speed_max <= kMaxTrafficSpeed,
+             f + ".speed_min", fl.speed_min,
+             "0 < speed_min <= speed_max = " + FormatShort(fl.speed_max) + " <= 70 m/s");
     const bool lane_ok =
         fl.lane == "random" || fl.lane == "free" || fl.lane == "best" ||
         (!fl.lane.empty() && fl.lane.find_first_not_of("0123456789") == std::string::npos);
-    if (!lane_ok)
-      return Fail(error, f + ".lane", "must be a lane index, 'random', 'free' or 'best'");
+    c.Expect(lane_ok, f + ".lane", Quoted(fl.lane), "a lane index, 'random', 'free' or 'best'");
   }
   for (std::size_t i = 0; i < actions.size(); ++i) {
     const ActionSpec& a = actions[i];
-    const std::string f = "actions[" + std::to_string(i) + "]";
+    const std::string f = Indexed("actions", i);
     // Actions after the end never fire, so a shortened --duration keeps the file valid.
-    if (!(a.time >= 0.0)) return Fail(error, f + ".time", "must be >= 0 s");
-    if (!ids.count(a.vehicle))
-      return Fail(error, f + ".vehicle", "unknown vehicle '" + a.vehicle + "'");
-    if (!a.set_speed && !a.change_lane) return Fail(error, f, "needs set_speed or change_lane");
-    if (a.set_speed && !(*a.set_speed > 0.0 && *a.set_speed <= kMaxTrafficSpeed))
-      return Fail(error, f + ".set_speed", "must be in (0, 70] m/s");
-    if (a.change_lane && *a.change_lane < 0) return Fail(error, f + ".change_lane", "must be >= 0");
-    if (!(a.duration > 0.0)) return Fail(error, f + ".duration", "must be > 0 s");
+    c.NonNegative(f + ".time", a.time, "s");
+    c.Expect(ids.count(a.vehicle) > 0, f + ".vehicle", Quoted(a.vehicle),
+             "a vehicle of the scenario");
+    c.Expect(a.set_speed || a.change_lane, f, "{}", "set_speed or change_lane");
+    if (a.set_speed)
+      c.InRange(f + ".set_speed", *a.set_speed, 0.0, kMaxTrafficSpeed, Interval::kLeftOpen, "m/s");
+    if (a.change_lane) c.AtLeast(f + ".change_lane", *a.change_lane, 0);
+    c.Positive(f + ".duration", a.duration, "s");
   }
   for (std::size_t i = 0; i < guard_rails.size(); ++i) {
-    const std::string f = "obstacles.guard_rails[" + std::to_string(i) + "]";
+    const std::string f = Indexed("obstacles.guard_rails", i);
     const auto& pts = guard_rails[i].points;
-    if (pts.size() < 2) return Fail(error, f + ".points", "needs at least 2 points");
+    c.Expect(pts.size() >= 2, f + ".points", std::to_string(pts.size()) + " points",
+             "at least 2 points");
     for (std::size_t k = 1; k < pts.size(); ++k)
-      if (!((pts[k] - pts[k - 1]).norm() > 1e-3))
-        return Fail(error, f + ".points",
-                    "has a segment of zero length (points " + std::to_string(k - 1) + " and " +
-                        std::to_string(k) + " coincide)");
+      c.Expect((pts[k] - pts[k - 1]).norm() > 1e-3, Indexed(f + ".points", k),
+               FormatTuple({pts[k].x(), pts[k].y()}),
+               "a point other than points[" + std::to_string(k - 1) + "] (no zero-length segment)");
   }
   for (std::size_t i = 0; i < parked.size(); ++i) {
     const OrientedBox& b = parked[i].box;
-    const std::string f = "obstacles.parked[" + std::to_string(i) + "]";
-    if (!(b.length > 0.0)) return Fail(error, f + ".length", "must be > 0 m");
-    if (!(b.width > 0.0)) return Fail(error, f + ".width", "must be > 0 m");
+    const std::string f = Indexed("obstacles.parked", i);
+    c.Positive(f + ".length", b.length, "m");
+    c.Positive(f + ".width", b.width, "m");
   }
-  return true;
+  return c.Done(error);
 }
 
 }  // namespace dualgrid::sim

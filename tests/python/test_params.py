@@ -89,7 +89,8 @@ class FilterParamsTest(unittest.TestCase):
         for name, bad in cases.items():
             p = dualgrid.FilterParams(**{name: bad})
             self.assertFalse(p.is_valid(), name)
-            with self.assertRaisesRegex(ValueError, f"FilterParams: {name} must"):
+            # core/validation.hpp's form: the field, the value given, what was expected.
+            with self.assertRaisesRegex(ValueError, f"FilterParams: {name} = {bad:g}: expected"):
                 p.validate()
             with self.assertRaisesRegex(ValueError, name):
                 dualgrid.DynamicGrid(p, seed=1)

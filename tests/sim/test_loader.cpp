@@ -93,18 +93,18 @@ TEST_CASE("Malformed scenarios are rejected naming the key and the expectation",
   };
   const Case c = GENERATE(values<Case>({
       {"duration: 5.0", "duration: five", "'duration'", "expected a number"},
-      {"duration: 5.0", "duration: -5", "'duration'", "must be in (0, 3600] s"},
+      {"duration: 5.0", "duration: -5", "'duration'", "expected in (0, 3600] s, got -5"},
       {"duration: 5.0", "duraton: 5.0", "'duraton'", "not a known setting"},
       {"network: highway\n", "", "'network'", "required"},
       {"lane: 1,", "lane: one,", "'ego.lane'", "expected an integer"},
       {"route: east, lane: 0", "route: west, lane: 0", "'traffic.vehicles[0].route'",
-       "unknown route"},
+       "expected a route of the scenario, got 'west'"},
       {"period: 2}", "period: 2, colour: red}", "'traffic.flows[0].colour'", "not a known setting"},
       {"set_speed: 30", "set_speed: [30]", "'actions[0].set_speed'", "expected a number"},
       {"[[0, 0], [100, 0]]", "[[0, 0], [100]]", "'obstacles.guard_rails[0].points[1]'",
        "expected a point"},
-      {"car: {length: 4.5", "car: {length: 0", "'vehicle_types.car.length'", "must be in"},
-      {"vehicle: a", "vehicle: nobody", "'actions[0].vehicle'", "unknown vehicle"},
+      {"car: {length: 4.5", "car: {length: 0", "'vehicle_types.car.length'", "expected in (0, 30] m, got 0"},
+      {"vehicle: a", "vehicle: nobody", "'actions[0].vehicle'", "expected a vehicle of the scenario, got 'nobody'"},
       {"ego: {", "ego: [", "", "not valid YAML"},
   }));
   const std::string msg = ErrorOf(Replace(kValid, c.from, c.to));

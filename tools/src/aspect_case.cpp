@@ -45,12 +45,6 @@ constexpr TargetType kTypes[] = {{"car", 4.5, 1.8, 10.0, "passenger"},
                                  {"truck", 12.0, 2.55, 20.0, "truck"},
                                  {"cyclist", 1.8, 0.6, 0.0, "bicycle"}};
 
-std::string F(double v, int digits = 3) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
 // Runs netconvert on the plain-XML files; its output goes to `log`.
 void Netconvert(const std::filesystem::path& nod, const std::filesystem::path& edg,
                 const std::filesystem::path& net, const std::filesystem::path& log) {
@@ -108,10 +102,11 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
   if (!sensor)
     throw std::invalid_argument("--sensor: expected one of " + names + ", got '" + c.sensor + "'");
   if (c.range <= sensor->min_range + 1.0 || c.range >= sensor->max_range - 5.0)
-    throw std::invalid_argument("--range: the " + c.sensor + " radar sees " +
-                                F(sensor->min_range, 1) + "-" + F(sensor->max_range, 0) +
-                                " m; expected a range within (" + F(sensor->min_range + 1.0, 1) +
-                                ", " + F(sensor->max_range - 5.0, 0) + ") m, got " + F(c.range, 1));
+    throw std::invalid_argument(
+        "--range: the " + c.sensor + " radar sees " + FormatFixed(sensor->min_range, 1) + "-" +
+        FormatFixed(sensor->max_range, 0) + " m; expected a range within (" +
+        FormatFixed(sensor->min_range + 1.0, 1) + ", " + FormatFixed(sensor->max_range - 5.0, 0) +
+        ") m, got " + FormatFixed(c.range, 1));
   const double theta = DegToRad(c.angle_deg);
   const double psi = sensor->mount.yaw;  // ego yaw 0: world yaw of the boresight
   const Vector2 los = UnitVector(psi);
@@ -183,8 +178,9 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
     for (double w = 5.0 * std::ceil(c.grid_width / 5.0); w <= 400.0 && need == 0.0; w += 5.0)
       if (fits(w)) need = w;
     if (c.auto_grid_width && need > 0.0) {
-      widened = "# The grid is widened from the paper's " + F(c.grid_width, 0) + " m to " +
-                F(need, 0) + " m (filter.width_y) so that every target is scored.\n";
+      widened = "# The grid is widened from the paper's " + FormatFixed(c.grid_width, 0) +
+                " m to " + FormatFixed(need, 0) +
+                " m (filter.width_y) so that every target is scored.\n";
       c.grid_width = need;
       for (auto& t : targets) t.frames_in_grid = frames_in(t.p, t.t_ref, t.depart, need);
     }
@@ -194,18 +190,20 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
     for (double w = 5.0 * std::ceil(c.grid_width / 5.0); w <= 400.0 && need == 0.0; w += 5.0)
       if (fits(w)) need = w;
     const Target& t = targets.front();
-    std::string why = std::abs(t.p.y()) > 0.5 * c.grid_width - 0.5 - half_l
-                          ? "its reference point, " + F(c.range, 1) + " m on the " + c.sensor +
-                                " radar's boresight, lies " + F(std::abs(t.p.y()), 1) +
-                                " m to the side of the ego, outside the " + F(c.grid_width, 0) +
-                                " m wide grid"
-                          : "it would be in the " + F(c.grid_width, 0) + " m wide grid for " +
-                                std::to_string(frames_in(t.p, t.t_ref, t.depart, c.grid_width)) +
-                                " frames, fewer than the " + std::to_string(kMinFrames) +
-                                " a scored target needs";
-    throw std::invalid_argument("the targets would not be scored: " + why + "; " +
-                                (need > 0.0 ? "use --grid-width " + F(need, 0) + ", " : "") +
-                                "a lower --speed or a shorter --range");
+    std::string why =
+        std::abs(t.p.y()) > 0.5 * c.grid_width - 0.5 - half_l
+            ? "its reference point, " + FormatFixed(c.range, 1) + " m on the " + c.sensor +
+                  " radar's boresight, lies " + FormatFixed(std::abs(t.p.y()), 1) +
+                  " m to the side of the ego, outside the " + FormatFixed(c.grid_width, 0) +
+                  " m wide grid"
+            : "it would be in the " + FormatFixed(c.grid_width, 0) + " m wide grid for " +
+                  std::to_string(frames_in(t.p, t.t_ref, t.depart, c.grid_width)) +
+                  " frames, fewer than the " + std::to_string(kMinFrames) +
+                  " a scored target needs";
+    throw std::invalid_argument(
+        "the targets would not be scored: " + why + "; " +
+        (need > 0.0 ? "use --grid-width " + FormatFixed(need, 0) + ", " : "") +
+        "a lower --speed or a shorter --range");
   }
 
   // Network: the ego's road along world x, and one straight road per target through its
@@ -215,17 +213,18 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
   nod << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!-- generated by dualgrid tangential, "
          "kind aspect -->\n<nodes>\n"
       << "    <node id=\"ego_w\" x=\"-100.00\" y=\"0.00\" type=\"priority\"/>\n"
-      << "    <node id=\"ego_e\" x=\"" << F(road_end, 2) << "\" y=\"0.00\" type=\"priority\"/>\n";
+      << "    <node id=\"ego_e\" x=\"" << FormatFixed(road_end, 2)
+      << "\" y=\"0.00\" type=\"priority\"/>\n";
   edg << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<edges>\n"
       << "    <edge id=\"ego_road\" from=\"ego_w\" to=\"ego_e\" numLanes=\"1\" speed=\"45\" "
          "width=\"3.5\" spreadType=\"center\"/>\n";
   for (std::size_t k = 0; k < roads.size(); ++k) {
     const Position a = roads[k].p - roads[k].before * dir, b = roads[k].p + roads[k].after * dir;
     const std::string id = "t" + std::to_string(k + 1);
-    nod << "    <node id=\"" << id << "_a\" x=\"" << F(a.x()) << "\" y=\"" << F(a.y())
-        << "\" type=\"priority\"/>\n"
-        << "    <node id=\"" << id << "_b\" x=\"" << F(b.x()) << "\" y=\"" << F(b.y())
-        << "\" type=\"priority\"/>\n";
+    nod << "    <node id=\"" << id << "_a\" x=\"" << FormatFixed(a.x(), 3) << "\" y=\""
+        << FormatFixed(a.y(), 3) << "\" type=\"priority\"/>\n"
+        << "    <node id=\"" << id << "_b\" x=\"" << FormatFixed(b.x(), 3) << "\" y=\""
+        << FormatFixed(b.y(), 3) << "\" type=\"priority\"/>\n";
     edg << "    <edge id=\"" << id << "\" from=\"" << id << "_a\" to=\"" << id
         << "_b\" numLanes=\"1\" speed=\"45\" width=\"3.5\" spreadType=\"center\"/>\n";
   }
@@ -246,46 +245,52 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
     << " --interval " << c.interval << " --grid-width " << c.grid_width << " --seed " << c.seed
     << "\n# Geometry (docs/stress.md): at its reference time t_k each target's centre is "
     << c.range << " m from the " << c.sensor << " radar on its boresight (world yaw "
-    << F(RadToDeg(psi), 1) << " deg),\n# moving at " << c.speed
+    << FormatFixed(RadToDeg(psi), 1) << " deg),\n# moving at " << c.speed
     << " m/s over ground at aspect angle " << c.angle_deg
     << " deg to the line of sight (0 = receding along it, 90 = across it, 180 = approaching):\n"
-    << "# compensated radial speed there v cos(theta) = " << F(c.speed * std::cos(theta), 2)
-    << " m/s. Ego: a " << kEgoLength << " m car on a straight road along world x at " << c.ego_speed
-    << " m/s" << (c.ego_speed == 0.0 ? " (parked)" : "") << ".\n";
+    << "# compensated radial speed there v cos(theta) = "
+    << FormatFixed(c.speed * std::cos(theta), 2) << " m/s. Ego: a " << kEgoLength
+    << " m car on a straight road along world x at " << c.ego_speed << " m/s"
+    << (c.ego_speed == 0.0 ? " (parked)" : "") << ".\n";
   for (std::size_t k = 0; k < targets.size(); ++k)
-    y << "#   target_" << k + 1 << ": t_k = " << F(targets[k].t_ref, 2) << " s at ("
-      << F(targets[k].p.x(), 2) << ", " << F(targets[k].p.y(), 2) << "), departs "
-      << F(targets[k].depart, 2) << " s, " << targets[k].frames_in_grid << " frames in the grid\n";
+    y << "#   target_" << k + 1 << ": t_k = " << FormatFixed(targets[k].t_ref, 2) << " s at ("
+      << FormatFixed(targets[k].p.x(), 2) << ", " << FormatFixed(targets[k].p.y(), 2)
+      << "), departs " << FormatFixed(targets[k].depart, 2) << " s, " << targets[k].frames_in_grid
+      << " frames in the grid\n";
   y << widened << "# Network: " << out.stem().string() << ".net.xml, built by netconvert from "
     << out.stem().string() << ".nod.xml/.edg.xml (roads cross without junctions).\n"
-    << "name: aspect_" << c.sensor << "_" << F(c.angle_deg, 0) << "\n"
+    << "name: aspect_" << c.sensor << "_" << FormatFixed(c.angle_deg, 0) << "\n"
     << "description: targets at aspect angle " << c.angle_deg << " deg to the " << c.sensor
     << " radar's line of sight\n"
     << "network: " << out.stem().string() << ".net.xml\n"
-    << "duration: " << F(duration, 2) << "\nstep_length: " << kStep << "\nseed: " << c.seed
+    << "duration: " << FormatFixed(duration, 2) << "\nstep_length: " << kStep
+    << "\nseed: " << c.seed
     << "\n\nvehicle_types:\n  car: {length: 4.5, width: 1.8, max_speed: 50.0, rcs_dbsm: 10.0}\n";
   if (c.target != "car")
     y << "  " << type->name << ": {length: " << type->length << ", width: " << type->width
       << ", max_speed: 50.0, rcs_dbsm: " << type->rcs_dbsm << ", vclass: " << type->vclass << "}\n";
   y << "\nroutes:\n  ego: [ego_road]\n";
   for (std::size_t k = 0; k < roads.size(); ++k) y << "  t" << k + 1 << ": [t" << k + 1 << "]\n";
-  y << "\nego: {type: car, route: ego, lane: 0, position: " << F(ego_front, 2)
+  y << "\nego: {type: car, route: ego, lane: 0, position: " << FormatFixed(ego_front, 2)
     << ", speed: " << c.ego_speed << ", speed_policy: {mode: fixed, speed: " << c.ego_speed
     << "}}\n\ntraffic:\n  vehicles:\n";
   for (std::size_t k = 0; k < targets.size(); ++k)
     y << "    - {id: target_" << k + 1 << ", type: " << type->name << ", route: t"
-      << targets[k].road + 1 << ", lane: 0, depart: " << F(targets[k].depart, 2) << ", position: "
-      << F(roads[targets[k].road].before + half_l -
-               c.speed * (targets[k].t_ref - targets[k].depart),
-           2)
+      << targets[k].road + 1 << ", lane: 0, depart: " << FormatFixed(targets[k].depart, 2)
+      << ", position: "
+      << FormatFixed(roads[targets[k].road].before + half_l -
+                         c.speed * (targets[k].t_ref - targets[k].depart),
+                     2)
       << ", speed: " << c.speed << ", desired_speed: " << c.speed << ", lane_change: false}\n";
   if (c.grid_width != 25.0) y << "\nfilter: {width_y: " << c.grid_width << "}\n";
   y << "\nevaluation:\n  focus_object: target_1\n  snapshot_times: [";
-  for (std::size_t k = 0; k < targets.size(); ++k) y << (k ? ", " : "") << F(targets[k].t_ref, 2);
+  for (std::size_t k = 0; k < targets.size(); ++k)
+    y << (k ? ", " : "") << FormatFixed(targets[k].t_ref, 2);
   y << "]\n";
   WriteTextFile(out, y.str());
-  return "aspect " + F(c.angle_deg, 1) + " deg to the " + c.sensor + " radar at " + F(c.range, 1) +
-         " m, v cos(theta) = " + F(c.speed * std::cos(theta), 2) + " m/s";
+  return "aspect " + FormatFixed(c.angle_deg, 1) + " deg to the " + c.sensor + " radar at " +
+         FormatFixed(c.range, 1) +
+         " m, v cos(theta) = " + FormatFixed(c.speed * std::cos(theta), 2) + " m/s";
 }
 
 }  // namespace dualgrid::tools

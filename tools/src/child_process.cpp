@@ -1,4 +1,5 @@
 #include "child_process.hpp"
+#include "dualgrid/core/text.hpp"
 
 #include <fcntl.h>
 #include <sys/prctl.h>
@@ -92,10 +93,6 @@ std::string LastLine(const std::filesystem::path& p) {
   return last;
 }
 
-std::string Exact(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
+std::string Exact(double v) { return FormatSignificant(v, 17); }
 
 }  // namespace dualgrid::tools

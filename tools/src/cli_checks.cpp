@@ -1,4 +1,5 @@
 #include "cli_checks.hpp"
+#include "dualgrid/core/text.hpp"
 
 #include <sched.h>
 
@@ -11,11 +12,7 @@
 namespace dualgrid::tools {
 namespace {
 
-std::string Shown(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string Shown(double v) { return FormatSignificant(v, 6); }
 
 }  // namespace
 

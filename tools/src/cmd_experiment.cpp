@@ -223,7 +223,7 @@ int RunExperiment(const ExperimentOptions& o) {
     summary["seeds_failed"].push_back({{"seed", seed}, {"error", why}});
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!o.run.run.quiet)
-    std::cout << finished.size() << " of " << o.seeds << " seeds (" << Fixed(wall, 0)
+    std::cout << finished.size() << " of " << o.seeds << " seeds (" << FormatFixed(wall, 0)
               << " s of runs); results in " << out.string() << "\n";
   if (StopSignal()) return StopExitCode();
   if (!failed.empty()) {

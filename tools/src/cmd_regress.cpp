@@ -73,30 +73,6 @@ std::string CaseDigest(const std::filesystem::path& seed_dir) {
   return buf;
 }
 
-std::string XmlEscape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        o += "&amp;";
-        break;
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        // XML 1.0 allows no control characters but tab, newline and carriage return.
-        o += static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r' ? '?' : c;
-    }
-  }
-  return o;
-}
-
 struct CaseResult {
   std::string name;
   bool ran = false;   // the experiment finished with every seed

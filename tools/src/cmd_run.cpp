@@ -59,9 +59,9 @@ std::vector<double> SnapshotTimes(const FilterRunOptions& options,
   times.erase(std::unique(times.begin(), times.end()), times.end());
   for (double t : times)
     if (!(t > 0.0 && t <= config.sim.duration))
-      throw std::invalid_argument("--snapshots: time " + Fixed(t, 2) +
-                                  " s is outside the run (0, " + Fixed(config.sim.duration, 2) +
-                                  "] s");
+      throw std::invalid_argument("--snapshots: time " + FormatFixed(t, 2) +
+                                  " s is outside the run (0, " +
+                                  FormatFixed(config.sim.duration, 2) + "] s");
   return times;
 }
 
@@ -105,7 +105,7 @@ int RunFilters(const FilterRunOptions& options) {
   Progress progress("run " + config.sim.name + " seed " + std::to_string(config.sim.seed),
                     config.sim.StepCount(), !options.run.quiet);
   while (!StopSignal() && cosim.Step())
-    progress.Update(cosim.steps(), "t=" + Fixed(cosim.pipeline().frame().time, 1) + " s");
+    progress.Update(cosim.steps(), "t=" + FormatFixed(cosim.pipeline().frame().time, 1) + " s");
   progress.Finish();
   const int stop = StopSignal();
   const int steps = cosim.steps();
@@ -115,10 +115,11 @@ int RunFilters(const FilterRunOptions& options) {
   std::string status;
   if (stop)
     status = "Incomplete run: stopped by signal " + std::to_string(stop) +
-             " at t = " + Fixed(simulated, 2) + " s of " + Fixed(config.sim.duration, 2) + " s";
+             " at t = " + FormatFixed(simulated, 2) + " s of " +
+             FormatFixed(config.sim.duration, 2) + " s";
   else if (!complete)
-    status = "Shorter run than asked: SUMO ended at t = " + Fixed(simulated, 2) + " s of " +
-             Fixed(config.sim.duration, 2) + " s (the ego left the network; see sumo.log)";
+    status = "Shorter run than asked: SUMO ended at t = " + FormatFixed(simulated, 2) + " s of " +
+             FormatFixed(config.sim.duration, 2) + " s (the ego left the network; see sumo.log)";
   files.Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -228,7 +229,7 @@ int RunFilters(const FilterRunOptions& options) {
     std::cerr << "dualgrid: " << status << "; results in " << out.string() << "\n";
   if (stop) return StopExitCode();
   if (!options.run.quiet)
-    std::cout << config.sim.name << ": " << steps << " steps in " << Fixed(wall, 1)
+    std::cout << config.sim.name << ": " << steps << " steps in " << FormatFixed(wall, 1)
               << " s; results in " << out.string()
               << (warnings.empty() ? ""
                                    : " (" + std::to_string(warnings.size()) +

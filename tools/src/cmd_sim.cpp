@@ -55,8 +55,8 @@ int RunSim(const SimOptions& sim_options) {
           std::min(it->second.min_distance, (v.box.center - f.ego.box.center).norm());
     }
     ++steps;
-    progress.Update(
-        steps, "t=" + Fixed(f.time, 1) + " s, " + std::to_string(f.vehicles.size()) + " vehicles");
+    progress.Update(steps, "t=" + FormatFixed(f.time, 1) + " s, " +
+                               std::to_string(f.vehicles.size()) + " vehicles");
   }
   progress.Finish();
   truth.Close();
@@ -87,19 +87,19 @@ int RunSim(const SimOptions& sim_options) {
   WriteTextFile(options.out / "summary.json", summary.dump(2) + "\n");
   if (StopSignal()) {
     std::cerr << "dualgrid: stopped by signal " << StopSignal()
-              << " at t = " << Fixed(steps * spec.step_length, 2) << " s; the simulated part is in "
-              << options.out.string() << "\n";
+              << " at t = " << FormatFixed(steps * spec.step_length, 2)
+              << " s; the simulated part is in " << options.out.string() << "\n";
     return StopExitCode();
   }
   if (steps != spec.StepCount())
     std::cerr << "dualgrid: shorter run than asked: SUMO ended at t = "
-              << Fixed(steps * spec.step_length, 2) << " s of " << Fixed(spec.duration, 2)
-              << " s (the ego left the network; see sumo.log)\n";
+              << FormatFixed(steps * spec.step_length, 2) << " s of "
+              << FormatFixed(spec.duration, 2) << " s (the ego left the network; see sumo.log)\n";
   if (!options.quiet) {
-    std::cout << spec.name << ": " << steps << " steps (" << Fixed(steps * spec.step_length, 1)
-              << " s simulated in " << Fixed(wall, 1) << " s), " << seen.size()
-              << " other vehicles, " << detection_count << " radar detections; output in "
-              << options.out.string() << "\n";
+    std::cout << spec.name << ": " << steps << " steps ("
+              << FormatFixed(steps * spec.step_length, 1) << " s simulated in "
+              << FormatFixed(wall, 1) << " s), " << seen.size() << " other vehicles, "
+              << detection_count << " radar detections; output in " << options.out.string() << "\n";
   }
   return 0;
 }

@@ -21,8 +21,9 @@ int RunSnapshot(const SnapshotOptions& options) {
                                 "' is a folder; give a .png, .svg or .pdf file name");
   scenario::ScenarioConfig config = LoadConfig(run);
   if (!(options.time >= config.sim.step_length && options.time <= config.sim.duration))
-    throw std::invalid_argument("--time must be in [" + Fixed(config.sim.step_length, 2) + ", " +
-                                Fixed(config.sim.duration, 2) + "] s (one step to the duration)");
+    throw std::invalid_argument("--time must be in [" + FormatFixed(config.sim.step_length, 2) +
+                                ", " + FormatFixed(config.sim.duration, 2) +
+                                "] s (one step to the duration)");
   config.sim.duration = options.time;
   // SUMO's route file and log are working files of this command only: a temporary folder,
   // removed afterwards (kept, and named, only if SUMO fails, for its log).
@@ -33,13 +34,13 @@ int RunSnapshot(const SnapshotOptions& options) {
   }
   const cosim::Pipeline& pipeline = cosim.pipeline();
   if (!pipeline.has_radar())
-    throw std::runtime_error("the ego never departed before t = " + Fixed(options.time, 2) +
+    throw std::runtime_error("the ego never departed before t = " + FormatFixed(options.time, 2) +
                              " s: nothing to draw");
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
   RenderScene(pipeline, png, options.behind, options.ahead, options.half_width);
   if (!run.quiet)
-    std::cout << "wrote " << png.string() << " (t = " << Fixed(pipeline.frame().time, 2) << " s, "
-              << pipeline.detections().size() << " detections)\n";
+    std::cout << "wrote " << png.string() << " (t = " << FormatFixed(pipeline.frame().time, 2)
+              << " s, " << pipeline.detections().size() << " detections)\n";
   return 0;
 }
 

@@ -54,7 +54,7 @@ std::string Crossing(const TangentialOptions& o) {
   const double t_e = (800.0 - x0) / o.ego_speed;
   std::ostringstream os;
   os << Header(o, "vehicles cross the ego's road ahead of it, perpendicular to the front radar");
-  os << "network: crossing\nduration: " << Fixed(t_e + 3.0, 2)
+  os << "network: crossing\nduration: " << FormatFixed(t_e + 3.0, 2)
      << "\nstep_length: 0.05\nseed: " << o.seed << "\n\n"
      << "vehicle_types:\n  car: {length: 4.5, width: 1.8, max_speed: 50.0, rcs_dbsm: 10.0}\n\n"
      << "routes:\n  east: [east_in, east_out]\n  north: [north_in, north_out]\n"
@@ -66,7 +66,7 @@ std::string Crossing(const TangentialOptions& o) {
   for (int i = 0; i < o.count; ++i) {
     const double d = o.first_distance + i * r.spacing;
     const double t_i = (800.0 - d - x0) / o.ego_speed;
-    snapshots += (snapshots.empty() ? "" : ", ") + Fixed(t_i, 2);
+    snapshots += (snapshots.empty() ? "" : ", ") + FormatFixed(t_i, 2);
     const double approach = (600.0 + 0.5 * kCarLength) / r.speed;
     double depart = t_i - approach, position = 0.0;
     if (depart < 0.0) {
@@ -75,8 +75,9 @@ std::string Crossing(const TangentialOptions& o) {
     }
     depart = std::round(depart * 20.0) / 20.0;  // whole steps
     os << "    - {id: cross_" << (i + 1) << ", type: car, route: " << (i % 2 ? "south" : "north")
-       << ", lane: 0, depart: " << Fixed(depart, 2) << ", position: " << Fixed(position, 2)
-       << ", speed: " << r.speed << ", desired_speed: " << r.speed << ", lane_change: false}\n";
+       << ", lane: 0, depart: " << FormatFixed(depart, 2)
+       << ", position: " << FormatFixed(position, 2) << ", speed: " << r.speed
+       << ", desired_speed: " << r.speed << ", lane_change: false}\n";
   }
   os << "\nobstacles:\n  parked:\n"
      << "    - {id: parked_1, center: [400, -6.0], yaw: 0.0, length: 4.5, width: 1.8}\n"
@@ -106,7 +107,7 @@ std::string Parallel(const TangentialOptions& o) {
     const double offset = (k - 0.5 * (per_lane - 1)) * r.spacing;
     const bool truck = i % 3 == 2;
     os << "    - {id: side_" << (i + 1) << ", type: " << (truck ? "truck" : "car")
-       << ", route: east, lane: " << lane << ", position: " << Fixed(300.0 + offset, 2)
+       << ", route: east, lane: " << lane << ", position: " << FormatFixed(300.0 + offset, 2)
        << ", speed: " << r.speed << ", desired_speed: " << r.speed << ", lane_change: false}\n";
   }
   os << "\nobstacles:\n  guard_rails:\n    - {id: rail_median, points: [[0, 0], [6000, 0]]}\n"
@@ -150,28 +151,29 @@ int RunTangential(const TangentialOptions& o) {
     throw std::invalid_argument(
         "--speed must be within 5 m/s of --ego-speed for parallel traffic "
         "(it stays alongside the ego), got " +
-        Fixed(r.speed, 2) + " m/s with an ego at " + Fixed(o.ego_speed, 2) + " m/s");
+        FormatFixed(r.speed, 2) + " m/s with an ego at " + FormatFixed(o.ego_speed, 2) + " m/s");
   // Parallel vehicles share lanes: SUMO inserts only with a gap of about one second of travel
   // plus a truck's length.
   const double min_spacing = o.kind == "parallel" ? 18.0 + o.ego_speed : 5.0;
   if (!(r.spacing >= min_spacing))
-    throw std::invalid_argument("--spacing must be >= " + Fixed(min_spacing, 1) + " m for " +
+    throw std::invalid_argument("--spacing must be >= " + FormatFixed(min_spacing, 1) + " m for " +
                                 o.kind + " traffic" +
                                 (o.kind == "parallel" ? " (18 m + ego speed x 1 s)" : "") +
-                                ", got " + Fixed(r.spacing, 1) + " m");
+                                ", got " + FormatFixed(r.spacing, 1) + " m");
   // A crossing car is in the 25 m wide grid for 25 m / speed: it must stay the 30 frames (1.5 s)
   // a scored target needs (min_frames_in_grid = 20, plus half a second).
   if (o.kind == "crossing" && 25.0 / r.speed < 1.5)
     throw std::invalid_argument(
-        "--speed " + Fixed(r.speed, 1) +
-        " m/s: a crossing car would be in the 25 m wide grid for " + Fixed(25.0 / r.speed, 2) +
+        "--speed " + FormatFixed(r.speed, 1) +
+        " m/s: a crossing car would be in the 25 m wide grid for " +
+        FormatFixed(25.0 / r.speed, 2) +
         " s, too short to be scored (1.5 s); use --speed <= 16.6, or --kind aspect (any angle, "
         "a widened grid)");
   if (o.kind == "crossing" && o.first_distance + (o.count - 1) * r.spacing > 600.0)
     throw std::invalid_argument(
         "--first-distance + (--count - 1) x --spacing must be <= 600 m (the crossing road's "
         "approach), got " +
-        Fixed(o.first_distance + (o.count - 1) * r.spacing, 1) + " m");
+        FormatFixed(o.first_distance + (o.count - 1) * r.spacing, 1) + " m");
   if (o.out.extension() != ".yaml" && o.out.extension() != ".yml")
     throw std::invalid_argument("--out must name a .yaml file, got '" + o.out.string() + "'");
   const std::string text = o.kind == "crossing" ? Crossing(o) : Parallel(o);

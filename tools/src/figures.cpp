@@ -34,8 +34,9 @@ namespace {
 // The caption's sentence on the axes of a picture in the grid frame, relative to the ego.
 std::string AxesNote(const GridFrame& g) {
   return "Axes: metres from the ego along the grid frame's axes (" +
-         (g.identity() ? std::string("here world east and north")
-                       : "x axis at " + Fixed(RadToDeg(g.yaw()), 0) + " deg from world east") +
+         (g.identity()
+              ? std::string("here world east and north")
+              : "x axis at " + FormatFixed(RadToDeg(g.yaw()), 0) + " deg from world east") +
          ").";
 }
 
@@ -72,12 +73,13 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
     return b;
   };
   viz::BirdsEyeOptions options;
-  options.title = pipeline.config().sim.name + ", t = " + Fixed(f.time, 2) + " s: radar view (" +
-                  std::to_string(pipeline.detections().size()) + " detections)";
+  options.title = pipeline.config().sim.name + ", t = " + FormatFixed(f.time, 2) +
+                  " s: radar view (" + std::to_string(pipeline.detections().size()) +
+                  " detections)";
   options.x_label = "x from the ego [m]";
   options.y_label = "y [m]";
   options.caption =
-      AxesNote(g) + " Arrows: motion over ground in " + Fixed(kArrowSeconds, 1) +
+      AxesNote(g) + " Arrows: motion over ground in " + FormatFixed(kArrowSeconds, 1) +
       " s; black: a vehicle's velocity (SUMO); coloured: a detection's radial velocity, ego "
       "motion compensated (short where a vehicle moves across the line of sight). Colour: the "
       "radar (field of view outline, its detections).";
@@ -171,7 +173,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
   viz::GridFigureOptions options;
   options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the caption)
   options.y_label = "y [m]";
-  options.title = "Dynamic grids at t = " + Fixed(time, 2) + " s";
+  options.title = "Dynamic grids at t = " + FormatFixed(time, 2) + " s";
   options.caption =
       "Cells: white free, black static, grey unknown; dynamic mass in the hue of its direction "
       "of motion over ground (the cell's mean particle velocity, grid frame: wheel), colours "
@@ -179,7 +181,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
       "the ego. Coloured outlines: the mode's clusters of dynamic particles (blue-violet "
       "matched to a vehicle, orange duplicate, magenta false) with their estimated velocity; "
       "black arrows: true velocity. Arrows: motion over ground in " +
-      Fixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
+      FormatFixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
   viz::RenderGridPanels(panels, path.string(), options);
 }
 
@@ -234,14 +236,14 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
                        filter::VelocityLikelihood likelihood, const std::filesystem::path& path) {
   viz::LineChart chart;
   chart.title = "Weights on " + object + " (" + mode + " filter, paper Fig. 4)";
-  chart.y_label = "share within " + Fixed(WeightTrace::kGoodVelocity, 0) + " m/s";
+  chart.y_label = "share within " + FormatFixed(WeightTrace::kGoodVelocity, 0) + " m/s";
   chart.y_min = 0.0;
   chart.y_max = 1.0;
   // Not the paper's Fig. 4 quantity (one particle's weights): readers compare the two, so the
   // caption says what is plotted and why w_velocity sits above w_position by default.
   chart.caption =
       "Share of each weight on " + object + " held by its particles within " +
-      Fixed(WeightTrace::kGoodVelocity, 0) +
+      FormatFixed(WeightTrace::kGoodVelocity, 0) +
       " m/s of its true velocity. w_position scores positions only; w_velocity also scores the "
       "Doppler. ";
   // The explanation depends on the run's f_v (eq. (8)): say which one this run used.

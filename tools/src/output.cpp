@@ -18,12 +18,6 @@
 
 namespace dualgrid::tools {
 
-std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
 scenario::ScenarioConfig LoadConfig(const RunOptions& options) {
   std::vector<scenario::Override> overrides;
   for (const std::string& text : options.sets) overrides.push_back(scenario::ParseOverride(text));
@@ -210,13 +204,15 @@ void GroundTruthWriter::Write(const sim::Frame& f) {
   auto row = [&](const sim::VehicleState& v, bool is_ego) {
     const Position p = ego.ToLocal(v.box.center);
     const Velocity vr = ego.RotateToLocal(v.velocity);
-    os << f.step << ',' << Fixed(f.time, 3) << ',' << v.id << ',' << v.type << ','
-       << (is_ego ? 1 : 0) << ',' << Fixed(v.box.center.x(), 4) << ',' << Fixed(v.box.center.y(), 4)
-       << ',' << Fixed(v.box.yaw, 6) << ',' << Fixed(v.velocity.x(), 4) << ','
-       << Fixed(v.velocity.y(), 4) << ',' << Fixed(v.speed, 4) << ',' << Fixed(v.lateral_speed, 4)
-       << ',' << Fixed(v.yaw_rate, 6) << ',' << Fixed(v.box.length, 3) << ','
-       << Fixed(v.box.width, 3) << ',' << v.lane << ',' << Fixed(p.x(), 4) << ',' << Fixed(p.y(), 4)
-       << ',' << Fixed(vr.x(), 4) << ',' << Fixed(vr.y(), 4) << ',' << Fixed(v.rcs_dbsm, 1) << '\n';
+    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << v.id << ',' << v.type << ','
+       << (is_ego ? 1 : 0) << ',' << FormatFixed(v.box.center.x(), 4) << ','
+       << FormatFixed(v.box.center.y(), 4) << ',' << FormatFixed(v.box.yaw, 6) << ','
+       << FormatFixed(v.velocity.x(), 4) << ',' << FormatFixed(v.velocity.y(), 4) << ','
+       << FormatFixed(v.speed, 4) << ',' << FormatFixed(v.lateral_speed, 4) << ','
+       << FormatFixed(v.yaw_rate, 6) << ',' << FormatFixed(v.box.length, 3) << ','
+       << FormatFixed(v.box.width, 3) << ',' << v.lane << ',' << FormatFixed(p.x(), 4) << ','
+       << FormatFixed(p.y(), 4) << ',' << FormatFixed(vr.x(), 4) << ',' << FormatFixed(vr.y(), 4)
+       << ',' << FormatFixed(v.rcs_dbsm, 1) << '\n';
   };
   row(f.ego, true);
   for (const auto& v : f.vehicles) row(v, false);
@@ -235,15 +231,17 @@ void DetectionWriter::Write(const cosim::Pipeline& p) {
   std::ostringstream os;
   os.precision(10);
   for (const auto& d : p.detections()) {
-    os << f.step << ',' << Fixed(f.time, 3) << ',' << d.sensor << ','
-       << p.radar().sensors()[d.sensor].name << ',' << Fixed(d.range, 4) << ','
-       << Fixed(d.azimuth, 6) << ',' << Fixed(d.range_rate, 4) << ',' << Fixed(d.snr_db, 2) << ','
-       << Fixed(d.position_ego.x(), 4) << ',' << Fixed(d.position_ego.y(), 4) << ','
-       << Fixed(d.position_world.x(), 4) << ',' << Fixed(d.position_world.y(), 4) << ','
-       << Fixed(d.radial_speed_compensated, 4) << ',' << Fixed(d.radial_velocity_world.x(), 4)
-       << ',' << Fixed(d.radial_velocity_world.y(), 4) << ','
-       << Fixed(d.sensor_position_world.x(), 4) << ',' << Fixed(d.sensor_position_world.y(), 4)
-       << ',' << p.ids().Name(d.source_id) << ',' << (d.is_clutter ? 1 : 0) << '\n';
+    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << d.sensor << ','
+       << p.radar().sensors()[d.sensor].name << ',' << FormatFixed(d.range, 4) << ','
+       << FormatFixed(d.azimuth, 6) << ',' << FormatFixed(d.range_rate, 4) << ','
+       << FormatFixed(d.snr_db, 2) << ',' << FormatFixed(d.position_ego.x(), 4) << ','
+       << FormatFixed(d.position_ego.y(), 4) << ',' << FormatFixed(d.position_world.x(), 4) << ','
+       << FormatFixed(d.position_world.y(), 4) << ',' << FormatFixed(d.radial_speed_compensated, 4)
+       << ',' << FormatFixed(d.radial_velocity_world.x(), 4) << ','
+       << FormatFixed(d.radial_velocity_world.y(), 4) << ','
+       << FormatFixed(d.sensor_position_world.x(), 4) << ','
+       << FormatFixed(d.sensor_position_world.y(), 4) << ',' << p.ids().Name(d.source_id) << ','
+       << (d.is_clutter ? 1 : 0) << '\n';
   }
   out_.buffer() += os.str();
   out_.MaybeFlush();

@@ -9,14 +9,12 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
 
 namespace dualgrid::tools {
-
-/// Formats with a fixed number of decimals.
-std::string Fixed(double v, int decimals);
 
 /// Loads the scenario and applies command-line overrides (seed, duration).
 scenario::ScenarioConfig LoadConfig(const RunOptions& options);

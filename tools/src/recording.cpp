@@ -115,7 +115,8 @@ void Writer::Add(const Frame& f) {
   packed_.resize(packed_size);
   // Level 1: the cell data is mostly runs of equal bytes; higher levels cost time for ~10 %.
   if (compress2(packed_.data(), &packed_size, raw_.data(), raw_.size(), 1) != Z_OK)
-    throw std::runtime_error("replay: compressing frame t = " + Fixed(f.time, 2) + " s failed");
+    throw std::runtime_error("replay: compressing frame t = " + FormatFixed(f.time, 2) +
+                             " s failed");
   bin_.write(reinterpret_cast<const char*>(packed_.data()),
              static_cast<std::streamsize>(packed_size));
   if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());

@@ -109,8 +109,8 @@ bool RecordingObserver::Finish(const nlohmann::json& metrics, const cosim::IdReg
 void InvariantObserver::OnStep(const cosim::StepView& v) {
   for (std::size_t m = 0; m < v.pipeline.num_filters(); ++m)
     if (const auto broken = v.pipeline.grid(m).CheckInvariants())
-      throw std::logic_error("filter invariant broken at t = " + Fixed(v.frame.time, 2) + " s (" +
-                             v.mode_names[m] + "): " + *broken);
+      throw std::logic_error("filter invariant broken at t = " + FormatFixed(v.frame.time, 2) +
+                             " s (" + v.mode_names[m] + "): " + *broken);
   if (v.step % std::max(1, static_cast<int>(std::lround(60.0 / step_length_))) == 0)
     rss_mb_.push_back({v.frame.time, ResidentMegabytes()});
 }
@@ -144,7 +144,7 @@ bool PictureObserver::WantsVelocities(int, double time) {
 void PictureObserver::OnStep(const cosim::StepView& v) {
   if (!picture_) return;
   const sim::Frame& f = v.frame;
-  const std::string stamp = Fixed(f.time, 2);
+  const std::string stamp = FormatFixed(f.time, 2);
   if (figures_) {
     TryFigures(
         out_ / "figures" / ("grid_t" + stamp + ".png"), formats_,

@@ -22,12 +22,13 @@ void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::st
     const Position pos = g.ToWorld(cl.position);
     const Velocity vel = g.VectorToWorld(cl.velocity);
     const Position local = f.EgoPose().ToLocal(pos);
-    os << f.step << ',' << Fixed(f.time, 3) << ',' << mode << ',' << Fixed(pos.x(), 3) << ','
-       << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ',' << Fixed(vel.y(), 3) << ','
-       << cl.weight << ',' << cl.size << ',' << kRole[static_cast<int>(a.role[c])] << ','
+    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << mode << ',' << FormatFixed(pos.x(), 3)
+       << ',' << FormatFixed(pos.y(), 3) << ',' << FormatFixed(vel.x(), 3) << ','
+       << FormatFixed(vel.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
+       << kRole[static_cast<int>(a.role[c])] << ','
        << (a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id)
                                        : std::string())
-       << ',' << Fixed(local.x(), 2) << ',' << Fixed(local.y(), 2) << '\n';
+       << ',' << FormatFixed(local.x(), 2) << ',' << FormatFixed(local.y(), 2) << '\n';
   }
   out_.buffer() += os.str();
   out_.MaybeFlush();
@@ -111,9 +112,9 @@ void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m,
     // Written in the world frame, like every other file of the run.
     const Position pos = g.ToWorld(Position(ps.x[i], ps.y[i]));
     const Velocity vel = g.VectorToWorld(Velocity(ps.vx[i], ps.vy[i]));
-    os << Fixed(pos.x(), 3) << ',' << Fixed(pos.y(), 3) << ',' << Fixed(vel.x(), 3) << ','
-       << Fixed(vel.y(), 3) << ',' << ps.w_position[i] << ',' << ps.w_velocity[i] << ','
-       << ps.weight[i] << ',' << Fixed(pd, 3) << '\n';
+    os << FormatFixed(pos.x(), 3) << ',' << FormatFixed(pos.y(), 3) << ','
+       << FormatFixed(vel.x(), 3) << ',' << FormatFixed(vel.y(), 3) << ',' << ps.w_position[i]
+       << ',' << ps.w_velocity[i] << ',' << ps.weight[i] << ',' << FormatFixed(pd, 3) << '\n';
   }
   pc.buffer() += os.str();
   pc.Close();
@@ -125,7 +126,7 @@ void WriteObjects(const std::vector<std::string>& modes,
   std::ostringstream os;
   os << "mode,id,name,frames_in_grid,frames_tracked,frames_tracked_v,scored,D,D_v,t_d,delta_x,"
         "delta_v\n";
-  auto opt = [](const std::optional<double>& v) { return v ? Fixed(*v, 4) : std::string(); };
+  auto opt = [](const std::optional<double>& v) { return v ? FormatFixed(*v, 4) : std::string(); };
   for (std::size_t m = 0; m < modes.size(); ++m)
     for (const auto& o : metrics[m].objects)
       os << modes[m] << ',' << o.id << ',' << ids.Name(o.id) << ',' << o.frames_in_grid << ','
@@ -143,9 +144,9 @@ void WriteWeights(const WeightTrace& t, const std::string& object,
   os << "time,object,w_position,w_velocity,w_resample,position_share,velocity_share,"
         "tangential_share\n";
   for (std::size_t i = 0; i < t.time.size(); ++i)
-    os << Fixed(t.time[i], 3) << ',' << object << ',' << t.w_position[i] << ',' << t.w_velocity[i]
-       << ',' << t.weight[i] << ',' << t.position_share[i] << ',' << t.velocity_share[i] << ','
-       << t.tangential_share[i] << '\n';
+    os << FormatFixed(t.time[i], 3) << ',' << object << ',' << t.w_position[i] << ','
+       << t.w_velocity[i] << ',' << t.weight[i] << ',' << t.position_share[i] << ','
+       << t.velocity_share[i] << ',' << t.tangential_share[i] << '\n';
   WriteTextFile(path, os.str());
 }
 

@@ -1,4 +1,5 @@
 #include "sweep_spec.hpp"
+#include "dualgrid/core/text.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -11,11 +12,7 @@ namespace {
 constexpr std::size_t kMaxValues = 1000;
 
 // Text of a value already rounded to 12 significant digits: "90", "0.3", "1e-05".
-std::string Text(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.12g", v);
-  return buf;
-}
+std::string Text(double v) { return FormatSignificant(v, 12); }
 
 }  // namespace
 

@@ -52,7 +52,7 @@ std::pair<std::size_t, std::size_t> FrameRange(const replay::Reader& reader,
                                                const ReplayOptions& o) {
   if (o.from < 0.0 || o.to < 0.0 || (o.to > 0.0 && o.to < o.from))
     throw std::invalid_argument("--from/--to: expected 0 <= from <= to (to = 0: the end), got " +
-                                Fixed(o.from, 2) + " and " + Fixed(o.to, 2));
+                                FormatFixed(o.from, 2) + " and " + FormatFixed(o.to, 2));
   std::size_t first = reader.size(), last = 0;
   for (std::size_t i = 0; i < reader.size(); ++i) {
     const double t = reader.time(i);
@@ -61,12 +61,13 @@ std::pair<std::size_t, std::size_t> FrameRange(const replay::Reader& reader,
     last = i + 1;
   }
   if (first >= last)
-    throw std::invalid_argument("--from/--to: no recorded frame in [" + Fixed(o.from, 2) + ", " +
-                                (o.to > 0.0 ? Fixed(o.to, 2) : std::string("end")) + "] s (" +
-                                std::to_string(reader.size()) + " frames recorded" +
-                                (reader.size() ? ", " + Fixed(reader.time(0), 2) + " to " +
-                                                     Fixed(reader.time(reader.size() - 1), 2) + " s"
-                                               : std::string()) +
+    throw std::invalid_argument("--from/--to: no recorded frame in [" + FormatFixed(o.from, 2) +
+                                ", " + (o.to > 0.0 ? FormatFixed(o.to, 2) : std::string("end")) +
+                                "] s (" + std::to_string(reader.size()) + " frames recorded" +
+                                (reader.size()
+                                     ? ", " + FormatFixed(reader.time(0), 2) + " to " +
+                                           FormatFixed(reader.time(reader.size() - 1), 2) + " s"
+                                     : std::string()) +
                                 ")");
   return {first, last};
 }
@@ -208,7 +209,7 @@ viz::ReplayPicture ToPicture(const replay::Reader& reader, const replay::Frame& 
     p.title = h.modes[m];
     const replay::Live& l = mf.live;
     const auto pct = [](long a, long b) {
-      return b > 0 ? Fixed(100.0 * a / b, 0) + " %" : std::string("-");
+      return b > 0 ? FormatFixed(100.0 * a / b, 0) + " %" : std::string("-");
     };
     p.live = "in grid " + std::to_string(l.in_grid) + " \u00b7 tracked " +
              std::to_string(l.tracked) + " \u00b7 right velocity " + std::to_string(l.tracked_v) +
@@ -254,7 +255,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   if (o.preview != "gif" && o.preview != "webm" && o.preview != "none")
     throw std::invalid_argument("--preview: expected gif, webm or none, got '" + o.preview + "'");
   if (!(o.speed >= 0.1 && o.speed <= 20.0))
-    throw std::invalid_argument("--speed: expected 0.1 to 20, got " + Fixed(o.speed, 2));
+    throw std::invalid_argument("--speed: expected 0.1 to 20, got " + FormatFixed(o.speed, 2));
   const fs::path out = CheckOutputFile(
       o.out.empty() ? reader.dir().parent_path() / "replay.mp4" : o.out, "--out", ".mp4");
   const auto [first, last] = FrameRange(reader, o);
@@ -329,7 +330,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
       const replay::Frame f = i == first ? first_frame : reader.Load(i);
       const std::uint8_t* raster = renderer.Render(ToPicture(reader, f, modes, o));
       if (!pipe.Write(raster, bytes)) break;  // ffmpeg stopped: Close() reports why
-      progress.Update(static_cast<int>(i - first + 1), "t=" + Fixed(f.time, 1) + " s");
+      progress.Update(static_cast<int>(i - first + 1), "t=" + FormatFixed(f.time, 1) + " s");
     }
     progress.Finish();
     pipe.Close();
