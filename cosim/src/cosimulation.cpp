@@ -108,6 +108,11 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     if (e) std::rethrow_exception(e);
 }
 
+bool CoSimulation::finished() const {
+  return pipeline_.started() && steps_ > 0 && pipeline_.simulation().reached_end() &&
+         !pipeline_.simulation().ego_left();
+}
+
 std::vector<eval::ScenarioMetrics> CoSimulation::Metrics() const {
   std::vector<eval::ScenarioMetrics> out;
   for (const ModeScorer& s : scorers_) out.push_back(s.Result());

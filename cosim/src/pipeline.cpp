@@ -70,6 +70,10 @@ void Pipeline::Start(const std::filesystem::path& network_dir,
       config_.sim, sim::ResolveNetwork(config_.sim.network, network_dir), work_dir);
 }
 
+void Pipeline::Finish() {
+  if (simulation_) simulation_->Close();
+}
+
 radar::Scene Pipeline::BuildScene() {
   radar::Scene scene = static_scene_;
   for (const sim::VehicleState& v : frame().vehicles)
@@ -81,18 +85,21 @@ void Pipeline::UpdateFilter(std::size_t i) {
   // The grid is centred on ego + offset (filter.ahead / filter.left); the filter reads only the
   // position of EgoInput's pose, to place the grid.
   const Pose2 pose = grid_frame_.ToGrid(ego_.pose);
-  filters_[i]->Update(
-      {{pose.position + centre_offset_, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)},
-      measurements_, coverage_, dt_);
+  const Position centre = pose.position + centre_offset_;
+  if (realign_angle_ != 0.0) filters_[i]->Reframe(realign_angle_, centre);
+  filters_[i]->Update({{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)}, measurements_,
+                      coverage_, dt_);
 }
 
 void Pipeline::FixFrameAndRig(const sim::Frame& f) {
-  // Whole degrees: a road along a world axis keeps an exactly world-aligned grid (SUMO's
-  // headings carry ~1e-6 deg of rounding), and 0.5 deg is 0.9 m across at 100 m.
-  const double yaw = config_.grid.frame == scenario::GridPlacement::Frame::kHeading
-                         ? DegToRad(std::round(RadToDeg(ego_.pose.yaw)))
-                         : 0.0;
-  grid_frame_ = GridFrame(WrapAngle(yaw) == 0.0 ? 0.0 : yaw);
+  // GridYawAlong: a road along a world axis keeps an exactly world-aligned grid (SUMO's headings
+  // carry ~1e-6 deg of rounding). The grid that follows the road starts along the ego's lane,
+  // the one that stays fixed along its heading.
+  using Frame = scenario::GridPlacement::Frame;
+  const Frame frame = config_.grid.frame;
+  grid_frame_ = GridFrame(frame == Frame::kWorld     ? 0.0
+                          : frame == Frame::kHeading ? GridYawAlong(ego_.pose.yaw)
+                                                     : GridYawAlong(f.ego.lane_yaw));
   centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
   // The default radars sit on the ego's box as SUMO simulates it: an ego of the user's route
   // files may not have the scenario type's box (a 5 m SUMO car put the front radar inside it).
@@ -108,7 +115,18 @@ bool Pipeline::Advance() {
   ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
   // The first filter cycle (the ego may depart late) predicts over one step.
   dt_ = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
-  if (!radar_) FixFrameAndRig(f);
+  realign_angle_ = 0.0;
+  if (!radar_) {
+    FixFrameAndRig(f);
+  } else if (config_.grid.frame == scenario::GridPlacement::Frame::kFollow) {
+    // The road has turned: the grid turns with it (the filters follow in UpdateFilter).
+    if (const auto yaw =
+            RealignedYaw(grid_frame_.yaw(), f.ego.lane_yaw, DegToRad(config_.grid.realign_deg))) {
+      realign_angle_ = WrapAngle(*yaw - grid_frame_.yaw());
+      grid_frame_ = GridFrame(*yaw);
+      ++realignments_;
+    }
+  }
   last_time_ = f.time;
 
   detections_ = radar_->Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
@@ -135,6 +153,18 @@ bool Pipeline::Advance() {
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
   return true;
+}
+
+OrientedBox Pipeline::GridFootprint() const {
+  const double length = config_.filter.length_x, width = config_.filter.width_y;
+  Position centre = grid_frame_.ToGrid(ego_.pose.position) + centre_offset_;
+  if (!filters_.empty() && filters_[0]->initialized()) {
+    const filter::DynamicGrid& g = *filters_[0];
+    const auto [gx, gy] = g.origin_index();
+    centre = {(static_cast<double>(gx) + 0.5 * g.cells_x()) * g.resolution(),
+              (static_cast<double>(gy) + 0.5 * g.cells_y()) * g.resolution()};
+  }
+  return {grid_frame_.ToWorld(centre), grid_frame_.yaw(), length, width};
 }
 
 std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) const {

@@ -17,8 +17,9 @@ using namespace detail;
 
 void DynamicGrid::Initialize(const EgoInput& ego) {
   const double r = params_.resolution;
-  origin_gx_ = static_cast<std::int64_t>(std::floor(ego.pose.position.x() / r)) - nx_ / 2;
-  origin_gy_ = static_cast<std::int64_t>(std::floor(ego.pose.position.y() / r)) - ny_ / 2;
+  const auto origin = OriginFor(ego.pose.position);
+  origin_gx_ = origin[0];
+  origin_gy_ = origin[1];
   // Particles start spread over the grid with zero weight: the first births replace them.
   const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
@@ -48,10 +49,14 @@ void DynamicGrid::ResetRow(std::int64_t gy) {
   std::fill_n(dynamic_.begin() + sy * nx_, nx_, 0.0);
 }
 
-void DynamicGrid::ShiftTo(const Position& ego) {
+std::array<std::int64_t, 2> DynamicGrid::OriginFor(const Position& ego) const {
   const double r = params_.resolution;
-  const std::int64_t gx = static_cast<std::int64_t>(std::floor(ego.x() / r)) - nx_ / 2;
-  const std::int64_t gy = static_cast<std::int64_t>(std::floor(ego.y() / r)) - ny_ / 2;
+  return {static_cast<std::int64_t>(std::floor(ego.x() / r)) - nx_ / 2,
+          static_cast<std::int64_t>(std::floor(ego.y() / r)) - ny_ / 2};
+}
+
+void DynamicGrid::ShiftTo(const Position& ego) {
+  const auto [gx, gy] = OriginFor(ego);
   const std::int64_t dx = gx - origin_gx_, dy = gy - origin_gy_;
   // Only the storage columns/rows that now represent new world cells are cleared (grid_map
   // style); everything else stays in place and is re-addressed through the new origin.

@@ -144,6 +144,7 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
     cs.AddObserver(&clusters);
     while (cs.Step()) {
     }
+    cs.Finish();
   }
   if (own_work) {
     std::error_code ec;

@@ -342,6 +342,24 @@ coverage: the fields of view of the sensors that scanned this cycle, a float arr
   RadarModel.coverage() builds it) or the same as named columns. None: nothing observed.
 dt: time since the previous cycle [s], >= 0 (keyword only).
 ValueError (naming the argument) for a bad shape, a missing column or a non-finite value.)doc");
+  cls.def(
+      "reframe",
+      [](Grid& g, double angle, py::handle ego_position) {
+        const Vector2 ego = ReadVector2(ego_position, "ego_position", "[m]");
+        if (!std::isfinite(angle))
+          throw py::value_error("angle: expected a finite angle [rad], got " +
+                                std::to_string(angle));
+        Locked(g, [&](DynamicGrid& grid) {
+          ApplyThreadCount();
+          grid.Reframe(angle, ego);
+        });
+      },
+      py::arg("angle"), py::arg("ego_position"), R"doc(
+Turns your frame by `angle` [rad] (counter-clockwise, about its origin) between two updates, for
+a grid that follows the ego's heading: the particles are turned exactly, the grid re-centred on
+`ego_position` (x, y) [m] given in the turned frame (as the next update() will give it), and each
+new cell takes the masses of the old cell under its centre. Give every later input in the turned
+frame. No-op before the first update. (DynamicGrid::Reframe; docs/algorithm.md, "Grid frame".))doc");
   cls.def("masses", &Masses, R"doc(
 Cell masses after the last update as (cells_y, cells_x) arrays: "free", "static", "dynamic"
 (float32 [probability], DynamicGrid::ExportMasses), "unknown" (float32, 1 - free - static -

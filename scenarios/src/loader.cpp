@@ -6,8 +6,10 @@
 #include <functional>
 #include <type_traits>
 
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/validation.hpp"
 #include "dualgrid/sim/sumo_files.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
 #include "yaml_reader.hpp"
 
 namespace dualgrid::scenario {
@@ -49,10 +51,7 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
       const sim::SumoConfigInputs in = sim::ReadSumoConfig(relative_to_file(cfg));
       s->network = in.net_file.string();
       for (const auto& f : in.route_files) s->route_files.push_back(f.string());
-      for (const auto& f : in.additional_files)
-        s->warnings.push_back(root.file() + ": key 'sumo_config': additional file " + f.string() +
-                              " is not loaded (stops, detectors, polygons are not simulated "
-                              "here; the radar sees vehicles, guard rails and parked boxes)");
+      for (const auto& f : in.additional_files) s->additional_files.push_back(f.string());
       cfg_step = in.step_length;
     } catch (const std::invalid_argument& e) {
       root.Fail("sumo_config", e.what());
@@ -62,7 +61,8 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
   }
   // A network given as a file (ending in .xml) is read relative to the scenario file, so a
   // scenario and its network can move together; a bare name is one of the built networks.
-  if (const std::filesystem::path net(s->network); net.extension() == ".xml" && net.is_relative())
+  if (const std::filesystem::path net(s->network);
+      sim::IsNetworkPath(s->network) && net.is_relative())
     s->network = relative_to_file(s->network);
   root.Read("duration", &s->duration);
   root.Read("step_length", &s->step_length);
@@ -131,6 +131,9 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
     std::vector<std::string> files;
     traffic->Read("route_files", &files);
     for (const std::string& f : files) s->route_files.push_back(relative_to_file(f));
+    files.clear();
+    traffic->Read("additional_files", &files);
+    for (const std::string& f : files) s->additional_files.push_back(relative_to_file(f));
     if (auto rcs = traffic->Map("rcs_dbsm")) {
       for (const std::string& type : rcs->Keys()) {
         double v = 0.0;
@@ -442,8 +445,17 @@ void ReadGridPlacement(MapReader& r, const filter::FilterParams& f, GridPlacemen
       g->frame = GridPlacement::Frame::kWorld;
     else if (frame == "heading")
       g->frame = GridPlacement::Frame::kHeading;
+    else if (frame == "follow")
+      g->frame = GridPlacement::Frame::kFollow;
     else
-      r.Fail("frame", "expected 'heading' or 'world', got '" + frame + "'");
+      r.Fail("frame", "expected 'follow', 'heading' or 'world', got '" + frame + "'");
+  }
+  if (r.Has("realign_deg")) {
+    if (g->frame != GridPlacement::Frame::kFollow)
+      r.Fail("realign_deg", "is used only with frame: follow (the grid that turns with the road)");
+    r.Read("realign_deg", &g->realign_deg);
+    if (!(g->realign_deg > 0.0 && g->realign_deg <= 90.0))
+      r.Fail("realign_deg", "expected an angle in (0, 90] deg, got " + Shown(g->realign_deg));
   }
   auto read_edge = [&](const char* key, double extent, const char* extent_key, double* out) {
     if (!r.Has(key)) return;
@@ -528,6 +540,57 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
   if (!e->IsValid(&error)) Invalid(root.file(), "evaluation", error);
 }
 
+// The user's SUMO route and additional files, indexed once (std::nullopt when there are none):
+// ids the scenario names must be vehicles SUMO will simulate and types it gives an RCS must exist
+// (a typo would otherwise fail at run time, or silently pick another vehicle or none).
+std::optional<sim::RouteFileIndex> IndexUserFiles(MapReader& root, const std::string& name,
+                                                  sim::ScenarioSpec& s) {
+  const bool cfg = root.Has("sumo_config");
+  if (s.route_files.empty() && s.additional_files.empty()) {
+    if (!s.type_rcs.empty())
+      throw ConfigError(name +
+                        ": key 'traffic.rcs_dbsm' gives vType RCS values, but there are no "
+                        "SUMO route or additional files whose vTypes they could be");
+    return std::nullopt;
+  }
+  sim::RouteFileIndex index;
+  const auto add = [&](const std::vector<std::string>& files, const char* what, const char* key) {
+    try {
+      sim::IndexSumoFiles(files, what, &index);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(name + ": key '" + (cfg ? "sumo_config" : key) + "': " + e.what());
+    }
+  };
+  add(s.additional_files, "SUMO additional file", "traffic.additional_files");
+  add(s.route_files, "SUMO route file", "traffic.route_files");
+  for (const std::string& w : index.warnings) s.warnings.push_back(w);
+  for (const auto& [type, rcs] : s.type_rcs) {
+    // SUMO's built-in types (DEFAULT_VEHTYPE, DEFAULT_BIKETYPE, ...) need no definition.
+    if (index.types.count(type) || type.rfind("DEFAULT_", 0) == 0) continue;
+    std::string known;
+    for (const std::string& t : index.types) known += (known.empty() ? "'" : ", '") + t + "'";
+    throw ConfigError(name + ": key 'traffic.rcs_dbsm." + type +
+                      "': no route or additional file "
+                      "defines a vType '" +
+                      type + "' (expected one of: " + (known.empty() ? "none defined" : known) +
+                      ", or DEFAULT_VEHTYPE)");
+  }
+  const std::string& ego = s.ego.id;
+  if (s.ego_from_routes && ego == sim::kAutoEgo) {
+    if (index.vehicles.empty() && index.flows.empty())
+      throw ConfigError(name +
+                        ": key 'ego.from_routes' is 'auto', but the route and additional "
+                        "files define no vehicle, trip or flow to choose from");
+  } else if (s.ego_from_routes) {
+    if (const auto problem = sim::VehicleIdProblem(index, ego))
+      throw ConfigError(name + ": key 'ego.from_routes': '" + ego + "' " + *problem +
+                        " (expected a vehicle, a trip, FLOW.k for a flow's k-th vehicle, or "
+                        "auto; e.g. " +
+                        sim::ExampleVehicleIds(index) + ")");
+  }
+  return index;
+}
+
 }  // namespace
 
 void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out);
@@ -549,7 +612,15 @@ Vector2 GridPlacement::CentreOffset(double length_x, double width_y) const {
 }
 
 std::string_view ToString(GridPlacement::Frame f) {
-  return f == GridPlacement::Frame::kWorld ? "world" : "heading";
+  switch (f) {
+    case GridPlacement::Frame::kWorld:
+      return "world";
+    case GridPlacement::Frame::kHeading:
+      return "heading";
+    case GridPlacement::Frame::kFollow:
+      break;
+  }
+  return "follow";
 }
 
 filter::FilterParams ScenarioConfig::FilterFor(filter::WeightMode mode) const {
@@ -654,11 +725,16 @@ void ApplyOverride(YAML::Node doc, const Override& o) {
 
 ScenarioConfig LoadScenario(const std::filesystem::path& file,
                             const std::vector<Override>& overrides) {
-  if (!std::filesystem::is_regular_file(file))
-    throw ConfigError(file.string() + ": scenario file not found");
+  // Bounded, and a FIFO or device is refused before it could block (core/input_file.hpp).
+  std::string text;
+  try {
+    text = ReadInputText(file, "scenario file");
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(e.what());
+  }
   return LoadDocument(
       [&] {
-        YAML::Node doc = YAML::LoadFile(file.string());
+        YAML::Node doc = YAML::Load(text);
         for (const Override& o : overrides) ApplyOverride(doc, o);
         return doc;
       },
@@ -699,6 +775,8 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   j["filter"]["velocity_likelihood"] = filter::ToString(c.filter.velocity_likelihood);
   j["filter"]["normalisation"] = filter::ToString(c.filter.normalisation);
   j["filter"]["frame"] = ToString(c.grid.frame);
+  if (c.grid.frame == GridPlacement::Frame::kFollow)
+    j["filter"]["realign_deg"] = c.grid.realign_deg;
   const Vector2 off = c.grid.CentreOffset(c.filter.length_x, c.filter.width_y);
   j["filter"]["ahead"] = 0.5 * c.filter.length_x + off.x();
   j["filter"]["left"] = 0.5 * c.filter.width_y + off.y();
@@ -725,19 +803,7 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
   if (config.sim.name.empty()) config.sim.name = std::filesystem::path(name).stem().string();
   std::string error;
   if (!config.sim.IsValid(&error)) Invalid(name, "", error);
-  if (!config.sim.route_files.empty()) {
-    const char* key = root.Has("sumo_config") ? "sumo_config" : "traffic.route_files";
-    try {
-      for (std::string& w : sim::RouteFileWarnings(config.sim.route_files))
-        config.sim.warnings.push_back(std::move(w));
-    } catch (const std::invalid_argument& e) {
-      throw ConfigError(name + ": key '" + key + "': " + e.what());
-    }
-    if (config.sim.ego_from_routes &&
-        !sim::RouteFilesDefine(config.sim.route_files, config.sim.ego.id))
-      throw ConfigError(name + ": key 'ego.from_routes' names '" + config.sim.ego.id +
-                        "', which no vehicle of the route files has as its id");
-  }
+  const std::optional<sim::RouteFileIndex> routes = IndexUserFiles(root, name, config.sim);
   ReadRadar(root, config.sim, &config.radar);
   ReadFilter(root, &config);
   ReadEvaluation(root, &config.evaluation);
@@ -753,10 +819,7 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
           found || (focus.rfind(f.id + ".", 0) == 0 && focus.size() > f.id.size() + 1 &&
                     focus.find_first_not_of("0123456789", f.id.size() + 1) == std::string::npos);
     // A vehicle of the user's route files (or of one of their flows).
-    if (!found && !config.sim.route_files.empty())
-      found = sim::RouteFilesDefine(config.sim.route_files, focus) ||
-              (focus.rfind('.') != std::string::npos &&
-               sim::RouteFilesDefine(config.sim.route_files, focus.substr(0, focus.rfind('.'))));
+    if (!found && routes) found = !sim::VehicleIdProblem(*routes, focus);
     if (!found || focus == config.sim.ego.id)
       throw ConfigError(name + ": key 'evaluation.focus_object' names '" + focus +
                         "', which is no vehicle of the scenario (expected an id of "

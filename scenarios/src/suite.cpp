@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dualgrid/core/input_file.hpp"
 #include "yaml_reader.hpp"
 
 namespace dualgrid::scenario {
@@ -64,11 +65,15 @@ std::vector<eval::Ordering> ReadOrderings(MapReader& r) {
 }  // namespace
 
 RegressionSuite LoadSuite(const std::filesystem::path& file) {
-  if (!std::filesystem::is_regular_file(file))
-    throw ConfigError(file.string() + ": suite file not found");
+  std::string text;
+  try {
+    text = ReadInputText(file, "suite file");  // bounded; FIFOs and devices refused
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(e.what());
+  }
   YAML::Node doc;
   try {
-    doc = YAML::LoadFile(file.string());
+    doc = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(file.string() + ":" + std::to_string(e.mark.line + 1) +
                       ": not valid YAML: " + e.msg);

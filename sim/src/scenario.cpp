@@ -57,8 +57,8 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   c.Expect(!network.empty(), "network", "''", "the name or path of a network");
   c.InRange("duration", duration, 0.0, 3600.0, Interval::kLeftOpen, "s");
   c.InRange("step_length", step_length, 0.001, 1.0, Interval::kClosed, "s");
-  c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6,
-           "step_length", step_length, "a whole number of milliseconds (SUMO's resolution)");
+  c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6, "step_length",
+           step_length, "a whole number of milliseconds (SUMO's resolution)");
   c.NonNegative("lane_change_duration", lane_change_duration, "s");
   for (const auto& [name, t] : vehicle_types) {
     const std::string f = "vehicle_types." + name;
@@ -78,8 +78,9 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   c.Expect(duration >= step_length, "duration", duration,
            ">= step_length = " + FormatShort(step_length) + " s (at least one step)");
   if (ego_from_routes)
-    c.Expect(!route_files.empty(), "ego.from_routes", Quoted(ego.id),
-             "SUMO route files to take it from (traffic.route_files or sumo_config)");
+    c.Expect(!route_files.empty() || !additional_files.empty(), "ego.from_routes", Quoted(ego.id),
+             "SUMO route or additional files to take it from (traffic.route_files or "
+             "sumo_config)");
   else
     CheckVehicle(c, ego, "ego", *this);
   c.Expect(ego.depart < duration, "ego.depart", ego.depart,

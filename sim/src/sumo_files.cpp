@@ -1,42 +1,15 @@
 #include "dualgrid/sim/sumo_files.hpp"
 
-#include <fstream>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
+#include "dualgrid/sim/xml_scan.hpp"
+
 namespace dualgrid::sim {
 namespace {
-
-std::string ReadAll(const std::filesystem::path& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path.string() + ": cannot read this " + what);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// The value attribute of the first element <tag value="..."/> of `xml` (either quote), outside
-// comments; std::nullopt when absent.
-std::optional<std::string> ValueOf(const std::string& xml, const std::string& tag) {
-  std::size_t at = 0;
-  while ((at = xml.find("<" + tag, at)) != std::string::npos) {
-    const std::size_t comment = xml.rfind("<!--", at);
-    if (comment != std::string::npos && xml.find("-->", comment) > at) {  // inside a comment
-      at = xml.find("-->", comment);
-      continue;
-    }
-    const std::size_t end = xml.find('>', at);
-    const std::string element = xml.substr(at, end - at);
-    at = end;
-    const std::size_t v = element.find("value=");
-    if (v == std::string::npos || v + 6 >= element.size()) continue;
-    const char quote = element[v + 6];
-    const std::size_t close = element.find(quote, v + 7);
-    if (close == std::string::npos) continue;
-    return element.substr(v + 7, close - v - 7);
-  }
-  return std::nullopt;
-}
 
 std::vector<std::filesystem::path> PathList(const std::string& list,
                                             const std::filesystem::path& base) {
@@ -52,70 +25,173 @@ std::vector<std::filesystem::path> PathList(const std::string& list,
   return out;
 }
 
-// Elements outside comments whose tag is exactly `tag`.
-std::size_t CountElements(const std::string& xml, const std::string& tag) {
-  std::size_t n = 0, at = 0;
-  while ((at = xml.find("<" + tag, at)) != std::string::npos) {
-    const std::size_t after = at + 1 + tag.size();
-    const std::size_t comment = xml.rfind("<!--", at);
-    const bool in_comment = comment != std::string::npos && xml.find("-->", comment) > at;
-    if (!in_comment && after < xml.size() &&
-        (xml[after] == ' ' || xml[after] == '>' || xml[after] == '/' || xml[after] == '\n' ||
-         xml[after] == '\t' || xml[after] == '\r'))
-      ++n;
-    at = after;
-  }
-  return n;
+// A SUMO time or count attribute as a finite number; std::nullopt when absent or not a plain
+// number (SUMO also reads "1:00:00" and "exp(0.1)": then the count depends on SUMO).
+std::optional<double> Number(const char* text) {
+  if (text == nullptr || *text == '\0') return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  return v;
 }
+
+// How many vehicles a <flow> creates (SUMO's rules: `number`; else departures from begin every
+// period, 3600 / vehsPerHour, before end); std::nullopt when chance or the run decides.
+std::optional<long> FlowMembers(const XmlElement& e, double begin) {
+  if (const auto n = Number(e.Attribute("number"))) return std::max(0L, std::lround(*n));
+  const auto end = Number(e.Attribute("end"));
+  std::optional<double> period = Number(e.Attribute("period"));
+  if (!period)
+    if (const auto vph = Number(e.Attribute("vehsPerHour")); vph && *vph > 0)
+      period = 3600.0 / *vph;
+  if (!end || !period || !(*period > 0.0)) return std::nullopt;
+  if (!(*end > begin)) return 0L;
+  return static_cast<long>(std::ceil((*end - begin) / *period - 1e-9));
+}
+
+// Elements whose id names something that is not a vehicle (for "'x' is a vType").
+bool NamesOther(std::string_view tag) {
+  static const char* kTags[] = {"vType",  "vTypeDistribution", "route",     "routeDistribution",
+                                "person", "personFlow",        "container", "containerFlow"};
+  return std::find(std::begin(kTags), std::end(kTags), tag) != std::end(kTags);
+}
+
+std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
 SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
-  const std::string xml = ReadAll(cfg, "SUMO configuration");
   const std::filesystem::path base = std::filesystem::absolute(cfg).parent_path();
   SumoConfigInputs in;
-  const auto net = ValueOf(xml, "net-file");
+  std::optional<std::string> net, routes, additional, step;
+  // SUMO's option names and their synonyms (sumo --help); in a configuration each is an element
+  // <name value="..."/> or an attribute name="..." of a section element (<input net-file=.../>).
+  const std::pair<std::optional<std::string>*, std::vector<std::string_view>> kOptions[] = {
+      {&net, {"net-file", "net", "n"}},
+      {&routes, {"route-files", "routes", "r"}},
+      {&additional, {"additional-files", "additional", "a"}},
+      {&step, {"step-length"}}};
+  ScanXml(cfg, "SUMO configuration", [&](const XmlElement& e) {
+    for (const auto& [slot, names] : kOptions) {
+      if (*slot) continue;  // the first one, as SUMO reads its options
+      for (std::string_view name : names) {
+        if (e.tag() == name && e.Attribute("value")) *slot = e.Attribute("value");
+        if (e.depth() == 1 && e.Attribute(name)) *slot = e.Attribute(name);
+        if (*slot) break;
+      }
+    }
+    return true;
+  });
   const auto nets = net ? PathList(*net, base) : std::vector<std::filesystem::path>{};
   if (nets.empty())
     throw std::invalid_argument(cfg.string() +
-                                ": element <net-file value=\"...\"/> expected in <input>");
+                                ": element <net-file value=\"...\"/> (or <net value=...>) "
+                                "expected in <input>");
   in.net_file = nets.front();
-  if (const auto r = ValueOf(xml, "route-files")) in.route_files = PathList(*r, base);
-  if (const auto a = ValueOf(xml, "additional-files")) in.additional_files = PathList(*a, base);
-  if (const auto s = ValueOf(xml, "step-length")) {
-    try {
-      in.step_length = std::stod(*s);
-    } catch (const std::exception&) {
-      throw std::invalid_argument(cfg.string() + ": element <step-length value=\"" + *s +
-                                  "\"/>: expected a number of seconds");
-    }
+  if (routes) in.route_files = PathList(*routes, base);
+  if (additional) in.additional_files = PathList(*additional, base);
+  if (step) {
+    in.step_length = Number(step->c_str());
+    if (!in.step_length || !(*in.step_length > 0.0))
+      throw std::invalid_argument(cfg.string() + ": element <step-length value=\"" + *step +
+                                  "\"/>: expected a positive number of seconds");
   }
   return in;
 }
 
-std::vector<std::string> RouteFileWarnings(const std::vector<std::string>& route_files) {
-  std::vector<std::string> out;
-  for (const std::string& file : route_files) {
-    const std::string xml = ReadAll(file, "SUMO route file");
-    for (const char* tag : {"person", "personFlow", "container", "containerFlow"}) {
-      const std::size_t n = CountElements(xml, tag);
-      if (n == 0) continue;
-      out.push_back(file + ": " + std::to_string(n) + " <" + tag +
-                    "> element(s): SUMO simulates them, but the radar model and the scoring see "
-                    "vehicles only, so they are neither detected nor scored");
+namespace {
+
+// Indexes one file into `index`. `what` names its role in messages.
+void IndexFile(const std::string& file, const std::string& what, RouteFileIndex* index) {
+  std::map<std::string, std::size_t> unhonoured, unseen;  // tag -> count
+  ScanXml(file, what, [&](const XmlElement& e) {
+    const std::string_view tag = e.tag();
+    const char* id = e.Attribute("id");
+    if (tag == "person" || tag == "personFlow" || tag == "container" || tag == "containerFlow")
+      ++unhonoured[std::string(tag)];
+    if (tag == "poly" || tag == "poi") ++unseen[std::string(tag)];
+    if (id == nullptr) return true;
+    if (tag == "vehicle" || tag == "trip") {
+      index->vehicles.push_back({id, Number(e.Attribute("depart")).value_or(0.0), file});
+    } else if (tag == "flow") {
+      const double begin = Number(e.Attribute("begin")).value_or(0.0);
+      index->flows.push_back({id, FlowMembers(e, begin), begin, file});
+    } else if (NamesOther(tag)) {
+      index->others.emplace(id, std::string(tag));
+      if (tag == "vType" || tag == "vTypeDistribution") index->types.insert(id);
     }
-  }
-  return out;
+    return true;
+  });
+  for (const auto& [tag, n] : unhonoured)
+    index->warnings.push_back(file + ": " + std::to_string(n) + " <" + tag +
+                              "> element(s): SUMO simulates them, but the radar model and the "
+                              "scoring see vehicles only, so they are neither detected nor scored");
+  for (const auto& [tag, n] : unseen)
+    index->warnings.push_back(file + ": " + std::to_string(n) + " <" + tag +
+                              "> element(s): SUMO loads them, but the radar model does not see "
+                              "them (it sees vehicles and the scenario's guard rails and parked "
+                              "boxes), so they give no detections");
 }
 
-bool RouteFilesDefine(const std::vector<std::string>& route_files, const std::string& id) {
-  for (const std::string& file : route_files) {
-    const std::string xml = ReadAll(file, "SUMO route file");
-    if (xml.find("id=\"" + id + "\"") != std::string::npos ||
-        xml.find("id='" + id + "'") != std::string::npos)
-      return true;
+}  // namespace
+
+void IndexSumoFiles(const std::vector<std::string>& files, const std::string& what,
+                    RouteFileIndex* index) {
+  for (const std::string& file : files) IndexFile(file, what, index);
+}
+
+RouteFileIndex IndexRouteFiles(const std::vector<std::string>& route_files,
+                               const std::vector<std::string>& additional_files) {
+  RouteFileIndex index;
+  IndexSumoFiles(additional_files, "SUMO additional file", &index);
+  IndexSumoFiles(route_files, "SUMO route file", &index);
+  return index;
+}
+
+std::optional<std::string> VehicleIdProblem(const RouteFileIndex& index, const std::string& id) {
+  for (const auto& v : index.vehicles)
+    if (v.id == id) return std::nullopt;
+  for (const auto& f : index.flows) {
+    if (f.id == id)
+      return "is a flow, not a vehicle: SUMO names its vehicles " + Quote(id + ".0") + ", " +
+             Quote(id + ".1") + ", ...";
   }
-  return false;
+  // FLOW.k: the longest flow id that prefixes it (flow ids may contain dots themselves).
+  const auto dot = id.rfind('.');
+  if (dot != std::string::npos && dot + 1 < id.size() &&
+      id.find_first_not_of("0123456789", dot + 1) == std::string::npos) {
+    const std::string flow = id.substr(0, dot);
+    for (const auto& f : index.flows) {
+      if (f.id != flow) continue;
+      const long k = std::strtol(id.c_str() + dot + 1, nullptr, 10);
+      if (f.members && k >= *f.members)
+        return "is no member of flow " + Quote(flow) + ", which creates " +
+               std::to_string(*f.members) + " vehicle(s): " + Quote(flow + ".0") + " to " +
+               Quote(flow + "." + std::to_string(std::max(0L, *f.members - 1)));
+      return std::nullopt;
+    }
+  }
+  if (const auto it = index.others.find(id); it != index.others.end())
+    return "is a <" + it->second + ">, not a vehicle";
+  return "is no vehicle, trip or flow member of the route files";
+}
+
+std::string ExampleVehicleIds(const RouteFileIndex& index, std::size_t n) {
+  struct Candidate {
+    double depart;
+    std::string id;
+  };
+  std::vector<Candidate> all;
+  for (const auto& v : index.vehicles) all.push_back({v.depart, v.id});
+  for (const auto& f : index.flows)
+    if (!f.members || *f.members > 0) all.push_back({f.begin, f.id + ".0"});
+  std::stable_sort(all.begin(), all.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.depart < b.depart; });
+  std::string out;
+  for (std::size_t i = 0; i < all.size() && i < n; ++i)
+    out += (out.empty() ? "" : ", ") + Quote(all[i].id);
+  if (all.size() > n) out += ", ...";
+  return out.empty() ? "none" : out;
 }
 
 }  // namespace dualgrid::sim

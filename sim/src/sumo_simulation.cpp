@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -13,6 +14,8 @@
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/sim/conversions.hpp"
+#include "dualgrid/sim/sumo_additional.hpp"
+#include "dualgrid/sim/xml_scan.hpp"
 
 namespace dualgrid::sim {
 namespace {
@@ -34,21 +37,24 @@ std::string Num(double v) { return FormatSignificant(v, 10); }
 // immediate collisions (SUMO docs, "lane change mode" bits 8-9).
 constexpr int kLaneChangeModeScriptedOnly = 256;
 
-// A quick look at a network file before SUMO parses it: SUMO's own messages for a file that is
-// not XML or is cut short ("invalid document structure", "unexpected end of input") name no
-// file. A SUMO network is one <net> element; its end tag is the file's last.
+// A look at a network file before SUMO parses it: SUMO's own messages for a file that is not
+// XML or is cut short ("invalid document structure", "unexpected end of input") name no file.
+// A SUMO network is one <net> element; the whole document is parsed once (expat, linear), so a
+// truncated file is caught with its line.
 void CheckNetworkFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const auto fail = [&](const std::string& why) {
-    throw std::invalid_argument("network file " + path.string() + " " + why +
-                                " (build it with netconvert; see docs/scenarios.md)");
-  };
-  if (!in.eof() && in.fail()) fail("cannot be read");
-  if (text.find("<net") == std::string::npos) fail("is not a SUMO network (no <net> element)");
-  const auto end = text.find_last_not_of(" \t\r\n");
-  if (end == std::string::npos || end < 5 || text.compare(end - 5, 6, "</net>") != 0)
-    fail("is cut short or damaged (it does not end with </net>)");
+  const std::string hint = " (build it with netconvert; see docs/scenarios.md)";
+  try {
+    std::string root;
+    ScanXml(path, "network file", [&](const XmlElement& e) {
+      if (e.depth() == 0) root = e.tag();
+      return e.depth() == 0 ? root == "net" : true;
+    });
+    if (root != "net")
+      throw std::invalid_argument(path.string() + ": network file is not a SUMO network (root <" +
+                                  root + ">, expected <net>)");
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(e.what() + hint);
+  }
 }
 
 }  // namespace
@@ -72,12 +78,17 @@ NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
 
 std::filesystem::path DefaultNetworkDir() { return FindNetworkDir().dir; }
 
+bool IsNetworkPath(const std::string& network) {
+  return network.ends_with(".xml") || network.ends_with(".xml.gz") ||
+         network.find('/') != std::string::npos;
+}
+
 std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir) {
   std::filesystem::path p = network;
-  if (p.extension() != ".xml") p = network_dir / (network + ".net.xml");
+  if (!IsNetworkPath(network)) p = network_dir / (network + ".net.xml");
   if (std::filesystem::is_regular_file(p)) return p;
-  if (std::filesystem::path(network).extension() == ".xml")
+  if (IsNetworkPath(network))
     throw std::invalid_argument("network '" + network + "' not found: no file " + p.string() +
                                 " (a path in a scenario is read relative to the scenario file)");
   std::string built;
@@ -164,6 +175,103 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
   if (!out) throw std::runtime_error("cannot write route file " + path.string());
 }
 
+namespace {
+
+// SUMO's command line for `spec` (the scenario's route file first, then the user's files;
+// `additional` as prepared, comma-separated, or empty).
+std::vector<std::string> SumoArgs(const ScenarioSpec& spec,
+                                  const std::filesystem::path& network_file,
+                                  const std::string& route_files, const std::string& additional,
+                                  const std::filesystem::path& log) {
+  std::vector<std::string> args = {"sumo",
+                                   "--net-file",
+                                   network_file.string(),
+                                   "--route-files",
+                                   route_files,
+                                   "--step-length",
+                                   Num(spec.step_length),
+                                   "--seed",
+                                   std::to_string(spec.seed % 2147483647),
+                                   "--lanechange.duration",
+                                   Num(spec.lane_change_duration),
+                                   "--end",
+                                   Num(spec.duration + 1.0),
+                                   "--xml-validation",
+                                   "never",
+                                   "--no-step-log",
+                                   "true",
+                                   "--duration-log.disable",
+                                   "true",
+                                   "--message-log",
+                                   log.string(),
+                                   "--no-warnings",
+                                   "true",
+                                   "--time-to-teleport",
+                                   "-1",
+                                   "--collision.action",
+                                   "warn",
+                                   "--threads",
+                                   "1"};
+  if (!additional.empty()) {
+    args.push_back("--additional-files");
+    args.push_back(additional);
+  }
+  return args;
+}
+
+// `ego: {from_routes: auto}` (docs/scenarios.md): a dry run of SUMO over the scenario's duration;
+// the ego is the road vehicle of the user's route files that stays in the run longest (a vehicle
+// that never arrives stays to the end), ties going to the earlier departure; std::nullopt when
+// none departed.
+std::optional<std::string> ChooseAutoEgo(const ScenarioSpec& spec,
+                                         const std::vector<std::string>& args) {
+  libsumo::Simulation::start(args);
+  struct Closer {
+    ~Closer() {
+      try {
+        libsumo::Simulation::close();
+      } catch (...) {  // after a SUMO error close may throw again; that error is reported
+      }
+    }
+  } closer;
+  // The scenario's own vehicles are not the user's: only vehicles of the route files qualify.
+  std::set<std::string> own;
+  for (const auto& v : spec.vehicles) own.insert(v.id);
+  const auto own_flow = [&](const std::string& id) {
+    const std::string flow = id.substr(0, id.rfind('.'));
+    return std::any_of(spec.flows.begin(), spec.flows.end(),
+                       [&](const FlowSpec& f) { return f.id == flow; });
+  };
+  static const std::set<std::string> kOffRoad = {
+      "pedestrian", "wheelchair", "tram",   "rail_urban", "rail",    "rail_electric",
+      "rail_fast",  "ship",       "subway", "cable_car",  "aircraft"};
+  struct Candidate {
+    double depart = 0.0, arrive = 0.0;
+    std::size_t order = 0;
+  };
+  std::map<std::string, Candidate> seen;
+  for (int step = 0; step < spec.StepCount(); ++step) {
+    libsumo::Simulation::step();
+    const double now = libsumo::Simulation::getTime();
+    for (const std::string& id : libsumo::Simulation::getDepartedIDList()) {
+      if (own.count(id) || own_flow(id) || kOffRoad.count(libsumo::Vehicle::getVehicleClass(id)))
+        continue;
+      seen[id] = {now, spec.duration, seen.size()};
+    }
+    for (const std::string& id : libsumo::Simulation::getArrivedIDList())
+      if (auto it = seen.find(id); it != seen.end()) it->second.arrive = now;
+  }
+  // Longest in the run; ties: the earlier departure (order of departure).
+  const auto best = std::max_element(seen.begin(), seen.end(), [](const auto& a, const auto& b) {
+    const double ta = a.second.arrive - a.second.depart, tb = b.second.arrive - b.second.depart;
+    return ta != tb ? ta < tb : a.second.order > b.second.order;
+  });
+  if (best == seen.end()) return std::nullopt;
+  return best->first;
+}
+
+}  // namespace
+
 SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                                const std::filesystem::path& work_dir)
     : spec_(spec), log_path_(work_dir / "sumo.log"), own_types_(OwnTypes(spec)) {
@@ -172,57 +280,50 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
     throw std::invalid_argument("scenario '" + spec_.name + "': " + error);
   if (g_simulation_alive.exchange(true))
     throw std::logic_error("libsumo runs one simulation per process; one is already running");
+  std::string route_files, additional_list;
   try {
     CheckNetworkFile(network_file);
-  } catch (...) {
-    g_simulation_alive = false;
-    throw;
-  }
-  try {
     std::filesystem::create_directories(work_dir);
     const auto routes = work_dir / "routes.rou.xml";
     WriteRouteFile(spec_, routes);
     // The scenario's own vehicles first, then the user's SUMO route files as they are.
-    std::string route_files = routes.string();
+    route_files = routes.string();
     for (const std::string& f : spec_.route_files) route_files += "," + f;
-    std::sort(spec_.actions.begin(), spec_.actions.end(),
-              [](const ActionSpec& a, const ActionSpec& b) { return a.time < b.time; });
-    const std::vector<std::string> args = {"sumo",
-                                           "--net-file",
-                                           network_file.string(),
-                                           "--route-files",
-                                           route_files,
-                                           "--step-length",
-                                           Num(spec_.step_length),
-                                           "--seed",
-                                           std::to_string(spec_.seed % 2147483647),
-                                           "--lanechange.duration",
-                                           Num(spec_.lane_change_duration),
-                                           "--end",
-                                           Num(spec_.duration + 1.0),
-                                           "--xml-validation",
-                                           "never",
-                                           "--no-step-log",
-                                           "true",
-                                           "--duration-log.disable",
-                                           "true",
-                                           "--message-log",
-                                           log_path_.string(),
-                                           "--no-warnings",
-                                           "true",
-                                           "--time-to-teleport",
-                                           "-1",
-                                           "--collision.action",
-                                           "warn",
-                                           "--threads",
-                                           "1"};
-    libsumo::Simulation::start(args);
+    // The user's additional files, their outputs moved into the run folder.
+    const PreparedAdditionalFiles additional =
+        PrepareAdditionalFiles(spec_.additional_files, work_dir);
+    redirected_outputs_ = additional.outputs;
+    for (const std::string& f : additional.files)
+      additional_list += (additional_list.empty() ? "" : ",") + f;
+  } catch (...) {
+    g_simulation_alive = false;
+    throw;
+  }
+  std::sort(spec_.actions.begin(), spec_.actions.end(),
+            [](const ActionSpec& a, const ActionSpec& b) { return a.time < b.time; });
+  std::optional<std::string> auto_ego;
+  try {
+    if (spec_.ego_from_routes && spec_.ego.id == kAutoEgo) {
+      auto_ego = ChooseAutoEgo(spec_, SumoArgs(spec_, network_file, route_files, additional_list,
+                                               work_dir / "sumo_auto_ego.log"));
+      if (auto_ego) spec_.ego.id = *auto_ego;
+    }
+    if (!spec_.ego_from_routes || spec_.ego.id != kAutoEgo)
+      libsumo::Simulation::start(
+          SumoArgs(spec_, network_file, route_files, additional_list, log_path_));
   } catch (const std::exception& e) {
     g_simulation_alive = false;
     // SUMO refuses what it is given (the network, a route, a vehicle): bad input.
     throw std::invalid_argument("SUMO refused scenario '" + spec_.name + "' on network " +
                                 network_file.string() + ": " + OneLine(e.what()) + " (see " +
                                 log_path_.string() + ")");
+  }
+  if (spec_.ego.id == kAutoEgo && spec_.ego_from_routes) {
+    g_simulation_alive = false;
+    throw std::invalid_argument("scenario '" + spec_.name +
+                                "': ego.from_routes is auto, but no road vehicle of the route "
+                                "files departed before t=" +
+                                Num(spec_.duration) + " s");
   }
   try {
     CheckAgainstNetwork();
@@ -270,14 +371,18 @@ void SumoSimulation::CheckAgainstNetwork() const {
     check_vehicle(spec_.vehicles[i], "traffic.vehicles[" + std::to_string(i) + "]");
 }
 
-SumoSimulation::~SumoSimulation() {
+void SumoSimulation::Close() {
+  if (closed_) return;
+  closed_ = true;
   try {
     libsumo::Simulation::close();
   } catch (...) {
-    // Closing after a SUMO error may throw again; nothing useful to report from a destructor.
+    // Closing after a SUMO error may throw again; the run's own results are complete by now.
   }
   g_simulation_alive = false;
 }
+
+SumoSimulation::~SumoSimulation() { Close(); }
 
 const SumoSimulation::LaneGeometry& SumoSimulation::Lane(const std::string& lane_id) {
   auto it = lanes_.find(lane_id);
@@ -320,6 +425,7 @@ VehicleState SumoSimulation::ReadVehicle(const std::string& id) {
     lane_yaw = std::atan2(d.y(), d.x());
   }
   v.velocity = LaneSpeedsToVelocity(v.speed, v.lateral_speed, lane_yaw);
+  v.lane_yaw = lane_yaw;
   if (auto it = previous_yaw_.find(id); it != previous_yaw_.end())
     v.yaw_rate = WrapAngle(yaw - it->second) / spec_.step_length;
   return v;
@@ -328,11 +434,11 @@ VehicleState SumoSimulation::ReadVehicle(const std::string& id) {
 const VehicleTypeSpec& SumoSimulation::TypeOf(const std::string& vehicle, const std::string& type) {
   if (own_types_.count(type)) return spec_.vehicle_types.at(type);
   if (const auto it = sumo_types_.find(type); it != sumo_types_.end()) return it->second;
-  if (spec_.route_files.empty())
+  if (spec_.route_files.empty() && spec_.additional_files.empty())
     throw std::runtime_error("vehicle '" + vehicle + "' has type '" + type +
                              "', which the scenario does not define");
-  // A type of the user's route files: its box as SUMO simulates it, its RCS from the scenario
-  // (traffic.rcs_dbsm) or its vClass.
+  // A type of the user's route or additional files: its box as SUMO simulates it, its RCS from the
+  // scenario (traffic.rcs_dbsm) or its vClass.
   using V = libsumo::Vehicle;
   VehicleTypeSpec t;
   t.length = V::getLength(vehicle);
@@ -388,6 +494,7 @@ void SumoSimulation::ApplyActions() {
 }
 
 bool SumoSimulation::Step() {
+  if (closed_) throw std::logic_error("SumoSimulation::Step after Close");
   try {
     std::vector<std::string> ids;
     // Until the ego has departed, steps only advance SUMO: frames start with the ego.
@@ -417,7 +524,10 @@ bool SumoSimulation::Step() {
       ids = libsumo::Vehicle::getIDList();
       std::sort(ids.begin(), ids.end());
       if (std::binary_search(ids.begin(), ids.end(), spec_.ego.id)) break;
-      if (frame_.step != 0) return false;  // the ego reached the end of its route
+      if (frame_.step != 0) {  // the ego reached the end of its route
+        ego_left_ = true;
+        return false;
+      }
     }
     if (spec_.ego_speed.mode == SpeedPolicy::Mode::kFixed)
       libsumo::Vehicle::setSpeed(spec_.ego.id, spec_.ego_speed.speed);

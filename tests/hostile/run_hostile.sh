@@ -76,6 +76,60 @@ done
 check "network:folder" 2 "folder.net.xml" \
   "$dualgrid" run "$(scenario_for "$work/nets/folder.net.xml")" --duration 0.1 --no-figures -q --out "$work/net_folder"
 
+# 4. SUMO files that could block, never end, take quadratic time or loop (docs/scenarios.md,
+# "Bring your own SUMO scenario": every file is read once, streaming, bounded).
+sumo=$work/sumo
+net_abs=$(realpath "$network_dir")
+mkdir -p "$sumo/folder.rou.xml"
+mkfifo "$sumo/fifo.sumocfg" "$sumo/fifo.rou.xml"
+routes() {  # a valid route file on the highway network, with $1 inserted
+  printf '<routes>\n%s\n<vehicle id="v0" depart="0" departLane="1" departPos="300">\n' "$1"
+  printf '  <route edges="east_1 east_2"/>\n</vehicle>\n</routes>\n'
+}
+routes "" >"$sumo/ok.rou.xml"
+# A 3 MB comment (the text scan it replaces took over a minute).
+routes "<!-- $(head -c 3000000 /dev/zero | tr '\0' 'x') -->" >"$sumo/comment.rou.xml"
+routes "" | gzip -c | head -c 60 >"$sumo/damaged.rou.xml.gz"
+printf '<additional>\n  <include href="loop.add.xml"/>\n</additional>\n' >"$sumo/loop.add.xml"
+printf '<configuration>\n  <input>\n    <net-file value="net.bin"/>\n    <route-files value="ok.rou.xml"/>\n  </input>\n</configuration>\n' \
+  >"$sumo/binary_net.sumocfg"
+head -c 4000 /dev/urandom >"$sumo/net.bin"
+sumo_case() {  # NAME SCENARIO-LINES: a scenario on the highway network with ego v0 of the files
+  printf 'name: %s\nnetwork: %s\n%s\n' "$1" "$net_abs/highway.net.xml" "$2" \
+    >"$sumo/$1.yaml"
+  echo "$sumo/$1.yaml"
+}
+check "sumo:fifo_config" 2 "is a FIFO (named pipe), expected a regular file" \
+  "$dualgrid" run "$(printf 'sumo_config: fifo.sumocfg\nego: {from_routes: v0}\n' >"$sumo/c1.yaml"; echo "$sumo/c1.yaml")" --no-figures -q --out "$work/s1"
+check "sumo:fifo_routes" 2 "fifo.rou.xml: SUMO route file is a FIFO" \
+  "$dualgrid" run "$(sumo_case fifo_routes 'traffic: {route_files: [fifo.rou.xml]}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s2"
+check "sumo:urandom_config" 2 "/dev/urandom: SUMO configuration is a device" \
+  "$dualgrid" run "$(printf 'sumo_config: /dev/urandom\nego: {from_routes: v0}\n' >"$sumo/c3.yaml"; echo "$sumo/c3.yaml")" --no-figures -q --out "$work/s3"
+check "sumo:zero_additional" 2 "/dev/zero: SUMO additional file is a device" \
+  "$dualgrid" run "$(sumo_case zero_additional 'traffic: {route_files: [ok.rou.xml], additional_files: [/dev/zero]}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s4"
+check "sumo:folder_routes" 2 "SUMO route file is a directory" \
+  "$dualgrid" run "$(sumo_case folder_routes 'traffic: {route_files: [folder.rou.xml]}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s5"
+check "sumo:damaged_gzip" 2 "damaged.rou.xml.gz" \
+  "$dualgrid" run "$(sumo_case damaged_gzip 'traffic: {route_files: [damaged.rou.xml.gz]}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s6"
+check "sumo:include_loop" 2 "<include href> nested more than 8 levels deep" \
+  "$dualgrid" run "$(sumo_case include_loop 'traffic: {route_files: [ok.rou.xml], additional_files: [loop.add.xml]}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s7"
+check "sumo:binary_net" 2 "net.bin" \
+  "$dualgrid" run "$(printf 'sumo_config: binary_net.sumocfg\nego: {from_routes: v0}\n' >"$sumo/c8.yaml"; echo "$sumo/c8.yaml")" --no-figures -q --out "$work/s8"
+# The 3 MB comment is read in linear time: the run itself succeeds well within the time limit.
+if out=$(cd "$work" && timeout 60 "$dualgrid" run "$(sumo_case comment 'duration: 1
+traffic: {route_files: [comment.rou.xml]}
+ego: {from_routes: v0}')" --modes dual --no-figures -q --out "$work/s9" 2>&1); then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1))
+  printf 'FAIL sumo:comment: a valid route file with a 3 MB comment did not run: %s\n' "$out"
+fi
+
 # 3. Hostile command lines.
 mkdir -p "$work/existing/x.png"
 n=0

@@ -301,5 +301,32 @@ class ThreadTest(unittest.TestCase):
         self.assertEqual(errors, [])
 
 
+
+class ReframeTest(unittest.TestCase):
+
+    def test_reframe_turns_particles_exactly_and_recentres(self):
+        grid = dualgrid.DynamicGrid(small_params(), seed=3)
+        run(grid, 10)
+        before = grid.particles()
+        a = 0.4
+        c, s = math.cos(a), math.sin(a)
+        grid.reframe(a, (0.0, 0.0))
+        after = grid.particles()
+        np.testing.assert_allclose(after["x"], c * before["x"] + s * before["y"], atol=1e-9)
+        np.testing.assert_allclose(after["y"], -s * before["x"] + c * before["y"], atol=1e-9)
+        np.testing.assert_allclose(after["vx"], c * before["vx"] + s * before["vy"], atol=1e-4)
+        np.testing.assert_array_equal(after["weight"], before["weight"])
+        # The next cycle, in the turned frame, keeps the grid's invariants.
+        grid.update((0.0, 0.0, -a), (0.0, 0.0), None, None, dt=DT)
+        self.assertIsNone(grid.check_invariants())
+
+    def test_reframe_refuses_non_finite_input(self):
+        grid = dualgrid.DynamicGrid(small_params(), seed=3)
+        with self.assertRaisesRegex(ValueError, "angle"):
+            grid.reframe(float("nan"), (0.0, 0.0))
+        with self.assertRaisesRegex(ValueError, "ego_position"):
+            grid.reframe(0.1, (0.0, float("inf")))
+
+
 if __name__ == "__main__":
     unittest.main()

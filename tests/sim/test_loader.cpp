@@ -253,7 +253,8 @@ TEST_CASE("sensors.accuracy and sensors.overrides.all", "[loader][sensors]") {
 
 TEST_CASE("grid frame and placement keys", "[loader][frame]") {
   const auto d = LoadScenario(Write("frame0.yaml", kValid));
-  CHECK(d.grid.frame == scenario::GridPlacement::Frame::kHeading);  // the default
+  CHECK(d.grid.frame == scenario::GridPlacement::Frame::kFollow);  // the default
+  CHECK(d.grid.realign_deg == 5.0);
   CHECK(d.grid.CentreOffset(200.0, 25.0) == Vector2::Zero());       // the ego centred, exactly
   const auto w = LoadScenario(
       Write("frame1.yaml", std::string(kValid) + "filter: {frame: world, ahead: 150, left: 10}\n"));
@@ -262,8 +263,15 @@ TEST_CASE("grid frame and placement keys", "[loader][frame]") {
   CHECK(w.grid.CentreOffset(w.filter.length_x, w.filter.width_y).x() == Approx(50.0));
   CHECK(w.grid.CentreOffset(w.filter.length_x, w.filter.width_y).y() == Approx(-2.5));
   CHECK(ErrorOf(std::string(kValid) + "filter: {frame: diagonal}\n")
-            .find("'filter.frame' expected 'heading' or 'world', got 'diagonal'") !=
+            .find("'filter.frame' expected 'follow', 'heading' or 'world', got 'diagonal'") !=
         std::string::npos);
+  const auto f = LoadScenario(Write("frame4.yaml", std::string(kValid) + "filter: {realign_deg: 2}\n"));
+  CHECK(f.grid.realign_deg == 2.0);
+  CHECK(ErrorOf(std::string(kValid) + "filter: {realign_deg: 0}\n")
+            .find("'filter.realign_deg' expected an angle in (0, 90] deg, got 0") !=
+        std::string::npos);
+  CHECK(ErrorOf(std::string(kValid) + "filter: {frame: heading, realign_deg: 3}\n")
+            .find("'filter.realign_deg' is used only with frame: follow") != std::string::npos);
   CHECK(ErrorOf(std::string(kValid) + "filter: {ahead: 250}\n")
             .find("'filter.ahead' expected a distance in [0, length_x = 200] m, got 250") !=
         std::string::npos);

@@ -112,7 +112,7 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
   const json index = json::parse(Slurp(run / "replay" / "index.json"));
   const std::string bin = Slurp(run / "replay" / "frames.bin");
   CHECK(index["format"] == "dualgrid-replay");
-  CHECK(index["version"] == 1);
+  CHECK(index["version"] == 2);
   CHECK(index["complete"] == true);
   const double interval = index["interval"].get<double>();
   CHECK(interval == Approx(0.1));
@@ -120,7 +120,10 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
   REQUIRE(index["frames"].size() == 40);
   const std::size_t modes = index["modes"].size();
   REQUIRE(modes == 3);
-  const double yaw = index["frame_yaw_deg"].get<double>() * M_PI / 180.0;
+  // Each frame is in its own grid frame; its turn is grid.csv's at that time.
+  std::map<std::string, double> grid_yaw;
+  for (const auto& row : ReadCsv(run / "grid.csv"))
+    grid_yaw[row.at("time")] = std::stod(row.at("yaw_deg"));
 
   // Ground truth: every recorded box is the vehicle's ground_truth.csv row at that time, turned
   // into the grid frame.
@@ -137,6 +140,8 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
     CHECK(f["t"].get<double>() == Approx((i + 1) * interval));
     char stamp[16];
     std::snprintf(stamp, sizeof stamp, "%.3f", f["t"].get<double>());
+    CHECK(f["yaw"].get<double>() == grid_yaw.at(stamp));
+    const double yaw = f["yaw"].get<double>() * M_PI / 180.0;
     for (const json& b : f["truth"]) {
       const std::string name = index["names"][std::to_string(b[0].get<int>())];
       const auto& row = truth.at({stamp, name});
@@ -325,7 +330,7 @@ TEST_CASE("replay: bad input gets one line and exit code 2", "[cli][replay]") {
   index["version"] = 99;
   std::ofstream(d / "copy" / "replay" / "index.json") << index.dump();
   one_line_2(Run("replay " + (d / "copy").string()), "'version'");
-  index["version"] = 1;
+  index["version"] = 2;
   std::ofstream(d / "copy" / "replay" / "index.json") << index.dump();
   json bad = index;
   bad["cells_x"] = "400";

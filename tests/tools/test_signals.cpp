@@ -164,7 +164,8 @@ TEST_CASE("A run killed in a folder of an earlier finished run does not look fin
   CHECK_FALSE(fs::exists(dir / "summary.json"));
 }
 
-TEST_CASE("A run shorter than asked says so and is not complete", "[cli][signals]") {
+TEST_CASE("A run whose ego leaves the network ends there, complete, and says so",
+          "[cli][signals]") {
   const auto dir = TempDir("short");
   // The route ends about 450 m ahead of the ego, which drives 27.78 m/s: SUMO ends near 16 s.
   std::ofstream(dir / "short.yaml")
@@ -176,9 +177,14 @@ TEST_CASE("A run shorter than asked says so and is not complete", "[cli][signals
                           dir / "log.txt");
   CHECK(ExitCode(pid) == 0);
   const std::string log = Slurp(dir / "log.txt");
-  CHECK(log.find("dualgrid: Shorter run than asked: SUMO ended at t = ") != std::string::npos);
+  CHECK(log.find("dualgrid: Shorter run than asked: the ego 'ego' left the network at t = ") !=
+        std::string::npos);
+  CHECK(CountLines(log) == 1);
+  // The scenario ended with its ego: the run is complete, and summary.json says how it ended.
   const auto summary = nlohmann::json::parse(Slurp(dir / "out" / "summary.json"));
-  CHECK(summary.at("complete") == false);
+  CHECK(summary.at("complete") == true);
+  CHECK(summary.at("end") == "ego_left");
+  CHECK(summary.at("ended_s").get<double>() < 18.0);
   CHECK(summary.at("simulated_s").get<double>() < 18.0);
   CHECK(Slurp(dir / "out" / "table.md").find("**Shorter run than asked") != std::string::npos);
 }

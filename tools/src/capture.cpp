@@ -85,14 +85,12 @@ Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string
   h.particle_unit = ParticleUnit(h.cells_x * h.resolution, h.cells_y * h.resolution);
   h.max_particles = max_particles;
   h.dynamic_threshold = c.evaluation.dynamic_threshold;
+  // The static world in the world frame: each frame turns it into its own grid frame.
   for (std::size_t i = 0; i < c.sim.parked.size(); ++i)
-    h.parked.push_back(ToBox(-1, g.ToGrid(c.sim.parked[i].box), Velocity::Zero()));
+    h.parked.push_back(ToBox(-1, c.sim.parked[i].box, Velocity::Zero()));
   for (const auto& rail : c.sim.guard_rails) {
     h.rails.emplace_back();
-    for (const Position& p : rail.points) {
-      const Position q = g.ToGrid(p);
-      h.rails.back().push_back({q.x(), q.y()});
-    }
+    for (const Position& p : rail.points) h.rails.back().push_back({p.x(), p.y()});
   }
   return h;
 }
@@ -105,6 +103,7 @@ Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnap
   const sim::Frame& sf = pipeline.frame();
   Frame f;
   f.time = sf.time;
+  f.yaw_deg = RadToDeg(g.yaw());
   f.ego = ToBox(-1, g.ToGrid(sf.ego.box), g.VectorToGrid(sf.ego.velocity));
   f.origin_x = snapshots[0].origin.x();
   f.origin_y = snapshots[0].origin.y();

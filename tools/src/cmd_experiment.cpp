@@ -152,10 +152,15 @@ int RunExperiment(const ExperimentOptions& o) {
   std::vector<eval::ModeRuns> runs;
   for (const auto& m : o.run.modes) runs.push_back({m, {}});
   double wall = 0.0;
+  std::vector<std::string> ended_early;  // seeds whose ego left the network before the duration
   for (const std::uint64_t seed : finished) {
     const auto dir = seed_dir(seed);
     nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "metrics.json"));
-    wall += nlohmann::json::parse(std::ifstream(dir / "summary.json")).value("wall_s", 0.0);
+    const nlohmann::json run_summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
+    wall += run_summary.value("wall_s", 0.0);
+    if (run_summary.value("end", "") == "ego_left")
+      ended_early.push_back("seed " + std::to_string(seed) +
+                            " at t = " + FormatFixed(run_summary.value("ended_s", 0.0), 2) + " s");
     for (auto& r : runs) {
       eval::ScenarioMetrics m = j.at("modes").at(r.mode).get<eval::ScenarioMetrics>();
       for (auto& obj : m.objects)
@@ -168,6 +173,14 @@ int RunExperiment(const ExperimentOptions& o) {
   table.SetStatus(stop_status);
   for (const auto& [seed, why] : failed)
     table.AddNote("Seed " + std::to_string(seed) + " failed and is not in the table: " + why);
+  if (!ended_early.empty()) {
+    std::string list;
+    for (const std::string& e : ended_early) list += (list.empty() ? "" : ", ") + e;
+    table.AddNote(
+        "The ego left the network before the duration (its route ended; the run's "
+        "results cover its time in the network): " +
+        list);
+  }
   WriteTables(table, out);
 
   // Per-object tracked share over seeds (paper Fig. 6), D and D_v.

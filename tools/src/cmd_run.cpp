@@ -83,6 +83,7 @@ int RunFilters(const FilterRunOptions& options) {
 
   const auto wall_start = std::chrono::steady_clock::now();
   cosim.Start(options.run.network_dir, out);
+  NoteAutoEgo(cosim.pipeline(), options.run.quiet);
   std::vector<std::string> warnings;  // figures and recordings that could not be written
   // Weight traces (paper Fig. 4) of the dual filter, or of the last mode if dual is not run.
   const auto dual = std::find(modes.begin(), modes.end(), filter::WeightMode::kDual);
@@ -107,19 +108,14 @@ int RunFilters(const FilterRunOptions& options) {
   while (!StopSignal() && cosim.Step())
     progress.Update(cosim.steps(), "t=" + FormatFixed(cosim.pipeline().frame().time, 1) + " s");
   progress.Finish();
+  cosim.Finish();
   const int stop = StopSignal();
   const int steps = cosim.steps();
   const double simulated = cosim.simulated();
-  const bool complete = !stop && cosim.finished();
   const cosim::IdRegistry& ids = cosim.pipeline().ids();
   std::string status;
-  if (stop)
-    status = "Incomplete run: stopped by signal " + std::to_string(stop) +
-             " at t = " + FormatFixed(simulated, 2) + " s of " +
-             FormatFixed(config.sim.duration, 2) + " s";
-  else if (!complete)
-    status = "Shorter run than asked: SUMO ended at t = " + FormatFixed(simulated, 2) + " s of " +
-             FormatFixed(config.sim.duration, 2) + " s (the ego left the network; see sumo.log)";
+  const nlohmann::json end = EndRecord(cosim, stop, &status);
+  const bool complete = end.at("complete");
   files.Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -198,22 +194,24 @@ int RunFilters(const FilterRunOptions& options) {
   }
 
   // Written last: a run folder without summary.json did not finish.
-  nlohmann::json summary = {{"complete", complete},
-                            {"status", status},
-                            {"scenario", config.sim.name},
-                            {"seed", config.sim.seed},
-                            {"steps", steps},
-                            {"simulated_s", simulated},
-                            {"requested_s", config.sim.duration},
-                            {"wall_s", wall},
-                            {"warnings", warnings}};
+  nlohmann::json summary = end;
+  summary.update(nlohmann::json{{"status", status},
+                                {"scenario", config.sim.name},
+                                {"seed", config.sim.seed},
+                                {"steps", steps},
+                                {"simulated_s", simulated},
+                                {"requested_s", config.sim.duration},
+                                {"wall_s", wall},
+                                {"warnings", warnings}});
   if (invariants) {
     summary["invariants_checked_steps"] = steps;
     summary["rss_mb"] = invariants->Samples(simulated);
   }
   // The grid frame as resolved at the ego's departure (docs/algorithm.md, "Grid frame").
+  // The grid frame at the end, and how often it turned (grid.csv: every step's).
   summary["grid_frame"] = {{"frame", scenario::ToString(config.grid.frame)},
-                           {"yaw_deg", RadToDeg(cosim.pipeline().grid_frame().yaw())}};
+                           {"yaw_deg", RadToDeg(cosim.pipeline().grid_frame().yaw())},
+                           {"realignments", cosim.pipeline().grid_realignments()}};
   // The radars as mounted on the ego's box as SUMO simulated it (config.json holds the rig as
   // read, on the scenario type's box: they differ for an ego of the user's route files).
   summary["sensors_mounted"] = nlohmann::json::array();

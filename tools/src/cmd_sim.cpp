@@ -29,6 +29,7 @@ int RunSim(const SimOptions& sim_options) {
   const auto wall_start = std::chrono::steady_clock::now();
   cosim.Start(options.network_dir, options.out);
   const cosim::Pipeline& pipeline = cosim.pipeline();
+  NoteAutoEgo(pipeline, options.quiet);
   GroundTruthWriter truth(options.out / "ground_truth.csv");
   std::unique_ptr<DetectionWriter> detections;
   if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path);
@@ -58,14 +59,16 @@ int RunSim(const SimOptions& sim_options) {
     progress.Update(steps, "t=" + FormatFixed(f.time, 1) + " s, " +
                                std::to_string(f.vehicles.size()) + " vehicles");
   }
+  cosim.Finish();
   progress.Finish();
   truth.Close();
   if (detections) detections->Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
-  nlohmann::json summary;
-  summary["complete"] = !StopSignal() && steps == spec.StepCount();
+  std::string status;
+  nlohmann::json summary = EndRecord(cosim, StopSignal(), &status);
+  summary["status"] = status;
   summary["scenario"] = spec.name;
   summary["seed"] = spec.seed;
   summary["steps"] = steps;
@@ -91,10 +94,7 @@ int RunSim(const SimOptions& sim_options) {
               << " s; the simulated part is in " << options.out.string() << "\n";
     return StopExitCode();
   }
-  if (steps != spec.StepCount())
-    std::cerr << "dualgrid: shorter run than asked: SUMO ended at t = "
-              << FormatFixed(steps * spec.step_length, 2) << " s of "
-              << FormatFixed(spec.duration, 2) << " s (the ego left the network; see sumo.log)\n";
+  if (!status.empty()) std::cerr << "dualgrid: " << status << "\n";
   if (!options.quiet) {
     std::cout << spec.name << ": " << steps << " steps ("
               << FormatFixed(steps * spec.step_length, 1) << " s simulated in "

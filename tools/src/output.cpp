@@ -121,8 +121,18 @@ TempDir::~TempDir() {
 
 nlohmann::json OutputDigests(const std::filesystem::path& dir) {
   std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
-    if (e.is_regular_file()) files.push_back(e.path());
+  for (auto it = std::filesystem::recursive_directory_iterator(dir);
+       it != std::filesystem::recursive_directory_iterator(); ++it) {
+    // SUMO's own outputs (dated, and naming paths) and the additional files' copies (naming the
+    // run folder) are SUMO's business, not dualgrid's results.
+    const std::string name = it->path().filename().string();
+    if (it.depth() == 0 && it->is_directory() &&
+        (name == "sumo_outputs" || name == "sumo_additional")) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_regular_file()) files.push_back(it->path());
+  }
   std::sort(files.begin(), files.end());
   nlohmann::json digests = nlohmann::json::object();
   std::vector<char> buf(1 << 16);
@@ -220,6 +230,21 @@ void GroundTruthWriter::Write(const sim::Frame& f) {
   out_.MaybeFlush();
 }
 
+GridPoseWriter::GridPoseWriter(const std::filesystem::path& path) : out_(path) {
+  out_.buffer() += "step,time,x,y,yaw_deg,length,width,realigned\n";
+}
+
+void GridPoseWriter::Write(const cosim::Pipeline& p) {
+  const OrientedBox g = p.GridFootprint();
+  const sim::Frame& f = p.frame();
+  out_.buffer() += std::to_string(f.step) + ',' + FormatFixed(f.time, 3) + ',' +
+                   FormatFixed(g.center.x(), 4) + ',' + FormatFixed(g.center.y(), 4) + ',' +
+                   FormatSignificant(RadToDeg(g.yaw), 10) + ',' + FormatSignificant(g.length, 10) +
+                   ',' + FormatSignificant(g.width, 10) + ',' + (p.grid_realigned() ? "1" : "0") +
+                   '\n';
+  out_.MaybeFlush();
+}
+
 DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(path) {
   out_.buffer() +=
       "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
@@ -258,6 +283,51 @@ void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& 
     out << p.id << ",parked,0," << p.box.center.x() << ',' << p.box.center.y() << ',' << p.box.yaw
         << ',' << p.box.length << ',' << p.box.width << '\n';
   WriteTextFile(path, out.str());
+}
+
+void NoteAutoEgo(const cosim::Pipeline& pipeline, bool quiet) {
+  const sim::ScenarioSpec& spec = pipeline.config().sim;
+  if (quiet || !spec.ego_from_routes || spec.ego.id != sim::kAutoEgo) return;
+  std::cerr << "dualgrid: ego: auto chose '" << pipeline.simulation().ego_id()
+            << "' (the road vehicle of the route files longest in the run; docs/scenarios.md)\n";
+}
+
+nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status) {
+  const sim::ScenarioSpec& spec = cs.config().sim;
+  const bool started = cs.pipeline().started() && cs.steps() > 0;
+  const sim::SumoSimulation* sumo = started ? &cs.pipeline().simulation() : nullptr;
+  const double last = started ? cs.pipeline().frame().time : 0.0;
+  const double first = started ? last - (cs.steps() - 1) * spec.step_length : 0.0;
+  // The ego leaving the network ends the scenario: the run is complete, `end` says how it ended.
+  const bool ended = cs.finished() || (sumo && sumo->ego_left());
+  nlohmann::json r = {{"complete", !stop_signal && ended},
+                      {"ego", sumo ? sumo->ego_id() : spec.ego.id},
+                      {"ego_departed_s", first},
+                      {"ended_s", last}};
+  // Where SUMO wrote the outputs that the user's additional files declare.
+  r["sumo_outputs"] = nlohmann::json::array();
+  if (sumo)
+    for (const sim::RedirectedOutput& o : sumo->redirected_outputs())
+      r["sumo_outputs"].push_back({{"file", o.file},
+                                   {"element", o.element},
+                                   {"attribute", o.attribute},
+                                   {"original", o.original},
+                                   {"path", o.path}});
+  status->clear();
+  if (stop_signal) {
+    r["end"] = "signal";
+    *status = "Incomplete run: stopped by signal " + std::to_string(stop_signal) +
+              " at t = " + FormatFixed(last, 2) + " s of " + FormatFixed(spec.duration, 2) + " s";
+  } else if (sumo && sumo->ego_left()) {
+    r["end"] = "ego_left";
+    *status = "Shorter run than asked: the ego '" + sumo->ego_id() +
+              "' left the network at t = " + FormatFixed(last, 2) + " s of " +
+              FormatFixed(spec.duration, 2) +
+              " s (its route ended there); the results cover its time in the network";
+  } else {
+    r["end"] = "duration";
+  }
+  return r;
 }
 
 }  // namespace dualgrid::tools

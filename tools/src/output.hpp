@@ -10,7 +10,7 @@
 
 #include "commands.hpp"
 #include "dualgrid/core/text.hpp"
-#include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/cosim/cosimulation.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
 
@@ -56,6 +56,17 @@ class GroundTruthWriter {
  public:
   explicit GroundTruthWriter(const std::filesystem::path& path);
   void Write(const sim::Frame& frame);
+  void Close() { out_.Close(); }
+
+ private:
+  OutputFile out_;
+};
+
+/// grid.csv: where the grid lay, one row per step (world frame).
+class GridPoseWriter {
+ public:
+  explicit GridPoseWriter(const std::filesystem::path& path);
+  void Write(const cosim::Pipeline& pipeline);
   void Close() { out_.Close(); }
 
  private:
@@ -118,6 +129,19 @@ bool FaultInjected(const std::string& what);
 /// scenario and the seed alone (wall-clock times live only in summary.json), so equal digests
 /// mean equal outputs, whatever the thread count.
 nlohmann::json OutputDigests(const std::filesystem::path& dir);
+
+/// After Start(): names on stderr the vehicle that `ego: {from_routes: auto}` chose (nothing
+/// when `quiet` or the ego was named).
+void NoteAutoEgo(const cosim::Pipeline& pipeline, bool quiet);
+
+/// How a co-simulation ended, for summary.json and the one-line note: `complete` (no signal came
+/// and SUMO reached the duration or the ego left the network: the scenario's own end), `end`
+/// ("duration", "ego_left", "signal"), `ego` (its id: the scenario's, or the one `auto` chose),
+/// `ego_departed_s` and `ended_s` (SUMO's time at the first and last frame [s]), `sumo_outputs`
+/// (the outputs the additional files declare: file, element, attribute, original value, path
+/// written). `status` receives the note ("" for a run that reached the duration): why it ended
+/// otherwise, in one line.
+nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status);
 
 /// Writes a whole text file, checked: throws std::runtime_error naming the file and the reason.
 void WriteTextFile(const std::filesystem::path& path, const std::string& text);

@@ -122,6 +122,7 @@ void Writer::Add(const Frame& f) {
   if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
 
   json j = {{"t", R(f.time * 10.0) / 10.0},
+            {"yaw", f.yaw_deg},  // exact: positions far from the origin turn with it
             {"ego", BoxJson(f.ego)},
             {"origin", {R(f.origin_x), R(f.origin_y)}}};
   j["truth"] = json::array();
@@ -254,8 +255,11 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const std::string key = "frames[" + std::to_string(i) + "]";
     const json& f = frames[i];
-    double t = 0.0;
+    double t = 0.0, yaw = 0.0;
     get(f, "t", &t, "a time [s] (in " + key + ")");
+    get(f, "yaw", &yaw, "the grid frame's turn [deg] (in " + key + ")");
+    if (!std::isfinite(t) || !std::isfinite(yaw))
+      throw std::invalid_argument(where + ": key '" + key + "': expected a finite 't' and 'yaw'");
     times_.push_back(t);
     const json blob = f.value("blob", json());
     if (!blob.is_array() || blob.size() != 2 || !blob[0].is_number_unsigned() ||
@@ -310,6 +314,7 @@ Frame Reader::LoadFrame(std::size_t i) const {
   const std::size_t n = static_cast<std::size_t>(h.cells_x) * h.cells_y;
   Frame f;
   f.time = j.at("t").get<double>();
+  f.yaw_deg = j.at("yaw").get<double>();
   f.ego = BoxFrom(j.at("ego"));
   f.origin_x = j.at("origin").at(0).get<double>();
   f.origin_y = j.at("origin").at(1).get<double>();

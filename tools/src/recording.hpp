@@ -21,7 +21,7 @@
 namespace dualgrid::tools::replay {
 
 /// Current format version; the reader refuses others with a clear error.
-inline constexpr int kFormatVersion = 1;
+inline constexpr int kFormatVersion = 2;
 
 /// A box in the grid frame: centre [m], heading [rad], size [m], velocity over ground [m/s].
 struct Box {
@@ -65,7 +65,10 @@ struct ModeFrame {
 };
 
 struct Frame {
-  double time = 0.0;                      ///< [s]
+  double time = 0.0;  ///< [s]
+  /// The grid frame's turn from the world's at this frame [deg]: every position and velocity of
+  /// the frame is in that grid frame (the grid that follows the road turns during a run).
+  double yaw_deg = 0.0;
   Box ego;                                ///< the ego's box and velocity
   double origin_x = 0.0, origin_y = 0.0;  ///< lower-left corner of cell (0, 0) [m]
   std::vector<Box> truth;                 ///< other vehicles (ids as in objects.csv)
@@ -80,13 +83,13 @@ struct Header {
   std::vector<std::string> sensors;  ///< radar names, index = Detection::sensor
   int cells_x = 0, cells_y = 0;
   double resolution = 0.0;      ///< cell edge [m]
-  double frame_yaw_deg = 0.0;   ///< grid frame's turn from the world's [deg]
+  double frame_yaw_deg = 0.0;   ///< grid frame's turn from the world's at the start [deg]
   double interval = 0.1;        ///< time between recorded frames [s]
   double particle_unit = 0.01;  ///< [m] per particle coordinate step
   int max_particles = 0;        ///< per mode and frame
   double dynamic_threshold = 0.6;
-  std::vector<Box> parked;                                ///< static boxes, grid frame
-  std::vector<std::vector<std::array<double, 2>>> rails;  ///< guard-rail polylines, grid frame
+  std::vector<Box> parked;                                ///< static boxes, world frame
+  std::vector<std::vector<std::array<double, 2>>> rails;  ///< guard-rail polylines, world frame
   nlohmann::json names;                                   ///< object id (as text) -> vehicle name
   nlohmann::json metrics;  ///< the run's metrics.json per mode, once finished
   bool complete = false;

@@ -22,6 +22,7 @@ RunFilesObserver::RunFilesObserver(const std::filesystem::path& out,
                                    const std::optional<std::filesystem::path>& detections,
                                    std::size_t trace_mode, const std::string& focus)
     : truth_(out / "ground_truth.csv"),
+      grid_(out / "grid.csv"),
       clusters_(out / "clusters.csv"),
       trace_mode_(trace_mode),
       traces_(focus) {
@@ -30,6 +31,7 @@ RunFilesObserver::RunFilesObserver(const std::filesystem::path& out,
 
 void RunFilesObserver::OnStep(const cosim::StepView& v) {
   truth_.Write(v.frame);
+  grid_.Write(v.pipeline);
   if (detections_) detections_->Write(v.pipeline);
   for (std::size_t m = 0; m < v.scorers.size(); ++m)
     clusters_.Write(v.frame, v.pipeline.grid_frame(), v.mode_names[m], v.scorers[m], v.objects,
@@ -39,6 +41,7 @@ void RunFilesObserver::OnStep(const cosim::StepView& v) {
 
 void RunFilesObserver::Close() {
   truth_.Close();
+  grid_.Close();
   if (detections_) detections_->Close();
   clusters_.Close();
 }

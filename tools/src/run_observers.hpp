@@ -20,7 +20,8 @@
 
 namespace dualgrid::tools {
 
-/// ground_truth.csv, detections (optional), clusters.csv, and the weight traces of one mode.
+/// ground_truth.csv, grid.csv, detections (optional), clusters.csv, and the weight traces of one
+/// mode.
 class RunFilesObserver : public cosim::StepObserver {
  public:
   /// `detections`: the file for --detections, none if empty. `trace_mode`: the mode whose
@@ -35,6 +36,7 @@ class RunFilesObserver : public cosim::StepObserver {
 
  private:
   GroundTruthWriter truth_;
+  GridPoseWriter grid_;
   std::unique_ptr<DetectionWriter> detections_;
   ClusterWriter clusters_;
   std::size_t trace_mode_;

@@ -9,6 +9,9 @@
 // scenarios whose grid frame is the world frame give exactly the results of a world-fixed grid.
 #pragma once
 
+#include <cmath>
+#include <optional>
+
 #include "dualgrid/core/types.hpp"
 
 namespace dualgrid {
@@ -52,5 +55,25 @@ class GridFrame {
   double yaw_ = 0.0;
   double c_ = 1.0, s_ = 0.0;
 };
+
+/// A grid yaw [rad] along `heading` [rad]: the heading itself, except that a heading within
+/// 1e-3 deg of a whole degree is that whole degree. SUMO's headings of roads along a world axis
+/// carry ~1e-6 deg of rounding (an eastbound lane reads 89.99999... deg): snapped, such roads get
+/// exactly axis-aligned grids (GridFrame's identity at 0, bit for bit), while every other road
+/// gets a grid exactly along it, whatever the network's own orientation.
+inline double GridYawAlong(double heading) {
+  const double deg = RadToDeg(heading), whole = std::round(deg);
+  const double yaw = std::abs(deg - whole) < 1e-3 ? DegToRad(whole) : heading;
+  return WrapAngle(yaw) == 0.0 ? 0.0 : yaw;
+}
+
+/// The grid that follows the ego (docs/algorithm.md, "Grid frame"): the yaw [rad] to turn the
+/// grid to, GridYawAlong(heading), once `heading` [rad] has drifted from `grid_yaw` [rad] by more
+/// than `threshold` [rad] (> 0); std::nullopt while it has not. Depends on the angle between the
+/// two only (up to the snap), so a scene turned as a whole turns its grid at the same moments.
+inline std::optional<double> RealignedYaw(double grid_yaw, double heading, double threshold) {
+  if (!(std::abs(WrapAngle(heading - grid_yaw)) > threshold)) return std::nullopt;
+  return GridYawAlong(heading);
+}
 
 }  // namespace dualgrid

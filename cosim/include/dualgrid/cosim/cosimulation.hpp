@@ -71,6 +71,9 @@ class CoSimulation {
   /// One step: SUMO, radar, every mode's filter cycle, the shared ground truth and every mode's
   /// scoring, then the observers. False at the end of the run (nothing done then).
   bool Step();
+  /// Ends the run: SUMO closes and writes its own outputs (Pipeline::Finish). Results, the last
+  /// frame and the end state stay readable; Step() must not be called again.
+  void Finish() { pipeline_.Finish(); }
 
   const Pipeline& pipeline() const { return pipeline_; }
   const scenario::ScenarioConfig& config() const { return pipeline_.config(); }
@@ -80,8 +83,10 @@ class CoSimulation {
   int steps() const { return steps_; }
   /// Simulated time of the steps done [s].
   double simulated() const { return steps_ * config().sim.step_length; }
-  /// All steps of the scenario's duration were done.
-  bool finished() const { return steps_ == config().sim.StepCount(); }
+  /// SUMO reached the scenario's duration with the ego in the network (its frames start at the
+  /// ego's departure, so a late departure still finishes). False while running, and when the
+  /// ego left the network early (pipeline().simulation().ego_left()).
+  bool finished() const;
   std::size_t total_detections() const { return total_detections_; }
   /// Per mode, the paper's metrics over the steps done so far.
   std::vector<eval::ScenarioMetrics> Metrics() const;

@@ -55,6 +55,9 @@ class Pipeline {
   /// SUMO error. Call once.
   void Start(const std::filesystem::path& network_dir, const std::filesystem::path& work_dir);
   bool started() const { return simulation_ != nullptr; }
+  /// Ends SUMO (sim::SumoSimulation::Close: its outputs are written); everything read from the
+  /// last step stays readable, Advance() must not be called again. No-op before Start().
+  void Finish();
 
   /// Advances SUMO one step, scans the due radars and prepares the filters' inputs. False at the
   /// end (the duration reached, or the ego left the network). Needs Start().
@@ -84,9 +87,18 @@ class Pipeline {
   IdRegistry& ids() { return ids_; }
   const IdRegistry& ids() const { return ids_; }
 
-  /// The grid frame (docs/algorithm.md, "Grid frame"): fixed at the first Advance() from the
-  /// scenario's `filter.frame` and the ego's heading then; identity before.
+  /// The grid frame (docs/algorithm.md, "Grid frame") of the last Advance(): set at the first
+  /// from the scenario's `filter.frame` and the ego's heading then; with `frame: follow` turned
+  /// again whenever the ego's lane has turned by `filter.realign_deg`. Identity before.
   const GridFrame& grid_frame() const { return grid_frame_; }
+  /// The grid frame turned in the last Advance() (the filters turn with it in UpdateFilter).
+  bool grid_realigned() const { return realign_angle_ != 0.0; }
+  /// Turns of the grid frame so far.
+  int grid_realignments() const { return realignments_; }
+  /// The grid's footprint in the world after the last step's filter cycles: centre [m], yaw (the
+  /// grid frame's) [rad], length_x and width_y [m]. With filters, the lattice the first filter
+  /// actually covers (it moves by whole cells); without, where it would lie. Needs one Advance().
+  OrientedBox GridFootprint() const;
 
   /// Ground-truth vehicles (ego excluded) as evaluation objects for a grid, in the grid frame
   /// (boxes and velocities: the clusters' frame): in_grid when the centre lies in the grid,
@@ -114,6 +126,8 @@ class Pipeline {
   double last_time_ = 0.0;
   double dt_ = 0.0;  // of the last Advance() [s]
   GridFrame grid_frame_;
+  double realign_angle_ = 0.0;  // the grid frame's turn in the last Advance() [rad]
+  int realignments_ = 0;
   Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
 };
 

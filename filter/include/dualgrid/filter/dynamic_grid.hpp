@@ -75,6 +75,18 @@ class DynamicGrid {
   void Update(const EgoInput& ego, std::span<const Measurement> measurements,
               std::span<const SensorCoverage> coverage, double dt);
 
+  /// Turns the caller's frame by `angle` [rad] (counter-clockwise) about its origin, between two
+  /// cycles: the caller's next inputs come in the turned frame (the grid that follows the ego's
+  /// heading, docs/algorithm.md "Grid frame"). Every particle's position and velocity are mapped
+  /// exactly to the new frame (p -> R(-angle) p); the grid is re-centred on `ego` (new frame, as
+  /// the next Update's EgoInput will give it) and each new cell takes the free, static and
+  /// dynamic masses of the old cell under its centre (nearest cell: no mass is blurred, a cell
+  /// moves by at most half a cell diagonal); new cells outside the old grid are unknown. Until the
+  /// next Update, weighted_particles() and Cell()'s velocity moments still refer to the old frame.
+  /// No-op before the first Update or for angle == 0. O(particles + cells); its scratch layers
+  /// are allocated at the first call. Throws std::invalid_argument for a non-finite input.
+  void Reframe(double angle, const Position& ego);
+
   int cells_x() const { return nx_; }
   int cells_y() const { return ny_; }
   double resolution() const { return params_.resolution; }
@@ -127,6 +139,8 @@ class DynamicGrid {
   std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
   void Initialize(const EgoInput& ego);
   void ShiftTo(const Position& ego);
+  // Global index of logical cell (0, 0) for a grid centred on `ego`.
+  std::array<std::int64_t, 2> OriginFor(const Position& ego) const;
   void ResetColumn(std::int64_t gx);
   void ResetRow(std::int64_t gy);
   // Prediction (PredictParticles) fused with the counting sort's first pass.
@@ -184,6 +198,7 @@ class DynamicGrid {
   std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
   std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
+  std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {

@@ -63,9 +63,13 @@ struct EvaluationConfig {
 struct GridPlacement {
   enum class Frame {
     kWorld,    ///< grid axes along the world's x and y
-    kHeading,  ///< turned to the ego's heading when it enters, rounded to whole degrees; fixed
+    kHeading,  ///< turned to the ego's heading when it enters (GridYawAlong); fixed
+    kFollow,   ///< as kHeading, then turned again whenever the road has turned by realign_deg
   };
-  Frame frame = Frame::kHeading;
+  Frame frame = Frame::kFollow;
+  /// kFollow: the drift [deg] of the ego's lane direction from the grid's x axis that turns the
+  /// grid (RealignedYaw, core/grid_frame.hpp); in (0, 90].
+  double realign_deg = 5.0;
   /// Distance [m] from the ego to the grid's front edge (+x of the grid frame) and to its left
   /// edge (+y); NaN: half the extent (the ego centred). 0 <= ahead <= length_x,
   /// 0 <= left <= width_y.

@@ -17,6 +17,9 @@ struct VehicleState {
   double speed = 0.0;                    ///< [m/s] SUMO's longitudinal speed
   double lateral_speed = 0.0;            ///< [m/s] SUMO's lateral speed (lane changes), + left
   std::string lane;                      ///< SUMO lane id
+  /// Direction of its lane at the box centre [rad]: the road's direction, without the tilt of
+  /// the vehicle's heading during a lane change (the box's yaw when the lane has no shape).
+  double lane_yaw = 0.0;
   double rcs_dbsm = 10.0;
 };
 

@@ -83,6 +83,10 @@ struct ParkedBox {
   double rcs_dbsm = 10.0;
 };
 
+/// `ego: {from_routes: auto}`: the ego is chosen from the route files' vehicles by a dry run of
+/// SUMO (sumo_simulation.hpp, ChooseAutoEgo).
+inline constexpr const char* kAutoEgo = "auto";
+
 struct ScenarioSpec {
   std::string file;  ///< the scenario file it came from, named in error messages ("" if none)
   std::string name;
@@ -107,8 +111,14 @@ struct ScenarioSpec {
   /// (`traffic.route_files`, or the route-files of `sumo_config`). Their vehicles are scored like
   /// the others: box from their vType's length and width, RCS from `type_rcs` or VClassRcs.
   std::vector<std::string> route_files;
-  /// True: the ego is the vehicle `ego.id` of route_files (`ego: {from_routes: ID}`), not one
-  /// the scenario places.
+  /// SUMO additional files (absolute paths): vTypes, traffic-light programs, stops, rerouters,
+  /// polygons, ... loaded by SUMO as they are, before the route files (`traffic.additional_files`,
+  /// or the additional-files of `sumo_config`); the outputs they declare are written inside the
+  /// run folder (sumo_additional.hpp).
+  std::vector<std::string> additional_files;
+  /// True: the ego is the vehicle `ego.id` of route_files or additional_files
+  /// (`ego: {from_routes: ID}`), not one
+  /// the scenario places. ID kAutoEgo ("auto"): SumoSimulation chooses it (ChooseAutoEgo).
   bool ego_from_routes = false;
   /// Radar cross-section [dBsm] per vType id of route_files (`traffic.rcs_dbsm`).
   std::map<std::string, double> type_rcs;

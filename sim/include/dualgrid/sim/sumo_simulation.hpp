@@ -13,6 +13,7 @@
 
 #include "dualgrid/sim/ground_truth.hpp"
 #include "dualgrid/sim/scenario.hpp"
+#include "dualgrid/sim/sumo_additional.hpp"
 
 namespace dualgrid::sim {
 
@@ -33,6 +34,10 @@ NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {});
 /// FindNetworkDir().dir.
 std::filesystem::path DefaultNetworkDir();
 
+/// True when a scenario's `network` is a file path (it ends in .xml or .xml.gz, or has a '/'),
+/// false for the name of a built network ("highway").
+bool IsNetworkPath(const std::string& network);
+
 /// Resolves a scenario's network to an existing .net.xml file: a name ("highway") is looked up
 /// in `network_dir`; a path ending in .xml is taken as it is (the scenario loader has already
 /// made a relative path relative to the scenario file). Throws std::invalid_argument naming the
@@ -45,8 +50,11 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
 
 class SumoSimulation {
  public:
-  /// Starts SUMO. `work_dir` receives the generated route file and SUMO's message log.
-  /// Throws std::runtime_error with a one-line message on any SUMO error.
+  /// Starts SUMO. `work_dir` receives the generated route file, SUMO's message log, the copies of
+  /// additional files that declare outputs (sumo_additional/) and those outputs (sumo_outputs/).
+  /// With `ego: {from_routes: auto}` a first run of SUMO over the duration chooses the ego
+  /// (docs/scenarios.md). Throws std::invalid_argument with a one-line message for input SUMO
+  /// refuses, std::runtime_error when a file cannot be written.
   SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                  const std::filesystem::path& work_dir);
   ~SumoSimulation();
@@ -56,9 +64,20 @@ class SumoSimulation {
   /// Advances one step (spec.step_length) and refreshes frame(). Returns false once the scenario
   /// duration is reached or the ego has left the network.
   bool Step();
+  /// Ends SUMO, which then writes out the outputs of the additional files; frame(), ego_id()
+  /// and the end state stay readable. Step() must not be called afterwards. Idempotent.
+  void Close();
   /// Ground truth after the last Step().
   const Frame& frame() const { return frame_; }
+  /// The ego's id: the scenario's, or the one `auto` chose (ChooseAutoEgo, docs/scenarios.md).
+  const std::string& ego_id() const { return spec_.ego.id; }
+  /// Why Step() returned false: the ego left the network (its route ended) before the duration.
+  bool ego_left() const { return ego_left_; }
+  /// SUMO reached the scenario's duration (the run's frames start at the ego's departure).
+  bool reached_end() const { return step_ >= spec_.StepCount(); }
   const ScenarioSpec& spec() const { return spec_; }
+  /// Outputs declared by the additional files, as written inside the run folder.
+  const std::vector<RedirectedOutput>& redirected_outputs() const { return redirected_outputs_; }
   /// A lane's centre line (world frame) and width, for pictures.
   struct LaneShape {
     std::string id;
@@ -88,6 +107,9 @@ class SumoSimulation {
   std::filesystem::path log_path_;  ///< SUMO's message log, named in errors
   Frame frame_;
   int step_ = 0;
+  bool ego_left_ = false;
+  bool closed_ = false;
+  std::vector<RedirectedOutput> redirected_outputs_;
   std::size_t next_action_ = 0;
   std::map<std::string, LaneGeometry> lanes_;
   std::map<std::string, double> previous_yaw_;
