@@ -110,6 +110,29 @@ def experiment_table(out, scenario):
                   f"{fmt(summary(b), scale, digits)} | {fmt(summary(d), scale, digits)} |")
 
 
+def loss_table(out, scenario):
+    """The scenario with multipath on at other rail losses (multipath_on_lossN), beside off."""
+    base = os.path.join(out, scenario)
+    runs = [("off", seed_metrics(os.path.join(base, "multipath_off")))]
+    for name, label in (("multipath_on_loss0", "0 dB"), ("multipath_on", "6 dB (default)"),
+                        ("multipath_on_loss12", "12 dB")):
+        m = seed_metrics(os.path.join(base, name))
+        if m:
+            runs.append((label, m))
+    if len(runs) < 3:
+        return
+    print(f"\n#### {scenario}: rail loss per bounce (multipath on; mean ± 95 % CI over seeds)\n")
+    print("| metric | mode | " + " | ".join(label for label, _ in runs) + " |")
+    print("|---|---|" + "---:|" * len(runs))
+    for label, metric, scale, digits in METRICS:
+        for mode in MODES:
+            cells = []
+            for _, run in runs:
+                xs = [v for v in (value(run[s], mode, metric) for s in sorted(run)) if v is not None]
+                cells.append(fmt(summary(xs), scale, digits))
+            print(f"| {label} | {mode} | " + " | ".join(cells) + " |")
+
+
 def rates_table(out, scenarios):
     rows = []
     for scenario in scenarios:
@@ -172,6 +195,8 @@ def main():
     out, scenarios = sys.argv[1], sys.argv[2:]
     for scenario in scenarios:
         experiment_table(out, scenario)
+    for scenario in scenarios:
+        loss_table(out, scenario)
     rates_table(out, scenarios)
 
 
