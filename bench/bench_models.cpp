@@ -1,9 +1,11 @@
 // Speed of the radar model's Scan and of eval's ParticleClusterer (docs/performance.md).
 //   bench_models --benchmark_filter=RadarScan   (highway: 40 vehicles, 2 guard rails, DefaultRig)
+//   bench_models --benchmark_filter=Multipath   (the same scan, multipath off and on side by side)
 //   bench_models --benchmark_filter=Clusterer   (10,000 particles on 8 vehicles)
 // Argument: OpenMP threads.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -66,6 +68,57 @@ void BM_RadarScan(benchmark::State& state) {
   state.counters["detections"] = static_cast<double>(detections);
 }
 BENCHMARK(BM_RadarScan)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// The cost of multipath (issue 27: at most +20 % on a sim step): every iteration scans the same
+// scene with multipath off and then on, each timed, so that both see the same machine load; the
+// counters give the mean time of each and their ratio. Arguments: OpenMP threads; the ego's lane
+// (1: as BM_RadarScan, 5.25 m from the right rail; 3: the left lane, 3.25 m from the left rail).
+void BM_MultipathCost(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(0)));
+  radar::ModelOptions on_options;
+  on_options.multipath.enabled = true;
+  const radar::RadarModel off(radar::DefaultRig(4.5, 1.8), radar::ModelOptions{}, 1);
+  const radar::RadarModel on(radar::DefaultRig(4.5, 1.8), on_options, 1);
+  const radar::Scene scene = HighwayScene();
+  radar::EgoMotion ego;
+  ego.pose = Pose2{Position(0.0, -5.25 + 3.5 * static_cast<double>(state.range(1))), 0.0};
+  ego.velocity = Velocity(30.0, 0.0);
+  ego.length = 4.5;
+  ego.width = 1.8;
+  using Clock = std::chrono::steady_clock;
+  std::uint64_t step = 0;
+  double off_s = 0.0, on_s = 0.0;
+  std::size_t off_n = 0, on_n = 0, ghosts = 0;
+  for (auto _ : state) {
+    const auto t0 = Clock::now();
+    const std::vector<radar::Detection> a = off.Scan(ego, scene, step, 0.0, 0.05);
+    const auto t1 = Clock::now();
+    const std::vector<radar::Detection> b = on.Scan(ego, scene, step, 0.0, 0.05);
+    const auto t2 = Clock::now();
+    ++step;
+    off_s += std::chrono::duration<double>(t1 - t0).count();
+    on_s += std::chrono::duration<double>(t2 - t1).count();
+    off_n = a.size();
+    on_n = b.size();
+    ghosts = 0;
+    for (const radar::Detection& d : b) ghosts += d.path != radar::Path::kDirect;
+    benchmark::DoNotOptimize(a.data());
+    benchmark::DoNotOptimize(b.data());
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["off_us"] = 1e6 * off_s / n;
+  state.counters["on_us"] = 1e6 * on_s / n;
+  state.counters["ratio"] = on_s / off_s;
+  state.counters["detections_off"] = static_cast<double>(off_n);
+  state.counters["detections_on"] = static_cast<double>(on_n);
+  state.counters["ghosts"] = static_cast<double>(ghosts);
+}
+BENCHMARK(BM_MultipathCost)
+    ->Args({1, 1})
+    ->Args({2, 1})
+    ->Args({1, 3})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 // 10,000 weighted particles on 8 vehicles (uniform in each 4.5 m x 1.8 m box, 1,250 each) plus
 // 500 spread uniformly over the road (mostly DBSCAN noise), as the filter hands over its dynamic

@@ -9,155 +9,16 @@
 #include <stdexcept>
 #include <utility>
 
+#include "ghosts.hpp"
+#include "scan_geometry.hpp"
+
 namespace dualgrid::radar {
 namespace {
 
-constexpr int kCellBits = 20;              // per packed cell-index dimension and per RNG index
-constexpr int kMaxSensors = 1 << 12;       // sensor << kCellBits must fit the 32-bit RNG index
-constexpr double kMinSpacing = 0.02;       // [m] keeps sampling finite right next to a sensor
-constexpr double kMaxSpacing = 1.0;        // [m] keeps long faces' shapes for occlusion
-constexpr double kCornerShare = 0.5;       // corners (dihedrals) reflect strongly
-constexpr double kOcclusionShrink = 1e-3;  // [m] a scatterer must not occlude itself
-constexpr int kAzimuthBins = 128;          // occluder lookup by azimuth
-// [m] a line of sight must run this far inside the ego's body to be blocked: the sensors sit on
-// its surface, and a ray leaving the surface (or grazing it) is not hidden.
-constexpr double kEgoBodyMargin = 0.05;
-// [m] the body is tested shrunk by this skin: a line of sight exactly along its surface (a corner
-// radar on the flank looking at a car as wide as the ego, straight ahead in its lane) grazes it.
-// On the exact boundary, rounding decided: the same scene turned by 45 deg was seen, at 0 deg
-// not (docs/radar.md, tests "the radar model is rotation invariant").
-constexpr double kEgoBodySkin = 1e-3;
-// A face is visible only if the line of sight meets it at more than this grazing angle (sine):
-// a face seen exactly edge-on (a flank collinear with the sensor) returns nothing, and with it
-// its far corner, hidden behind the near one (docs/radar.md step 2).
-constexpr double kMinGrazingSin = 0.0087;  // sin(0.5 deg)
+using namespace detail;  // NOLINT: the scan's own geometry helpers
 
-/// Angular interval seen from the sensor, stored as centre direction and cos(half width) so
-/// membership is one dot product.
-struct Interval {
-  double center = 0.0;
-  double half_width = 0.0;
-};
-
-Interval IntervalOf(const Position* local, int n) {
-  const double a0 = std::atan2(local[0].y(), local[0].x());
-  double lo = 0.0, hi = 0.0;
-  for (int i = 1; i < n; ++i) {
-    const double d = WrapAngle(std::atan2(local[i].y(), local[i].x()) - a0);
-    lo = std::min(lo, d);
-    hi = std::max(hi, d);
-  }
-  return {WrapAngle(a0 + 0.5 * (lo + hi)), 0.5 * (hi - lo)};
-}
-
-struct Occluder {
-  int owner = 0;  // target index (>= 0) or -1 - rail segment index
-  bool is_box = true;
-  double min_distance = 0.0;
-  Vector2 center_dir = Vector2::Zero();  // sensor frame
-  double cos_half_width = 1.0;
-  // Box: centre, unit length axis, half extents. Segment: endpoints a, b (world).
-  Position a = Position::Zero(), b = Position::Zero();
-  Vector2 axis = Vector2::UnitX();
-  double half_length = 0.0, half_width = 0.0;
-};
-
-double Cross(const Vector2& u, const Vector2& v) { return u.x() * v.y() - u.y() * v.x(); }
-
-/// The parameter interval [t0, t1] of p + t (q - p), t in [0, 1], inside the box (Liang-Barsky
-/// slab clipping in the box frame); std::nullopt if the segment misses it.
-std::optional<std::pair<double, double>> ClipToBox(const Occluder& o, const Position& p,
-                                                   const Position& q) {
-  const Vector2 lateral(-o.axis.y(), o.axis.x());
-  const Vector2 rp = p - o.a, d = q - p;
-  const double s[2] = {rp.dot(o.axis), rp.dot(lateral)};
-  const double v[2] = {d.dot(o.axis), d.dot(lateral)};
-  const double h[2] = {o.half_length, o.half_width};
-  double t0 = 0.0, t1 = 1.0;
-  for (int i = 0; i < 2; ++i) {
-    if (std::abs(v[i]) < 1e-12) {
-      if (std::abs(s[i]) > h[i]) return std::nullopt;
-      continue;
-    }
-    double ta = (-h[i] - s[i]) / v[i], tb = (h[i] - s[i]) / v[i];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return std::nullopt;
-  }
-  return std::pair{t0, t1};
-}
-
-/// Does the segment p -> q cross the box?
-bool SegmentHitsBox(const Occluder& o, const Position& p, const Position& q) {
-  return ClipToBox(o, p, q).has_value();
-}
-
-/// Length of the part of the segment p -> q inside the box; 0 if it misses.
-double LengthInsideBox(const Occluder& o, const Position& p, const Position& q) {
-  const auto t = ClipToBox(o, p, q);
-  return t ? (t->second - t->first) * (q - p).norm() : 0.0;
-}
-
-bool SegmentsIntersect(const Position& p, const Position& q, const Position& a, const Position& b) {
-  const Vector2 r = q - p, s = b - a;
-  const double denom = Cross(r, s);
-  if (std::abs(denom) < 1e-12) return false;  // parallel: a thin rail cannot hide along itself
-  const double t = Cross(a - p, s) / denom, u = Cross(a - p, r) / denom;
-  return t >= 0.0 && t <= 1.0 && u >= 0.0 && u <= 1.0;
-}
-
-double PointSegmentDistance(const Position& p, const Position& a, const Position& b) {
-  const Vector2 ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
-/// Walks the edge a -> b emitting samples (midpoint, length ds, |sin| between edge and line of
-/// sight). The spacing keeps consecutive samples within half a range and half an azimuth
-/// resolution cell, so every cell the edge crosses receives a scatterer, and faces spanning
-/// more azimuth get more of them.
-template <class Emit>
-void WalkEdge(const Position& a, const Position& b, const Position& sensor, double range_res,
-              double azimuth_res, Emit&& emit) {
-  const double len = (b - a).norm();
-  if (len <= 0.0) return;
-  const Vector2 dir = (b - a) / len;
-  double pos = 0.0;
-  while (pos < len) {
-    const Vector2 r = a + pos * dir - sensor;
-    const double range = r.norm();
-    double ds = kMinSpacing;
-    if (range > 1e-9) {
-      const double sin_phi = std::abs(Cross(dir, r)) / range,
-                   cos_phi = std::abs(dir.dot(r)) / range;
-      const double rate = sin_phi / (range * azimuth_res) + cos_phi / range_res;  // cells per m
-      ds = std::clamp(0.5 / std::max(rate, 1e-12), kMinSpacing, kMaxSpacing);
-    }
-    ds = std::min(ds, len - pos);
-    const Position mid = a + (pos + 0.5 * ds) * dir;
-    const Vector2 rm = mid - sensor;
-    const double rn = rm.norm();
-    emit(mid, ds, rn > 1e-9 ? std::abs(Cross(dir, rm)) / rn : 1.0);
-    pos += ds;
-  }
-}
-
-/// Parameter interval [t0, t1] of a + t (b - a), t in [0, 1], inside the disc (c, radius).
-bool ClipToDisc(const Position& a, const Position& b, const Position& c, double radius, double* t0,
-                double* t1) {
-  const Vector2 d = b - a, f = a - c;
-  const double qa = d.squaredNorm(), qb = 2.0 * f.dot(d), qc = f.squaredNorm() - radius * radius;
-  if (qa <= 0.0) return false;
-  const double disc = qb * qb - 4.0 * qa * qc;
-  if (disc < 0.0) return false;
-  const double sq = std::sqrt(disc);
-  *t0 = std::max(0.0, (-qb - sq) / (2.0 * qa));
-  *t1 = std::min(1.0, (-qb + sq) / (2.0 * qa));
-  return *t0 < *t1;
-}
-
+constexpr int kCellBits = 20;         // per packed cell-index dimension and per RNG index
+constexpr int kMaxSensors = 1 << 12;  // sensor << kCellBits must fit the 32-bit RNG index
 struct SensorGeometry {
   Pose2 pose;
   Velocity velocity;  // over ground, including the yaw-rate lever arm
@@ -177,6 +38,9 @@ RadarModel::RadarModel(std::vector<SensorParams> sensors, ModelOptions options, 
                                   "'): " + error);
     models_.emplace_back(params_[i]);
   }
+  std::string error;
+  if (!options_.multipath.IsValid(&error))
+    throw std::invalid_argument("radar options: multipath." + error);
 }
 
 void RadarModel::CheckSensor(int sensor) const {
@@ -339,50 +203,19 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
     sc.velocity = v;
     sc.rcs_m2 = rcs_m2;
     sc.source_id = source_id;
+    sc.origin = q;
     out.push_back(sc);
   };
 
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
-  struct Sample {
-    Position q;
-    double weight;
-  };
-  std::vector<Sample> samples;
+  std::vector<FaceSample> samples;
   for (const int ti : candidate_targets) {
     const Target& t = scene.targets[ti];
-    const std::array<Position, 4> c = t.box.Corners();  // counter-clockwise
-    bool corner_visible[4] = {false, false, false, false};
-    samples.clear();
-    double edge_weight = 0.0;
-    for (int e = 0; e < 4; ++e) {
-      const Position& a = c[e];
-      const Position& b = c[(e + 1) % 4];
-      const Vector2 normal(b.y() - a.y(), a.x() - b.x());  // outward for a CCW polygon
-      const Vector2 to_sensor = s - 0.5 * (a + b);
-      const double nn = normal.norm() * to_sensor.norm();
-      if (!(nn > 0.0) || normal.dot(to_sensor) <= kMinGrazingSin * nn) continue;
-      corner_visible[e] = corner_visible[(e + 1) % 4] = true;
-      WalkEdge(a, b, s, p.range_resolution, p.azimuth_resolution,
-               [&](const Position& q, double ds, double sin_phi) {
-                 // Share ~ projected width across the line of sight.
-                 samples.push_back({q, ds * sin_phi});
-                 edge_weight += ds * sin_phi;
-               });
-    }
-    const int n_corners = static_cast<int>(std::count(corner_visible, corner_visible + 4, true));
-    if (n_corners == 0) continue;
-    const double rcs = std::pow(10.0, 0.1 * t.rcs_dbsm);
-    const double corner_share = edge_weight > 0.0 ? kCornerShare : 1.0;
-    for (int k = 0; k < 4; ++k) {
-      if (!corner_visible[k]) continue;
-      consider(c[k], RigidPointVelocity(t.velocity, t.yaw_rate, t.box.center, c[k]),
-               rcs * corner_share / n_corners, t.id, ti);
-    }
-    if (edge_weight > 0.0) {
-      for (const Sample& smp : samples)
-        consider(smp.q, RigidPointVelocity(t.velocity, t.yaw_rate, t.box.center, smp.q),
-                 rcs * (1.0 - kCornerShare) * smp.weight / edge_weight, t.id, ti);
-    }
+    BoxScatterers(t.box.Corners(), std::pow(10.0, 0.1 * t.rcs_dbsm), s, p.range_resolution,
+                  p.azimuth_resolution, samples, [&](const Position& q, double rcs_share) {
+                    consider(q, RigidPointVelocity(t.velocity, t.yaw_rate, t.box.center, q),
+                             rcs_share, t.id, ti);
+                  });
   }
 
   // 3. Guard rails: static line scatterers, RCS per metre of length.
@@ -393,6 +226,25 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
              [&](const Position& q, double ds, double) {
                consider(q, Velocity::Zero(), rcs_per_m * ds, line.id, -1 - piece.segment);
              });
+  }
+
+  // 4. Multipath: the boxes' ghosts in the mirrors (docs/radar.md, "Multipath").
+  if (options_.multipath.enabled) {
+    SensorView view;
+    view.params = &p;
+    view.model = &model;
+    view.s = s;
+    view.vs = vs;
+    view.to_local = to_local;
+    view.cos_half_fov = std::cos(half_fov);
+    view.occlusion = options_.occlusion;
+    view.has_body = has_body;
+    view.body = body;
+    if (has_body)
+      for (const Position& c :
+           OrientedBox{ego.pose.position, ego.pose.yaw, ego.length, ego.width}.Corners())
+        view.body_box.Add(c);
+    AddGhostScatterers(view, options_.multipath, scene, occluded, &out);
   }
   return out;
 }
@@ -444,33 +296,49 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
                    [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
 
   std::vector<Detection> out;
-  std::uint32_t cell = 0;
-  for (std::size_t begin = 0; begin < order.size(); ++cell) {
+  // Random streams per cell: cells holding a direct scatterer are numbered among themselves (so
+  // with multipath off nothing changes, and on, a cell without ghosts draws what it drew
+  // without them); cells of ghosts alone have their own purpose and numbering.
+  std::uint32_t cell = 0, ghost_cell = 0;
+  for (std::size_t begin = 0; begin < order.size();) {
     std::size_t end = begin;
     double snr = 0.0, best = -1.0, rr = 0.0;
     Position centroid = Position::Zero();
-    int source = -1;
+    const Scatterer* strongest = nullptr;
+    bool has_direct = false;
     for (; end < order.size() && keys[order[end]] == keys[order[begin]]; ++end) {
       const Scatterer& sc = scatterers[order[end]];
       const double si = model.SnrLinear(sc.rcs_m2, sc.truth.range);
       snr += si;
       centroid += si * sc.position;
       rr += si * sc.truth.range_rate;
+      has_direct = has_direct || sc.path == Path::kDirect;
       if (si > best) {
         best = si;
-        source = sc.source_id;
+        strongest = &sc;
       }
     }
     begin = end;
+    const std::uint32_t ordinal = has_direct ? cell++ : ghost_cell++;
     if (!(snr > 0.0)) continue;
     centroid /= snr;
     const Position local = pose.ToLocal(centroid);
     const Polar truth{local.norm(), std::atan2(local.y(), local.x()), rr / snr};
-    assert(cell < (1u << kCellBits));
-    CounterRng rng(seed_, RngPurpose::kRadarScatter, step,
-                   (static_cast<std::uint32_t>(sensor) << kCellBits) | cell);
+    assert(ordinal < (1u << kCellBits));
+    CounterRng rng(seed_, has_direct ? RngPurpose::kRadarScatter : RngPurpose::kRadarGhost, step,
+                   (static_cast<std::uint32_t>(sensor) << kCellBits) | ordinal);
     const std::optional<Polar> m = model.Measure(truth, snr, options_.noise, rng);
-    if (m) out.push_back(make_detection(*m, 10.0 * std::log10(snr), source, false));
+    if (!m) continue;
+    const bool ghost = strongest->path != Path::kDirect;
+    Detection d =
+        make_detection(*m, 10.0 * std::log10(snr), ghost ? -1 : strongest->source_id, false);
+    if (ghost) {
+      d.path = strongest->path;
+      d.bounces = strongest->bounces;
+      d.reflector_id = strongest->reflector_id;
+      d.ghost_of = strongest->source_id;
+    }
+    out.push_back(d);
   }
 
   if (options_.false_alarms) {

@@ -338,6 +338,43 @@ void WriteSensorProfile(const radar::SensorParams& s, nlohmann::json* j) {
   throw ConfigError(key(field) + message);
 }
 
+// `sensors.multipath`: on / off (true / false), or a map of radar::MultipathParams fields, which
+// turns it on (unless it says `enabled: false`). docs/radar.md, "Multipath".
+void ReadMultipath(MapReader& section, radar::MultipathParams* mp) {
+  if (!section.Has("multipath")) return;
+  if (section.IsMap("multipath")) {
+    auto r = section.Map("multipath");
+    mp->enabled = true;
+    r->Read("enabled", &mp->enabled);
+    r->Read("rails", &mp->rails);
+    r->Read("vehicles", &mp->vehicles);
+    r->Read("rail_loss_db", &mp->rail_loss_db);
+    r->Read("vehicle_loss_db", &mp->vehicle_loss_db);
+    r->Read("vehicle_min_length", &mp->vehicle_min_length);
+    r->Read("max_bounces", &mp->max_bounces);
+    r->Read("min_pd", &mp->min_pd);
+    r->Finish();
+  } else {
+    std::string text;
+    section.Read("multipath", &text);
+    // YAML 1.1's spellings of true and false, as yaml-cpp reads the other switches.
+    const auto any_of = [&](std::initializer_list<const char*> words) {
+      return std::any_of(words.begin(), words.end(), [&](const char* w) { return text == w; });
+    };
+    if (any_of({"on", "On", "ON", "true", "True", "TRUE", "yes", "Yes", "YES", "y", "Y"}))
+      mp->enabled = true;
+    else if (any_of({"off", "Off", "OFF", "false", "False", "FALSE", "no", "No", "NO", "n", "N"}))
+      mp->enabled = false;
+    else
+      section.Fail("multipath",
+                   "expected on, off or a map of its parameters (rail_loss_db, "
+                   "vehicle_loss_db, ...), got '" +
+                       text + "'");
+  }
+  std::string error;
+  if (!mp->IsValid(&error)) Invalid(section.file(), "sensors.multipath", error);
+}
+
 void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* radar) {
   const auto& ego_type = spec.vehicle_types.at(spec.ego.type);
   auto section = root.Map("sensors");
@@ -358,6 +395,7 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
   section->Read("noise", &radar->options.noise);
   section->Read("false_alarms", &radar->options.false_alarms);
   section->Read("occlusion", &radar->options.occlusion);
+  ReadMultipath(*section, &radar->options.multipath);
   auto names = [&] {
     std::string all;
     for (const auto& s : radar->sensors) all += (all.empty() ? "" : ", ") + s.name;
@@ -757,6 +795,16 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   j["sensors"]["noise"] = c.radar.options.noise;
   j["sensors"]["false_alarms"] = c.radar.options.false_alarms;
   j["sensors"]["occlusion"] = c.radar.options.occlusion;
+  // Only when on: a run with multipath off writes the same config.json as before it existed.
+  if (const radar::MultipathParams& mp = c.radar.options.multipath; mp.enabled)
+    j["sensors"]["multipath"] = {{"enabled", mp.enabled},
+                                 {"rails", mp.rails},
+                                 {"vehicles", mp.vehicles},
+                                 {"rail_loss_db", mp.rail_loss_db},
+                                 {"vehicle_loss_db", mp.vehicle_loss_db},
+                                 {"vehicle_min_length", mp.vehicle_min_length},
+                                 {"max_bounces", mp.max_bounces},
+                                 {"min_pd", mp.min_pd}};
   for (const auto& s : c.radar.sensors) {
     nlohmann::json sj = {{"name", s.name},
                          {"mount",

@@ -1,5 +1,6 @@
-// `dualgrid tangential --kind aspect`: the generated geometry is what was asked for, measured
-// from the simulation's own ground truth and radar detections (docs/stress.md).
+// `dualgrid tangential --kind aspect` and `--kind guardrail`: the generated geometry is what was
+// asked for, measured from the simulation's own ground truth and radar detections
+// (docs/stress.md).
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -128,4 +129,73 @@ TEST_CASE("aspect cases that could not be scored are refused with what to change
       Run("tangential --kind crossing --ego-speed 0 -q --out " + (dir / "c.yaml").string());
   CHECK(parked.code == 2);
   CHECK(parked.output.find("--ego-speed") != std::string::npos);
+}
+
+TEST_CASE("guardrail cases: vehicles pass on the ego's far side, their ghosts lie beyond the rail",
+          "[cli][stress][multipath]") {
+  // The ego in the highway's left lane (y = -3.75 m), the rail 3 m to its left (y = -0.75 m),
+  // three vehicles overtaking at 26 m/s in lanes 1 and 0 (y = -7.25, -10.75 m). With multipath on
+  // every ghost is one of theirs off the rail; an order-3 ghost is a mirror image: beyond the
+  // rail, where a near face at y < -6 has its image at y > 4.5 (noise: centimetres).
+  const fs::path dir = TempDir("stress", "guardrail");
+  const auto gen =
+      Run("tangential --kind guardrail --offset 3 --ego-speed 20 --speed 26 "
+          "--count 3 -q --out " +
+          (dir / "case.yaml").string());
+  INFO(gen.output);
+  REQUIRE(gen.code == 0);
+  const auto sim = Run("sim " + (dir / "case.yaml").string() + " --out " + (dir / "sim").string() +
+                       " -q --duration 10 --set sensors.multipath=on");
+  INFO(sim.output);
+  REQUIRE(sim.code == 0);
+  double ego_y = 0.0;
+  std::map<std::string, double> lane_y, speed_sum, rows;
+  for (const auto& r : ReadCsv(dir / "sim" / "ground_truth.csv")) {
+    if (r.at("is_ego") == "1") {
+      ego_y = std::stod(r.at("y"));
+      continue;
+    }
+    lane_y[r.at("id")] = std::stod(r.at("y"));
+    speed_sum[r.at("id")] += std::stod(r.at("speed"));
+    rows[r.at("id")] += 1.0;
+  }
+  CHECK(ego_y == Approx(-3.75).margin(0.05));
+  REQUIRE(lane_y.size() == 3);
+  for (const auto& [id, y] : lane_y) {
+    CHECK(y < ego_y - 3.0);  // the ego's other side
+    // They overtake: SUMO's drivers keep near their desired 26 m/s (the ego drives 20 m/s).
+    CHECK(speed_sum[id] / rows[id] > 23.0);
+  }
+  int ghosts = 0, images = 0;
+  for (const auto& r : ReadCsv(dir / "sim" / "detections.csv")) {
+    if (r.at("path") == "direct" || r.at("path") == "clutter") continue;
+    ++ghosts;
+    CHECK(r.at("reflector") == "rail");
+    CHECK(r.at("ghost_of").rfind("pass_", 0) == 0);
+    CHECK(r.at("source") == "clutter");  // a ghost is no object's detection
+    if (r.at("bounces") == "3") {
+      ++images;
+      CHECK(std::stod(r.at("y")) > -0.75);
+    }
+  }
+  CHECK(ghosts > 0);
+  CHECK(images > 0);
+}
+
+TEST_CASE("guardrail cases that cannot be built are refused with what to change",
+          "[cli][stress][multipath]") {
+  const fs::path dir = TempDir("stress", "guardrail_bad");
+  const auto out = " -q --out " + (dir / "x.yaml").string();
+  const auto slow = Run("tangential --kind guardrail --ego-speed 20 --speed 21" + out);
+  CHECK(slow.code == 2);
+  CHECK_THAT(slow.output, Catch::Contains("--speed must differ from --ego-speed"));
+  const auto gap = Run("tangential --kind guardrail --speed 30 --spacing 30" + out);
+  CHECK(gap.code == 2);
+  CHECK_THAT(gap.output, Catch::Contains("--spacing must be >= 48.0 m"));
+  const auto kind = Run("tangential --kind parallel --offset 3" + out);
+  CHECK(kind.code == 2);
+  CHECK_THAT(kind.output, Catch::Contains("options of --kind guardrail"));
+  const auto offset = Run("tangential --kind guardrail --offset 0.5" + out);
+  CHECK(offset.code == 2);
+  CHECK_THAT(offset.output, Catch::Contains("--offset"));
 }

@@ -480,6 +480,63 @@ def check_slider_and_keys(browser, frames):
     require(abs(shown_time(browser) - frames[0]["t"]) < 0.005, f"Home: first frame, t = {frames[0]['t']}")
 
 
+def check_ghost_layer(browser, index):
+    """Multipath ghosts (docs/replay.md): their own layer. At a frame with ghosts, with only their
+    radar's detections shown, switching the layer off changes pixels on the ghosts' rings (drawn
+    2.5 px around each ghost) and switching it on again brings every one of them back."""
+    has = browser.eval("!!document.getElementById('layer-ghosts')")
+    if not index.get("multipath"):
+        require(not has, "no ghost layer without multipath")
+        return
+    require(has, "a 'multipath ghosts' layer when the recording has multipath")
+    frames = index["frames"]
+    k = next((i for i, f in enumerate(frames) if any(len(d) > 6 for d in f["det"])), None)
+    require(k is not None, "the multipath recording has ghosts")
+    browser.key("Home", 36)
+    for _ in range(k):
+        browser.key("ArrowRight", 39)
+    drawn(browser)
+    require(browser.eval("window.dualgridViewer.frame()") == k, f"at frame {k}, which has ghosts")
+    fr, res = frames[k], index["resolution"]
+    sensors = sorted({d[0] for d in fr["det"] if len(d) > 6})
+    for s in range(len(index.get("sensors", []))):
+        selector = f"#layer-sensor-{s}"
+        if browser.eval(f"document.querySelector({json.dumps(selector)}).checked") != (s in sensors):
+            toggle(browser, selector, s in sensors)
+    mode = browser.eval("window.dualgridViewer.panels()")[0]
+    sx, sy = browser.eval("[window.scrollX, window.scrollY]")
+    points = []  # ring pixels of every ghost inside the viewport
+    for d in fr["det"]:
+        if len(d) <= 6:
+            continue
+        ci, cj = int((d[1] - fr["origin"][0]) // res), int((d[2] - fr["origin"][1]) // res)
+        p0 = browser.eval(f"window.dualgridViewer.cellToPage({mode}, {ci}, {cj})")
+        p1 = browser.eval(f"window.dualgridViewer.cellToPage({mode}, {ci + 1}, {cj + 1})")
+        if not p0 or not p1:
+            continue
+        # The cell centres' pixels give the map's scale (y up on the page's y down).
+        kx, ky = (p1["x"] - p0["x"]) / res, (p1["y"] - p0["y"]) / res
+        x = p0["x"] + (d[1] - fr["origin"][0] - (ci + 0.5) * res) * kx
+        y = p0["y"] + (d[2] - fr["origin"][1] - (cj + 0.5) * res) * ky
+        for a in range(8):
+            px = int(round(x + 2.5 * math.cos(a * math.pi / 4))) - sx
+            py = int(round(y + 2.5 * math.sin(a * math.pi / 4))) - sy
+            if 0 <= px < VIEWPORT[0] and 0 <= py < VIEWPORT[1]:
+                points.append((px, py))
+    require(points, "ghost rings inside the viewport")
+    on = browser.screenshot()
+    before = [on(x, y) for x, y in points]
+    toggle(browser, "#layer-ghosts", False)
+    off = browser.screenshot()
+    changed = sum(1 for (x, y), b in zip(points, before) if not close(off(x, y), b, 3))
+    require(changed > 0, f"ghost layer off: {changed} of {len(points)} ring pixels changed")
+    toggle(browser, "#layer-ghosts", True)
+    again = browser.screenshot()
+    require(all(close(again(x, y), b, 3) for (x, y), b in zip(points, before)),
+            "ghost layer on again: every ring pixel is back")
+    print(f"ghost layer: {changed} of {len(points)} ring pixels at frame {k} change", flush=True)
+
+
 def check_playback(browser, index):
     """Space plays in real time, Space again pauses. The focus is on a checkbox clicked just
     before: Space must not toggle it."""
@@ -512,15 +569,17 @@ def run_checks(browser, index, run, html):
     x, y = check_pixels(browser, index, html, k, mi, ci, cj, m)
     check_hover(browser, index, x, y, ci, cj, m)
     check_slider_and_keys(browser, index["frames"])
+    check_ghost_layer(browser, index)
     check_playback(browser, index)
 
 
 def record(binary, work):
-    """A 6 s simple_road run with its recording (figures on: they switch the recording on; PNG
-    only, for speed) and its viewer page. Returns (run folder, page)."""
+    """A 6 s simple_road run with multipath ghosts (its rails and trucks are mirrors) and its
+    recording (figures on: they switch the recording on; PNG only, for speed) and its viewer
+    page. Returns (run folder, page)."""
     run, html = os.path.join(work, "run"), os.path.join(work, "replay.html")
     for cmd in ([binary, "run", "scenarios/simple_road.yaml", "--out", run, "--duration", "6",
-                 "--figure-formats", "png", "--quiet"],
+                 "--figure-formats", "png", "--set", "sensors.multipath=on", "--quiet"],
                 [binary, "replay", run, "--html", "--html-out", html, "--quiet"]):
         print("$", " ".join(cmd), flush=True)
         try:

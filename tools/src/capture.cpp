@@ -85,6 +85,7 @@ Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string
   h.particle_unit = ParticleUnit(h.cells_x * h.resolution, h.cells_y * h.resolution);
   h.max_particles = max_particles;
   h.dynamic_threshold = c.evaluation.dynamic_threshold;
+  h.multipath = c.radar.options.multipath.enabled;
   // The static world in the world frame: each frame turns it into its own grid frame.
   for (std::size_t i = 0; i < c.sim.parked.size(); ++i)
     h.parked.push_back(ToBox(-1, c.sim.parked[i].box, Velocity::Zero()));
@@ -111,7 +112,8 @@ Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnap
   for (const radar::Detection& d : pipeline.detections()) {
     const Position p = g.ToGrid(d.position_world);
     const Velocity v = g.VectorToGrid(d.radial_velocity_world);
-    f.detections.push_back({d.sensor, p.x(), p.y(), v.x(), v.y(), d.is_clutter});
+    f.detections.push_back(
+        {d.sensor, p.x(), p.y(), v.x(), v.y(), d.is_clutter, static_cast<int>(d.path)});
   }
   f.modes.resize(snapshots.size());
   for (std::size_t m = 0; m < snapshots.size(); ++m) {

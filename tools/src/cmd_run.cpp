@@ -88,7 +88,8 @@ int RunFilters(const FilterRunOptions& options) {
   // Weight traces (paper Fig. 4) of the dual filter, or of the last mode if dual is not run.
   const auto dual = std::find(modes.begin(), modes.end(), filter::WeightMode::kDual);
   const std::size_t trace_mode = dual != modes.end() ? dual - modes.begin() : modes.size() - 1;
-  RunFilesObserver files(out, detections_path, trace_mode, config.evaluation.focus_object);
+  RunFilesObserver files(out, detections_path, config.radar.options.multipath.enabled, trace_mode,
+                         config.evaluation.focus_object);
   cosim.AddObserver(&files);
   std::optional<RecordingObserver> recording;
   if (options.record) {

@@ -32,7 +32,8 @@ int RunSim(const SimOptions& sim_options) {
   NoteAutoEgo(pipeline, options.quiet);
   GroundTruthWriter truth(options.out / "ground_truth.csv");
   std::unique_ptr<DetectionWriter> detections;
-  if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path);
+  const bool multipath = config.radar.options.multipath.enabled;
+  if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path, multipath);
   WriteObstacles(spec, options.out / "obstacles.csv");
 
   struct Seen {
@@ -42,13 +43,16 @@ int RunSim(const SimOptions& sim_options) {
   std::map<std::string, Seen> seen;
   Progress progress("sim " + spec.name, spec.StepCount(), !options.quiet);
   int steps = 0;
-  std::size_t detection_count = 0, clutter_count = 0;
+  std::size_t detection_count = 0, clutter_count = 0, ghost_count = 0;
   while (!StopSignal() && cosim.Step()) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
     detection_count += pipeline.detections().size();
-    for (const auto& d : pipeline.detections()) clutter_count += d.is_clutter ? 1 : 0;
+    for (const auto& d : pipeline.detections()) {
+      clutter_count += d.is_clutter ? 1 : 0;
+      ghost_count += d.path != radar::Path::kDirect ? 1 : 0;
+    }
     for (const auto& v : f.vehicles) {
       auto [it, inserted] = seen.try_emplace(v.id, Seen{v.type, f.time, f.time, 1e9});
       it->second.last = f.time;
@@ -76,6 +80,7 @@ int RunSim(const SimOptions& sim_options) {
   summary["wall_s"] = wall;
   summary["detections"] = detection_count;
   summary["clutter_detections"] = clutter_count;
+  if (multipath) summary["ghost_detections"] = ghost_count;
   summary["sensors"] = nlohmann::json::array();
   for (const auto& sensor : config.radar.sensors) summary["sensors"].push_back(sensor.name);
   for (const auto& [id, s] : seen) {

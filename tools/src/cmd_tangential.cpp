@@ -3,7 +3,9 @@
 //   crossing: on the `crossing` network, vehicles cross the ego's road ahead of it at right
 //             angles, perpendicular to the front radar's boresight;
 //   parallel: on the `highway` network, vehicles drive alongside the ego in both adjacent lanes
-//             at nearly its speed, perpendicular to the corner radars' lines of sight.
+//             at nearly its speed, perpendicular to the corner radars' lines of sight;
+//   guardrail: (multipath, issue 27) the ego beside a guard rail, vehicles passing on its other
+//             side (guardrail_case.cpp); aspect: any aspect angle (aspect_case.cpp).
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -12,6 +14,7 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/scenario/loader.hpp"
+#include "guardrail_case.hpp"
 #include "output.hpp"
 
 namespace dualgrid::tools {
@@ -26,9 +29,13 @@ struct Resolved {
 };
 
 Resolved Resolve(const TangentialOptions& o) {
-  const bool parallel = o.kind == "parallel";
-  return {o.speed.value_or(parallel ? o.ego_speed + 0.3 : 15.0),
-          o.spacing.value_or(parallel ? 40.0 : 20.0)};
+  const bool parallel = o.kind == "parallel", guardrail = o.kind == "guardrail";
+  return {o.speed.value_or(parallel    ? o.ego_speed + 0.3
+                           : guardrail ? o.ego_speed + 5.0
+                                       : 15.0),
+          o.spacing.value_or(guardrail  ? 50.0
+                             : parallel ? 40.0
+                                        : 20.0)};
 }
 
 std::string Header(const TangentialOptions& o, const std::string& what) {
@@ -142,6 +149,25 @@ int RunTangential(const TangentialOptions& o) {
                 << o.out.string() << " --out run/" << o.out.stem().string() << "\n";
     return 0;
   }
+  if (o.kind == "guardrail") {
+    const Resolved r = Resolve(o);
+    GuardRailCase c;
+    c.offset = o.offset;
+    c.rail_angle = o.rail_angle;
+    c.ego_speed = o.ego_speed;
+    c.speed = r.speed;
+    c.count = o.count;
+    c.spacing = r.spacing;
+    c.seed = o.seed;
+    const std::string text = GuardRailScenario(c);
+    if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
+    WriteTextFile(o.out, text);
+    scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
+    if (!o.quiet)
+      std::cout << "wrote " << o.out.string() << "; run it with: dualgrid run " << o.out.string()
+                << " --set sensors.multipath=on --out run/" << o.out.stem().string() << "\n";
+    return 0;
+  }
   // Ranges of single options are checked by the command line; these depend on the kind.
   if (!(o.ego_speed > 0.0))
     throw std::invalid_argument("--ego-speed must be > 0 for " + o.kind +
@@ -195,8 +221,16 @@ Command AddTangentialCommand(CLI::App& app, const CliContext&) {
                          "ego, or driving alongside it), to run with `dualgrid run`");
   Opt(cmd, "--kind", &o->kind,
       "crossing (ahead, across the front radar), parallel (alongside, across the corner "
-      "radars), or aspect (any --angle to any --sensor's line of sight; docs/stress.md)")
-      ->check(CLI::IsMember({"crossing", "parallel", "aspect"}));
+      "radars), aspect (any --angle to any --sensor's line of sight), or guardrail (traffic "
+      "passing the ego on the side away from a guard rail: multipath ghosts; docs/stress.md)")
+      ->check(CLI::IsMember({"crossing", "parallel", "aspect", "guardrail"}));
+  Opt(cmd, "--offset", &o->offset,
+      "guardrail: distance from the ego's centre line to the rail, on its left [m]")
+      ->check(Number(1.2, 20.0, false));
+  Opt(cmd, "--rail-angle", &o->rail_angle,
+      "guardrail: the rail's aspect, its angle to the road [deg] (+: turning away from the "
+      "road ahead)")
+      ->check(Number(-10.0, 10.0, false));
   Opt(cmd, "--sensor", &o->sensor, "aspect: the radar whose line of sight the angle refers to")
       ->check(CLI::IsMember({"front", "front_left", "front_right", "rear_left", "rear_right"}));
   Opt(cmd, "--angle", &o->angle,
@@ -219,14 +253,15 @@ Command AddTangentialCommand(CLI::App& app, const CliContext&) {
       ->check(Number(0.0, 40.0, false));
   cmd->add_option("--speed", o->speed,
                   "Stress vehicles' speed over ground [m/s] (default: crossing 15; parallel "
-                  "ego speed + 0.3, so they stay alongside)")
+                  "ego speed + 0.3, so they stay alongside; guardrail ego speed + 5, so they "
+                  "pass)")
       ->check(Number(0.0, 40.0, true));
   Opt(cmd, "--first-distance", &o->first_distance,
       "crossing: distance ahead of the ego of the first crossing [m]")
       ->check(Number(10.0, 600.0, false));
   cmd->add_option("--spacing", o->spacing,
-                  "crossing: distance between crossings (default 20 m); parallel: distance "
-                  "between vehicles of one lane (default 40 m) [m]")
+                  "crossing: distance between crossings (default 20 m); parallel (default 40 m) "
+                  "and guardrail (50 m): distance between vehicles of one lane [m]")
       ->check(Number(0.0, 600.0, true));
   Opt(cmd, "--seed", &o->seed, "Scenario seed")
       ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
@@ -246,6 +281,10 @@ Command AddTangentialCommand(CLI::App& app, const CliContext&) {
                   "--sensor, --angle, --range, --target, --interval and "
                   "--grid-width are options of --kind aspect, not " +
                   o->kind);
+            if ((cmd->count("--offset") > 0 || cmd->count("--rail-angle") > 0) &&
+                o->kind != "guardrail")
+              throw std::invalid_argument(
+                  "--offset and --rail-angle are options of --kind guardrail, not " + o->kind);
             return RunTangential(*o);
           }};
 }

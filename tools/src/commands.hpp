@@ -94,8 +94,9 @@ struct SnapshotOptions {
 
 /// `dualgrid tangential`: writes a tangential-motion stress scenario.
 struct TangentialOptions {
-  /// "crossing" (ahead, across the front radar), "parallel" (alongside) or "aspect" (any aspect
-  /// angle to any sensor, aspect_case.hpp).
+  /// "crossing" (ahead, across the front radar), "parallel" (alongside), "aspect" (any aspect
+  /// angle to any sensor, aspect_case.hpp) or "guardrail" (vehicles passing the ego on the side
+  /// away from a guard rail: multipath, guardrail_case.hpp).
   std::string kind = "crossing";
   int count = 4;            ///< stress vehicles
   double ego_speed = 20.0;  ///< [m/s]
@@ -116,6 +117,9 @@ struct TangentialOptions {
   double interval = 6.0;  ///< [s]
   /// [m]; unset: the paper's 25 m, widened when a target would not be scored.
   std::optional<double> grid_width;
+  // kind guardrail:
+  double offset = 3.75;     ///< ego centre line -> rail [m]
+  double rail_angle = 0.0;  ///< the rail's aspect to the road [deg]
 };
 
 /// `dualgrid regress`.

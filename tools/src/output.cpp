@@ -245,10 +245,13 @@ void GridPoseWriter::Write(const cosim::Pipeline& p) {
   out_.MaybeFlush();
 }
 
-DetectionWriter::DetectionWriter(const std::filesystem::path& path) : out_(path) {
+DetectionWriter::DetectionWriter(const std::filesystem::path& path, bool multipath)
+    : out_(path), multipath_(multipath) {
   out_.buffer() +=
       "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
-      "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter\n";
+      "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter";
+  // Only with multipath on: without it the file is the same as before multipath existed.
+  out_.buffer() += multipath_ ? ",path,bounces,reflector,ghost_of\n" : "\n";
 }
 
 void DetectionWriter::Write(const cosim::Pipeline& p) {
@@ -266,7 +269,14 @@ void DetectionWriter::Write(const cosim::Pipeline& p) {
        << FormatFixed(d.radial_velocity_world.y(), 4) << ','
        << FormatFixed(d.sensor_position_world.x(), 4) << ','
        << FormatFixed(d.sensor_position_world.y(), 4) << ',' << p.ids().Name(d.source_id) << ','
-       << (d.is_clutter ? 1 : 0) << '\n';
+       << (d.is_clutter ? 1 : 0);
+    if (multipath_) {
+      const bool ghost = d.path != radar::Path::kDirect;
+      os << ',' << (d.is_clutter ? "clutter" : radar::ToString(d.path)) << ',' << d.bounces << ','
+         << (ghost ? p.ids().Name(d.reflector_id) : "") << ','
+         << (ghost ? p.ids().Name(d.ghost_of) : "");
+    }
+    os << '\n';
   }
   out_.buffer() += os.str();
   out_.MaybeFlush();

@@ -73,15 +73,18 @@ class GridPoseWriter {
   OutputFile out_;
 };
 
-/// detections.csv (or detections.csv.gz): one row per radar detection per step.
+/// detections.csv (or detections.csv.gz): one row per radar detection per step. With
+/// `multipath` (sensors.multipath on) four columns more name each detection's path: path
+/// (direct, type1, type2, clutter), bounces, reflector and ghost_of (docs/output.md).
 class DetectionWriter {
  public:
-  explicit DetectionWriter(const std::filesystem::path& path);
+  explicit DetectionWriter(const std::filesystem::path& path, bool multipath = false);
   void Write(const cosim::Pipeline& pipeline);
   void Close() { out_.Close(); }
 
  private:
   OutputFile out_;
+  bool multipath_;
 };
 
 /// The detection file for a `--detections` format ("csv" or "csv.gz"); empty for "none".

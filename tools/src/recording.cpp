@@ -69,6 +69,7 @@ json HeaderJson(const Header& h) {
             {"metrics", h.metrics.is_null() ? json::object() : h.metrics},
             {"complete", h.complete},
             {"status", h.status}};
+  if (h.multipath) j["multipath"] = true;
   j["parked"] = json::array();
   for (const Box& b : h.parked) j["parked"].push_back(BoxJson(b));
   j["rails"] = json::array();
@@ -128,8 +129,11 @@ void Writer::Add(const Frame& f) {
   j["truth"] = json::array();
   for (const Box& b : f.truth) j["truth"].push_back(BoxJson(b));
   j["det"] = json::array();
-  for (const Detection& d : f.detections)
-    j["det"].push_back({d.sensor, R(d.x), R(d.y), R(d.vx), R(d.vy), d.clutter ? 1 : 0});
+  for (const Detection& d : f.detections) {
+    json row = {d.sensor, R(d.x), R(d.y), R(d.vx), R(d.vy), d.clutter ? 1 : 0};
+    if (d.path != 0) row.push_back(d.path);  // ghosts only (docs/replay.md)
+    j["det"].push_back(std::move(row));
+  }
   j["modes"] = json::array();
   for (const ModeFrame& m : f.modes) {
     json cl = json::array();
@@ -219,6 +223,7 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   get(index_, "metrics", &h.metrics, "an object");
   get(index_, "complete", &h.complete, "true or false");
   get(index_, "status", &h.status, "a text");
+  if (index_.contains("multipath")) get(index_, "multipath", &h.multipath, "true or false");
   // The filter's own bound on cells (FilterParams) keeps the arrays allocatable.
   if (h.cells_x <= 0 || h.cells_y <= 0 || static_cast<double>(h.cells_x) * h.cells_y > 2e8)
     throw std::invalid_argument(where +
@@ -321,7 +326,8 @@ Frame Reader::LoadFrame(std::size_t i) const {
   for (const json& b : j.at("truth")) f.truth.push_back(BoxFrom(b));
   for (const json& d : j.at("det"))
     f.detections.push_back({d.at(0).get<int>(), d.at(1).get<double>(), d.at(2).get<double>(),
-                            d.at(3).get<double>(), d.at(4).get<double>(), d.at(5).get<int>() != 0});
+                            d.at(3).get<double>(), d.at(4).get<double>(), d.at(5).get<int>() != 0,
+                            d.size() > 6 ? d.at(6).get<int>() : 0});
   const json& modes = j.at("modes");
   if (modes.size() != h.modes.size())
     throw std::invalid_argument(where + ": wrong number of modes");

@@ -35,6 +35,9 @@ struct Detection {
   int sensor = 0;
   double x = 0.0, y = 0.0, vx = 0.0, vy = 0.0;
   bool clutter = false;
+  /// Multipath: 0 direct (or clutter), 1 type-1 ghost, 2 type-2 ghost (radar::Path). Written as
+  /// a 7th element only for ghosts, so recordings without multipath keep their format.
+  int path = 0;
 };
 
 /// A cluster of dynamic particles (the scorer's, docs/metrics.md) and its association.
@@ -94,6 +97,9 @@ struct Header {
   nlohmann::json metrics;  ///< the run's metrics.json per mode, once finished
   bool complete = false;
   std::string status;  ///< why the run is incomplete, else empty
+  /// sensors.multipath was on: detections may carry a path (index key `multipath`, written only
+  /// when true).
+  bool multipath = false;
 };
 
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).

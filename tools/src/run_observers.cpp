@@ -20,13 +20,13 @@ double ResidentMegabytes() {
 
 RunFilesObserver::RunFilesObserver(const std::filesystem::path& out,
                                    const std::optional<std::filesystem::path>& detections,
-                                   std::size_t trace_mode, const std::string& focus)
+                                   bool multipath, std::size_t trace_mode, const std::string& focus)
     : truth_(out / "ground_truth.csv"),
       grid_(out / "grid.csv"),
       clusters_(out / "clusters.csv"),
       trace_mode_(trace_mode),
       traces_(focus) {
-  if (detections) detections_ = std::make_unique<DetectionWriter>(*detections);
+  if (detections) detections_ = std::make_unique<DetectionWriter>(*detections, multipath);
 }
 
 void RunFilesObserver::OnStep(const cosim::StepView& v) {

@@ -24,11 +24,12 @@ namespace dualgrid::tools {
 /// mode.
 class RunFilesObserver : public cosim::StepObserver {
  public:
-  /// `detections`: the file for --detections, none if empty. `trace_mode`: the mode whose
-  /// particles give the weight traces (paper Fig. 4); `focus`: the scenario's focus object.
+  /// `detections`: the file for --detections, none if empty; `multipath`: the scenario's
+  /// sensors.multipath is on (the detections get their path columns). `trace_mode`: the mode
+  /// whose particles give the weight traces (paper Fig. 4); `focus`: the scenario's focus object.
   RunFilesObserver(const std::filesystem::path& out,
-                   const std::optional<std::filesystem::path>& detections, std::size_t trace_mode,
-                   const std::string& focus);
+                   const std::optional<std::filesystem::path>& detections, bool multipath,
+                   std::size_t trace_mode, const std::string& focus);
   void OnStep(const cosim::StepView& v) override;
   /// Checks every write (throws std::runtime_error naming the file).
   void Close();

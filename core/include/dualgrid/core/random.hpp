@@ -16,6 +16,7 @@ namespace dualgrid {
 enum class RngPurpose : std::uint32_t {
   kRadarScatter = 1,
   kRadarClutter = 2,
+  kRadarGhost = 3,  ///< resolution cells holding multipath ghosts only
   kFilterPredict = 10,
   kFilterBirth = 11,
   kFilterResample = 12,

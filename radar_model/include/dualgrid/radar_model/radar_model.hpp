@@ -5,27 +5,39 @@
 #include <cstdint>
 #include <vector>
 
+#include "dualgrid/radar_model/multipath.hpp"
 #include "dualgrid/radar_model/scene.hpp"
 #include "dualgrid/radar_model/sensor_model.hpp"
 #include "dualgrid/radar_model/sensor_params.hpp"
 
 namespace dualgrid::radar {
 
-/// Switches for the individual effects (YAML: radar: {noise, false_alarms, occlusion}).
+/// Switches for the individual effects (YAML: sensors: {noise, false_alarms, occlusion,
+/// multipath}).
 struct ModelOptions {
-  bool noise = true;         ///< measurement noise on range, azimuth, range rate
-  bool false_alarms = true;  ///< clutter detections
-  bool occlusion = true;     ///< nearer boxes / rails hide scatterers behind them
+  bool noise = true;          ///< measurement noise on range, azimuth, range rate
+  bool false_alarms = true;   ///< clutter detections
+  bool occlusion = true;      ///< nearer boxes / rails hide scatterers behind them
+  MultipathParams multipath;  ///< ghosts off rails and truck flanks (off by default)
 };
 
 /// A point scatterer as seen by one sensor (after field of view, range, range-rate window and
-/// occlusion), before resolution-cell merging. Exposed for tests and diagnostics.
+/// occlusion), before resolution-cell merging: a direct return or a multipath ghost of one point
+/// of a box. Exposed for tests and diagnostics.
 struct Scatterer {
-  Position position = Position::Zero();  ///< world
-  Velocity velocity = Velocity::Zero();  ///< world, over ground
-  double rcs_m2 = 0.0;                   ///< linear share of the source's RCS
-  Polar truth{};                         ///< noise-free polar in the sensor frame
-  int source_id = -1;
+  /// World; for a ghost, where the radar places it (its path's range along its arrival
+  /// direction).
+  Position position = Position::Zero();
+  Velocity velocity = Velocity::Zero();  ///< world, over ground, of the real scattering point
+  /// Linear share of the source's RCS [m^2]; for a ghost times its path's losses, so that
+  /// SensorModel::SnrLinear(rcs_m2, truth.range) is the path's SNR.
+  double rcs_m2 = 0.0;
+  Polar truth{};       ///< noise-free polar in the sensor frame (a ghost's apparent one)
+  int source_id = -1;  ///< the real object (target or polyline id)
+  Path path = Path::kDirect;
+  int bounces = 1;                     ///< 1 direct, 2 or 3 for a ghost
+  int reflector_id = -1;               ///< the mirror's polyline or target id; -1 direct
+  Position origin = Position::Zero();  ///< the real scattering point, world
 };
 
 class RadarModel {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/radar_model/multipath.hpp"
 
 namespace dualgrid::radar {
 
@@ -56,8 +57,17 @@ struct Detection {
   /// radial_speed_compensated times the world line-of-sight unit vector (paper eq. (1)).
   Velocity radial_velocity_world = Velocity::Zero();
   Position sensor_position_world = Position::Zero();
-  int source_id = -1;  ///< target or polyline id of the strongest scatterer; -1 = clutter
+  /// Target or polyline id of the strongest scatterer of the cell when it is a direct return;
+  /// -1 for clutter and for ghosts (a ghost is never its object: see ghost_of).
+  int source_id = -1;
   bool is_clutter = false;
+  /// Multipath labels of the strongest scatterer (docs/radar.md, "Multipath"): the path, its
+  /// number of bounces (1 direct and clutter, 2 or 3), the mirror's polyline or target id and
+  /// the real object whose ghost it is (-1 when direct).
+  Path path = Path::kDirect;
+  int bounces = 1;
+  int reflector_id = -1;
+  int ghost_of = -1;
 };
 
 }  // namespace dualgrid::radar
