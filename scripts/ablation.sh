@@ -8,6 +8,8 @@
 #   scripts/ablation.sh OUT particles   3,000 and 30,000 particles for the presets and the default
 #   scripts/ablation.sh OUT paper       the paper preset on the highway, PAPER_SEEDS (10) seeds
 #   scripts/ablation.sh OUT doppler     highway: Doppler accuracy 0.03-1 m/s, default and paper
+#   scripts/ablation.sh OUT fit         the velocity fit to neighbouring Dopplers (issue 28): births,
+#                                       likelihood, both, on the default preset; 4 scenarios
 #   scripts/ablation.sh OUT table       Markdown tables of everything measured so far (stdout)
 #   scripts/ablation.sh OUT all         all of the above
 #
@@ -81,6 +83,20 @@ stage_switches() {
 stage_dualgrid() {
   for scen in "${SCENARIOS[@]}"; do
     experiment "$scen" preset_dualgrid "$SEEDS" yes --set filter.preset=dualgrid
+  done
+}
+# The fit of one velocity to the Doppler of neighbouring detections (docs/algorithm.md, "Births"
+# and eq. 8), each use alone and both, against the preset without it (radial, Doppler births).
+stage_fit() {
+  for scen in "${SCENARIOS[@]}"; do
+    local base=(--set filter.preset=dualgrid --set filter.birth_velocity=doppler
+      --set filter.velocity_likelihood=radial)
+    experiment "$scen" fit_none "$SEEDS" no "${base[@]}"
+    experiment "$scen" fit_births "$SEEDS" no "${base[@]}" --set filter.birth_velocity=doppler_fit
+    experiment "$scen" fit_likelihood "$SEEDS" no "${base[@]}" \
+      --set filter.velocity_likelihood=radial_fit
+    experiment "$scen" fit_both "$SEEDS" no "${base[@]}" --set filter.birth_velocity=doppler_fit \
+      --set filter.velocity_likelihood=radial_fit
   done
 }
 stage_particles() {
@@ -168,6 +184,7 @@ case $STAGE in
   particles) stage_particles ;;
   paper) stage_paper ;;
   doppler) stage_doppler ;;
+  fit) stage_fit ;;
   table) stage_table ;;
   all) stage_switches; stage_dualgrid; stage_particles; stage_paper; stage_doppler; stage_table ;;
   *) echo "scripts/ablation.sh: unknown stage '$STAGE'" >&2; exit 2 ;;

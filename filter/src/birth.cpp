@@ -125,6 +125,12 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   const double vt_max = std::min(
       vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed - v_radial * v_radial)));
   const bool uniform = params_.birth_velocity == BirthVelocity::kUniform;
+  // doppler_fit: where the fit knows the tangential part better than the uniform draw (whose
+  // standard deviation is vt_max / sqrt(3)), births draw it from the fit, but for a share kept
+  // uniform (FitDetectionVelocities).
+  const bool fitted = params_.birth_velocity == BirthVelocity::kDopplerFit &&
+                      det_fit_sd_[j] < vt_max / std::sqrt(3.0);
+  const double fit_t = fitted ? det_fit_t_[j] : 0.0, fit_sd = fitted ? det_fit_sd_[j] : 0.0;
   constexpr std::int64_t kBatch = 64;
   alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
   for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
@@ -147,10 +153,13 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
         const double angle = 2.0 * kPi * detail::ToUnit24(raw2[1][t]);
         v = speed * Vector2(std::cos(angle), std::sin(angle));
       } else {
-        // Radial component from the Doppler, tangential one unobservable: sampled uniformly,
-        // within what keeps the speed at most max_speed.
-        v = (v_radial + params_.birth_sigma_radial * n0) * los +
-            vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0) * tangent;
+        // Radial component from the Doppler, tangential one unobservable by this detection:
+        // sampled uniformly, within what keeps the speed at most max_speed, or from the fit.
+        // (Draw 5 and the second normal are used by doppler_fit only: doppler is unchanged.)
+        double vt = vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0);
+        if (fitted && detail::ToUnit24(raw2[1][t]) >= params_.birth_fit_uniform_share)
+          vt = std::clamp(fit_t + fit_sd * n1, -vt_max, vt_max);
+        v = (v_radial + params_.birth_sigma_radial * n0) * los + vt * tangent;
       }
       births_.vx[k] = v.x();
       births_.vy[k] = v.y();

@@ -89,9 +89,12 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   }
   PredictAndSort(dt);                            // 2. prediction, 3. assignment
   BuildMeasurementGrid(measurements, coverage);  // 4. measurement grid
-  UpdateCells(measurements);                     // 5.-6. occupancy update, weights, 9. statistics
-  Birth(measurements);                           // 7. birth
-  Resample();                                    // 8. resampling
+  if (params_.birth_velocity == BirthVelocity::kDopplerFit ||
+      params_.velocity_likelihood == VelocityLikelihood::kRadialFit)
+    FitDetectionVelocities(measurements);  // 4a. velocity fit to neighbouring Dopplers
+  UpdateCells(measurements);               // 5.-6. occupancy update, weights, 9. statistics
+  Birth(measurements);                     // 7. birth
+  Resample();                              // 8. resampling
   ++step_;
 }
 

@@ -44,11 +44,15 @@ std::optional<E> ValueOf(const std::pair<E, std::string_view> (&table)[N], std::
   return std::nullopt;
 }
 constexpr std::pair<BirthVelocity, std::string_view> kBirthNames[] = {
-    {BirthVelocity::kDoppler, "doppler"}, {BirthVelocity::kUniform, "uniform"}};
+    {BirthVelocity::kDoppler, "doppler"},
+    {BirthVelocity::kUniform, "uniform"},
+    {BirthVelocity::kDopplerFit, "doppler_fit"}};
 constexpr std::pair<ZeroLikelihood, std::string_view> kZeroNames[] = {
     {ZeroLikelihood::kKeepPrediction, "keep_prediction"}, {ZeroLikelihood::kLiteral, "literal"}};
 constexpr std::pair<VelocityLikelihood, std::string_view> kLikelihoodNames[] = {
-    {VelocityLikelihood::kVector, "vector"}, {VelocityLikelihood::kRadial, "radial"}};
+    {VelocityLikelihood::kVector, "vector"},
+    {VelocityLikelihood::kRadial, "radial"},
+    {VelocityLikelihood::kRadialFit, "radial_fit"}};
 constexpr std::pair<Normalisation, std::string_view> kNormNames[] = {
     {Normalisation::kPerCell, "per_cell"}, {Normalisation::kLiteral, "literal"}};
 
@@ -121,6 +125,9 @@ bool FilterParams::IsValid(std::string* error) const {
   c.NonNegative("birth_max_tangential_speed", birth_max_tangential_speed, "m/s");
   c.Positive("max_speed", max_speed, "m/s");
   c.NonNegative("birth_sigma_radial", birth_sigma_radial, "m/s");
+  c.Positive("doppler_fit_radius", doppler_fit_radius, "m");
+  c.Positive("doppler_fit_sigma", doppler_fit_sigma, "m/s");
+  c.InRange("birth_fit_uniform_share", birth_fit_uniform_share, 0.0, 1.0);
   c.Positive("sigma_f", sigma_f, "m");
   c.Positive("sigma_static_distance", sigma_static_distance, "m");
   c.Positive("sigma_static_velocity", sigma_static_velocity, "m/s");
@@ -143,11 +150,12 @@ bool FilterParams::IsValid(std::string* error) const {
     c.Expect(name != "unknown", field, std::to_string(static_cast<int>(value)), expected);
   };
   check_enum("mode", mode, ToString(mode), "position, velocity or dual");
-  check_enum("birth_velocity", birth_velocity, ToString(birth_velocity), "doppler or uniform");
+  check_enum("birth_velocity", birth_velocity, ToString(birth_velocity),
+             "doppler, uniform or doppler_fit");
   check_enum("zero_likelihood", zero_likelihood, ToString(zero_likelihood),
              "keep_prediction or literal");
   check_enum("velocity_likelihood", velocity_likelihood, ToString(velocity_likelihood),
-             "vector or radial");
+             "vector, radial or radial_fit");
   check_enum("normalisation", normalisation, ToString(normalisation), "per_cell or literal");
   return c.Done(error);
 }

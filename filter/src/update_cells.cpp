@@ -39,9 +39,25 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     det_los_[3 * j + 1] = u.y();
     det_los_[3 * j + 2] = z[j].radial_velocity.dot(u);
   }
+  // radial_fit: per detection 1 / (2 (sigma_v^2 + s_t^2)) of the tangential term, 0 where no fit.
+  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  if (radial_fit) {
+    if (static_cast<int>(det_fit_k_.size()) < nz) det_fit_k_.resize(nz);  // grow only
+    for (int j = 0; j < nz; ++j) {
+      const double s2 = p.sigma_v * p.sigma_v + det_fit_sd_[j] * det_fit_sd_[j];
+      det_fit_k_[j] = std::isfinite(s2) ? 0.5 / s2 : 0.0;
+    }
+  }
+  const double* const fit_k = det_fit_k_.data();
+  const double* const fit_t = det_fit_t_.data();
+  // The static hypothesis (v = 0) is scored by the same f_v: under radial_fit its tangential
+  // part 0 against the fit's v_t as well, so a fitted crossing car is not taken for static.
+  if (radial_fit)
+    for (int j = 0; j < nz; ++j)
+      if (fit_k[j] > 0.0) det_fv0_[j] *= ExpUnder(-fit_t[j] * fit_t[j] * fit_k[j]);
   const double* const fv0_of = det_fv0_.data();
   const double* const los_of = det_los_.data();
-  const bool radial = p.velocity_likelihood == VelocityLikelihood::kRadial;
+  const bool radial = p.velocity_likelihood != VelocityLikelihood::kVector;
   const bool literal_norm = p.normalisation == Normalisation::kLiteral;
   const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
   const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
@@ -190,6 +206,10 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
               const double* u = los_of + 3 * jn;
               const double e = q.vx[i] * u[0] + q.vy[i] * u[1] - u[2];
               e2 = e * e;
+              if (radial_fit && fit_k[jn] > 0.0) {  // along the tangent (-u_y, u_x): the fit
+                const double et = -q.vx[i] * u[1] + q.vy[i] * u[0] - fit_t[jn];
+                e2 += et * et * fit_k[jn] / inv_2v2;  // in units of sigma_v^2
+              }
             } else {  // eq. (8): the full vector against mu_v = (v_rx, v_ry)
               const double ex = q.vx[i] - z[jn].radial_velocity.x();
               const double ey = q.vy[i] - z[jn].radial_velocity.y();

@@ -86,6 +86,12 @@ Enum-like fields are strings.)doc");
         "radial speed exceeds it, and births never exceed it.");
   Field(cls, names, "birth_sigma_radial", &FilterParams::birth_sigma_radial,
         "Radial birth speed noise around the Doppler [m/s].");
+  Field(cls, names, "doppler_fit_radius", &FilterParams::doppler_fit_radius,
+        "doppler_fit / radial_fit: detections within this radius share one velocity [m].");
+  Field(cls, names, "doppler_fit_sigma", &FilterParams::doppler_fit_sigma,
+        "doppler_fit / radial_fit: noise floor of a detection's radial speed in the fit [m/s].");
+  Field(cls, names, "birth_fit_uniform_share", &FilterParams::birth_fit_uniform_share,
+        "birth_velocity 'doppler_fit': share of births kept uniform tangentially [probability].");
   // Measurement kernels.
   Field(cls, names, "sigma_f", &FilterParams::sigma_f, "Width of f_d, eq. (2) [m].");
   Field(cls, names, "sigma_static_distance", &FilterParams::sigma_static_distance,
@@ -121,7 +127,8 @@ Enum-like fields are strings.)doc");
       "Weight that drives resampling: eq. (7), eq. (8) or both (eq. 14).");
   EnumField(cls, names, "birth_velocity", &FilterParams::birth_velocity,
             &filter::ParseBirthVelocity,
-            {filter::BirthVelocity::kDoppler, filter::BirthVelocity::kUniform},
+            {filter::BirthVelocity::kDoppler, filter::BirthVelocity::kUniform,
+             filter::BirthVelocity::kDopplerFit},
             "Velocity of new-born particles (switch; docs/algorithm.md).");
   EnumField(cls, names, "zero_likelihood", &FilterParams::zero_likelihood,
             &filter::ParseZeroLikelihood,
@@ -129,8 +136,10 @@ Enum-like fields are strings.)doc");
             "Eq. (7) in an observed cell where every hypothesis scores 0 (switch).");
   EnumField(cls, names, "velocity_likelihood", &FilterParams::velocity_likelihood,
             &filter::ParseVelocityLikelihood,
-            {filter::VelocityLikelihood::kVector, filter::VelocityLikelihood::kRadial},
-            "f_v of eq. (8): the full vector or only the line-of-sight component (switch).");
+            {filter::VelocityLikelihood::kVector, filter::VelocityLikelihood::kRadial,
+             filter::VelocityLikelihood::kRadialFit},
+            "f_v of eq. (8): the full vector, only the line-of-sight component, or that and the "
+            "tangential part of a fit to neighbouring Dopplers (switch).");
   EnumField(cls, names, "normalisation", &FilterParams::normalisation, &filter::ParseNormalisation,
             {filter::Normalisation::kPerCell, filter::Normalisation::kLiteral},
             "Joint normalisation of eqs. (9)-(12) (switch).");

@@ -224,6 +224,9 @@ const Field<FP, double> kFilterDoubles[] = {
     {"birth_probability", &FP::birth_probability},
     {"birth_max_tangential_speed", &FP::birth_max_tangential_speed},
     {"birth_sigma_radial", &FP::birth_sigma_radial},
+    {"doppler_fit_radius", &FP::doppler_fit_radius},
+    {"doppler_fit_sigma", &FP::doppler_fit_sigma},
+    {"birth_fit_uniform_share", &FP::birth_fit_uniform_share},
     {"max_speed", &FP::max_speed},
     {"sigma_f", &FP::sigma_f},
     {"sigma_static_distance", &FP::sigma_static_distance},
@@ -531,11 +534,11 @@ void ReadFilter(MapReader& root, ScenarioConfig* config) {
   f->mode = *parsed;
   ReadSwitch(*r, "zero_likelihood", filter::ParseZeroLikelihood, "'keep_prediction' or 'literal'",
              &f->zero_likelihood);
-  ReadSwitch(*r, "velocity_likelihood", filter::ParseVelocityLikelihood, "'vector' or 'radial'",
-             &f->velocity_likelihood);
+  ReadSwitch(*r, "velocity_likelihood", filter::ParseVelocityLikelihood,
+             "'vector', 'radial' or 'radial_fit'", &f->velocity_likelihood);
   ReadSwitch(*r, "normalisation", filter::ParseNormalisation, "'per_cell' or 'literal'",
              &f->normalisation);
-  constexpr const char* kBirthNames = "'doppler' or 'uniform'";
+  constexpr const char* kBirthNames = "'doppler', 'uniform' or 'doppler_fit'";
   if (r->IsMap("birth_velocity")) {
     // Per mode: {position: uniform, velocity: doppler, dual: doppler}.
     auto per_mode = r->Map("birth_velocity");

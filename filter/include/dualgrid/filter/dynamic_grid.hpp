@@ -149,6 +149,9 @@ class DynamicGrid {
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
   void Birth(std::span<const Measurement> z);
+  // doppler_fit / radial_fit: per detection, the tangential velocity that a robust fit to the
+  // Doppler of its neighbours gives, and its standard deviation (inf: no fit).
+  void FitDetectionVelocities(std::span<const Measurement> z);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                       std::int64_t k_hi, double mass, double r, double vmax);
@@ -198,7 +201,10 @@ class DynamicGrid {
   std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
   std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
-  std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
+  std::vector<double> reframe_layers_;          // Reframe: the old free, static and dynamic layers
+  std::vector<double> det_fit_t_, det_fit_sd_;  // FitDetectionVelocities: per detection [m/s]
+  std::vector<double> det_fit_los_,
+      det_fit_k_;  // FitDetectionVelocities: u_x, u_y, v_r per detection
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {

@@ -28,6 +28,10 @@ std::optional<WeightMode> ParseWeightMode(std::string_view name);
 enum class BirthVelocity {
   kDoppler,  ///< radial part from the detection's Doppler, tangential part uniform.
   kUniform,  ///< uniform in the disc |v| <= max_speed: no Doppler reaches position mode at all.
+  /// Radial part from the detection's Doppler; tangential part from a robust least-squares fit
+  /// of one velocity to the Doppler of every detection within doppler_fit_radius (all sensors)
+  /// where the fit determines it better than the uniform draw, else uniform (docs/algorithm.md).
+  kDopplerFit,
 };
 /// Eq. (7) in an observed cell where every hypothesis scores 0 (no detection near any of them).
 enum class ZeroLikelihood {
@@ -39,6 +43,11 @@ enum class VelocityLikelihood {
   kVector,  ///< the paper: N(v_p; mu_v = (v_rx, v_ry), sigma_v^2 I) on the full velocity vector.
   kRadial,  ///< N(v_p . u; v_r, sigma_v^2): only the particle's line-of-sight component, the part
             ///< a Doppler measures (u: unit line of sight, v_r: compensated radial speed).
+  /// kRadial times N(v_p . t; v_t, sigma_v^2 + s_t^2) along the detection's tangent t, where a
+  /// robust fit of one velocity to the Doppler of the detections within doppler_fit_radius (all
+  /// sensors) gives its tangential part v_t with standard deviation s_t (docs/algorithm.md).
+  /// Where the lines of sight do not spread, s_t is large and this is kRadial.
+  kRadialFit,
 };
 /// The joint normalisation of eqs. (9)-(12).
 enum class Normalisation {
@@ -79,6 +88,16 @@ struct FilterParams {
   /// compensated radial speed exceeds it (clutter), and births never exceed it.
   double max_speed = 50.0;
   double birth_sigma_radial = 0.5;  ///< Radial birth speed noise around Doppler [m/s].
+  // birth_velocity: doppler_fit and velocity_likelihood: radial_fit. The detections of one object
+  // within this radius [m] (about a car's length across) share one velocity; their Doppler along
+  // different lines of sight fits it.
+  double doppler_fit_radius = 3.0;
+  /// Noise floor of a detection's compensated radial speed in the fit [m/s]: the radars' range
+  /// rate accuracy (0.10-0.12 m/s, docs/radar.md); the fit's own residual scale when larger.
+  double doppler_fit_sigma = 0.1;
+  /// Share of births that keep the uniform tangential draw where a fit exists (a defensive
+  /// mixture: a fit biased by another object's detections must not remove the truth).
+  double birth_fit_uniform_share = 0.25;
 
   // Measurement kernels (all scaled to peak 1, see docs/algorithm.md).
   double sigma_f = 0.6;                ///< f_d width, eq. (2) [m].
