@@ -24,7 +24,6 @@ if(NOT TARGET SUMO::libsumocpp)
   message(STATUS "SUMO's CMake config not found (package sumo-tools); using ${LIBSUMO_LIBRARY}")
 endif()
 find_package(ZLIB REQUIRED)
-
 find_package(EXPAT REQUIRED)  # users' SUMO files, parsed streaming (sim/xml_scan.hpp)
 find_package(PkgConfig REQUIRED)
 if(NOT TARGET PkgConfig::CAIRO)

@@ -42,13 +42,14 @@ Velocity TrackVelocity(const std::vector<TrackSample>& s) {
     b += x.vr * x.u;
   }
   const double n = static_cast<double>(s.size());
+  const double det_a = a(0, 0) * a(1, 1) - a(0, 1) * a(1, 0);
   // Smallest eigenvalue of the mean u u^T: sin^2 of the lines of sight's spread, roughly. 0.02
   // is a spread of about 8 degrees, where a 0.1 m/s Doppler error becomes ~0.7 m/s across.
-  const double tr = a.trace() / n, det = a.determinant() / (n * n);
+  const double tr = a.trace() / n, det = det_a / (n * n);
   const double lambda_min = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
   if (s.size() >= 2 && lambda_min >= 0.02) {  // A v = b, 2 x 2 (A symmetric, det > 0 here)
     return Vector2(a(1, 1) * b.x() - a(0, 1) * b.y(), a(0, 0) * b.y() - a(1, 0) * b.x()) /
-           a.determinant();
+           det_a;
   }
   // Centroids per distinct time.
   std::vector<std::pair<double, Position>> c;

@@ -165,6 +165,11 @@ rec_case empty_sequence 2 "scenes.json: key 'scenes': no scenes (an empty sequen
 rec_case truncated 2 "radar_data.h5"
 rec_case bad_sensor 2 "sensor_id': 7 has no radar_7 in sensors.json"
 rec_case not_json 2 "scenes.json: not valid JSON"
+rec_case sensors_not_number 2 "sensors.json: key 'radar_2.x': expected a finite number, got \"front\""
+rec_case missing_h5 2 "sequence_1/radar_data.h5: missing"
+rec_case label_out_of_range 2 "field 'label_id': 12 at row"
+rec_case row_timestamp 2 "field 'timestamp': 1600000000000001 at row 0"
+rec_case float_timestamp 2 "field 'timestamp': expected an integer, got a float"
 # NaN positions and velocities (the last detections of some published sequences): skipped and
 # counted in summary.json's input.skipped_detections, the run goes on.
 "$py" "$repo/tests/recorded/make_radarscenes.py" --out "$work/rs_nan" --duration 1 --mutate nan_detections >/dev/null

@@ -7,6 +7,12 @@ a car (track 'car-1', label 0) drives 14 m/s on the lane to its left, starting 1
 rows of static reflectors (label 11) line the road. Four corner radars at RadarScenes' default
 mounting scan at about 13 Hz each, staggered, with float32 fields where the data set has them.
 
+--widths narrow|wide: the field types. narrow (default) as the published files: float32 where
+the data set has it, uint64 timestamps, uint8 sensor and label ids, fixed-length bytes. wide:
+every float a float64 (x_seq big-endian), int64 timestamps and sensor ids, big-endian int16
+labels, variable-length bytes for uuid and track_id; the values are the narrow file's (rounded
+through float32 first), so a reader that converts widths correctly reads both the same.
+--labels none: without label_id and track_id (unlabelled data).
 --mutate KIND writes a broken variant (tests/hostile): see MUTATIONS.
 """
 import argparse
@@ -23,7 +29,8 @@ EGO_SPEED, HEADING = 10.0, 0.3
 CAR_SPEED, CAR_LEN, CAR_WID = 14.0, 4.5, 1.8
 MUTATIONS = ["missing_dataset", "missing_field", "wrong_type", "index_out_of_range",
              "index_overlap", "odometry_not_increasing", "nan_detections", "nan_odometry",
-             "empty_sequence", "truncated", "bad_sensor", "not_json"]
+             "empty_sequence", "truncated", "bad_sensor", "not_json", "sensors_not_number",
+             "missing_h5", "label_out_of_range", "row_timestamp", "float_timestamp"]
 
 
 def rot(a):
@@ -41,7 +48,26 @@ def car_centre(t):
     return ego_rear(0.0) + (14.0 + CAR_SPEED * t) * d + 3.5 * left
 
 
-def make(out, duration, seed):
+# Field types per --widths (radar_data, odometry); the rest of both datasets are float64.
+VLEN_BYTES = h5py.vlen_dtype(bytes)
+NARROW = {"timestamp": "<u8", "sensor_id": "u1", "range_sc": "<f4", "azimuth_sc": "<f4",
+          "rcs": "<f4", "vr": "<f4", "vr_compensated": "<f4", "x_cc": "<f4", "y_cc": "<f4",
+          "x_seq": "<f8", "y_seq": "<f8", "uuid": "S32", "track_id": "S32", "label_id": "u1"}
+WIDE = {"timestamp": "<i8", "sensor_id": "<i8", "range_sc": "<f8", "azimuth_sc": "<f8",
+        "rcs": "<f8", "vr": "<f8", "vr_compensated": "<f8", "x_cc": "<f8", "y_cc": "<f8",
+        "x_seq": ">f8", "y_seq": "<f8", "uuid": VLEN_BYTES, "track_id": VLEN_BYTES,
+        "label_id": ">i2"}
+ODO_NARROW = {"timestamp": "<u8", "vx": "<f4", "yaw_rate": "<f4"}
+ODO_WIDE = {"timestamp": "<i8", "vx": "<f8", "yaw_rate": "<f8"}
+ODO_FIELDS = ["timestamp", "x_seq", "y_seq", "yaw_seq", "vx", "yaw_rate"]
+
+
+def f32(v):
+    """The value as the narrow file stores it (float32), as a float64."""
+    return float(np.float32(v))
+
+
+def make(out, duration, seed, widths="narrow", labels=True):
     rng = np.random.default_rng(seed)
     root = out
     seq_dir = os.path.join(root, "data", "sequence_1")
@@ -55,8 +81,8 @@ def make(out, duration, seed):
     t0 = 1_600_000_000_000_000  # microseconds, like the data set's
     # Odometry at 100 Hz.
     odo_t = t0 + np.arange(0, int(duration * 1e6) + 20_000, 10_000, dtype=np.uint64)
-    odo = np.zeros(len(odo_t), dtype=[("timestamp", "<u8"), ("x_seq", "<f8"), ("y_seq", "<f8"),
-                                      ("yaw_seq", "<f8"), ("vx", "<f4"), ("yaw_rate", "<f4")])
+    odo_types = ODO_WIDE if widths == "wide" else ODO_NARROW
+    odo = np.zeros(len(odo_t), dtype=[(n, odo_types.get(n, "<f8")) for n in ODO_FIELDS])
     odo["timestamp"] = odo_t
     for i, t in enumerate(odo_t):
         p = ego_rear((int(t) - t0) / 1e6)
@@ -98,8 +124,9 @@ def make(out, duration, seed):
             vr_comp = float(vel @ u) + rng.normal(0, 0.05)
             vr = vr_comp - float(v_ego @ u)
             cc = rot(yaw).T @ (p - rear)
-            rows.append((ts, k, rng_m, az, rng.uniform(-10, 10), vr, vr_comp, cc[0], cc[1],
-                         p[0], p[1], rng.bytes(16).hex().encode(), track, label))
+            rows.append((ts, k, f32(rng_m), f32(az), f32(rng.uniform(-10, 10)), f32(vr),
+                         f32(vr_comp), f32(cc[0]), f32(cc[1]), p[0], p[1],
+                         rng.bytes(16).hex().encode(), track, label))
 
         c = car_centre(t)
         for _ in range(rng.integers(3, 7)):
@@ -122,11 +149,12 @@ def make(out, duration, seed):
         if e["sensor_id"] in last_same:
             scene_entries[last_same[e["sensor_id"]]]["next_timestamp_same_sensor"] = ts
         last_same[e["sensor_id"]] = ts
-    dtype = [("timestamp", "<u8"), ("sensor_id", "u1"), ("range_sc", "<f4"),
-             ("azimuth_sc", "<f4"), ("rcs", "<f4"), ("vr", "<f4"), ("vr_compensated", "<f4"),
-             ("x_cc", "<f4"), ("y_cc", "<f4"), ("x_seq", "<f8"), ("y_seq", "<f8"),
-             ("uuid", "S32"), ("track_id", "S32"), ("label_id", "u1")]
-    radar = np.array(rows, dtype=dtype)
+    types = WIDE if widths == "wide" else NARROW
+    names = list(NARROW)
+    radar = np.array(rows, dtype=[(n, types[n]) for n in names])
+    if not labels:
+        keep = [n for n in names if n not in ("track_id", "label_id")]
+        radar = np.array(radar[keep].tolist(), dtype=[(n, types[n]) for n in keep])
     scenes = {"sequence_name": "sequence_1", "first_timestamp": keys[0],
               "last_timestamp": keys[-1], "scenes": {str(t): scene_entries[t] for t in keys}}
     return seq_dir, radar, odo, scenes
@@ -144,8 +172,9 @@ def mutate(kind, seq_dir, radar, odo, scenes):
     first = scenes["scenes"][str(scenes["first_timestamp"])]
     second_key = sorted(int(k) for k in scenes["scenes"])[1]
     if kind == "missing_dataset":
+        write(seq_dir, radar, odo, scenes)
         with h5py.File(os.path.join(seq_dir, "radar_data.h5"), "w") as f:
-            f.create_dataset("radar_data", data=radar)
+            f.create_dataset("radar_data", data=radar)  # no odometry
         return
     if kind == "missing_field":
         names = [n for n in radar.dtype.names if n != "x_seq"]
@@ -172,7 +201,22 @@ def mutate(kind, seq_dir, radar, odo, scenes):
         scenes["scenes"] = {}
     elif kind == "bad_sensor":
         first["sensor_id"] = 7
+    elif kind == "label_out_of_range":
+        radar["label_id"][first["radar_indices"][0]] = 12
+    elif kind == "row_timestamp":  # a row of the first scene stamped 1 us later
+        radar["timestamp"][first["radar_indices"][0]] += 1
+    elif kind == "float_timestamp":  # microseconds as float64: not an integer field
+        dt = [(n, "<f8" if n == "timestamp" else radar.dtype[n]) for n in radar.dtype.names]
+        radar = radar.astype(dt)
     write(seq_dir, radar, odo, scenes)
+    if kind == "sensors_not_number":
+        path = os.path.join(os.path.dirname(os.path.dirname(seq_dir)), "sensors.json")
+        sensors = json.load(open(path))
+        sensors["radar_2"]["x"] = "front"
+        with open(path, "w") as f:
+            json.dump(sensors, f)
+    elif kind == "missing_h5":
+        os.remove(os.path.join(seq_dir, "radar_data.h5"))
     if kind == "truncated":
         path = os.path.join(seq_dir, "radar_data.h5")
         size = os.path.getsize(path)
@@ -188,9 +232,11 @@ def main():
     ap.add_argument("--out", required=True, help="dataset root to write")
     ap.add_argument("--duration", type=float, default=6.0, help="[s]")
     ap.add_argument("--seed", type=int, default=7)
+    ap.add_argument("--widths", choices=["narrow", "wide"], default="narrow")
+    ap.add_argument("--labels", choices=["yes", "none"], default="yes")
     ap.add_argument("--mutate", choices=MUTATIONS)
     a = ap.parse_args()
-    seq_dir, radar, odo, scenes = make(a.out, a.duration, a.seed)
+    seq_dir, radar, odo, scenes = make(a.out, a.duration, a.seed, a.widths, a.labels == "yes")
     if a.mutate:
         mutate(a.mutate, seq_dir, radar, odo, scenes)
     else:
