@@ -110,9 +110,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
               TruthClasses(snapshots_[0], pipeline_.grid_frame(), f, pipeline_.config().sim);
         });
       }
-#pragma omp task depend(in                    \
-                        : f_dep[m], t_dep[0]) \
-    shared(errors, truth_error, f, ego_box, score_points)
+#pragma omp task depend(in : f_dep[m], t_dep[0]) shared(errors, truth_error, f, ego_box)
       guarded(errors[m], [&] {
         if (truth_error || errors[m]) return;
         if (m > 0) TakeSnapshot(pipeline_.grid(m), with_velocities, snapshots_[m]);

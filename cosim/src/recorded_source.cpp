@@ -48,8 +48,7 @@ Velocity TrackVelocity(const std::vector<TrackSample>& s) {
   const double tr = a.trace() / n, det = det_a / (n * n);
   const double lambda_min = 0.5 * tr - std::sqrt(std::max(0.0, 0.25 * tr * tr - det));
   if (s.size() >= 2 && lambda_min >= 0.02) {  // A v = b, 2 x 2 (A symmetric, det > 0 here)
-    return Vector2(a(1, 1) * b.x() - a(0, 1) * b.y(), a(0, 0) * b.y() - a(1, 0) * b.x()) /
-           det_a;
+    return Vector2(a(1, 1) * b.x() - a(0, 1) * b.y(), a(0, 0) * b.y() - a(1, 0) * b.x()) / det_a;
   }
   // Centroids per distinct time.
   std::vector<std::pair<double, Position>> c;
