@@ -3,9 +3,10 @@
 // radars at ~13.3 Hz each, about 50 detections per scan, as the published data average) and runs
 // `dualgrid filter`'s loop on it (RecordedSource -> every mode's filter cycle -> scoring, the
 // default recorded grid of 100 m x 60 m and 10,000 particles), without the run folder's files.
-// Counter x_real_time = sequence seconds per wall second; the argument is the number of modes
-// (1: dual alone, 3: position, velocity, dual), side by side in one run.
-//   bench_recorded --benchmark_filter=Recorded
+// Counter x_real_time = sequence seconds per wall second. Arguments: the number of modes (1: dual
+// alone, 3: position, velocity, dual) and the batch window [ms] (1: a cycle per scan, the
+// default; 70: the four radars' scans of one ~75 ms round in one cycle), side by side in one run.
+//   OMP_NUM_THREADS=1 bench_recorded --benchmark_filter=Recorded
 // The end-to-end command (files, figures, replay) is timed in docs/performance.md.
 #include <benchmark/benchmark.h>
 
@@ -109,7 +110,8 @@ void BM_Recorded(benchmark::State& state) {
   for (auto _ : state) {
     const cosim::RecordedSequence seq = recorded::ReadRadarScenes(dir, std::nullopt);
     scenario::ScenarioConfig config = recorded::DefaultRecordedConfig();
-    const cosim::RecordedOptions o = recorded::FitConfig(seq, 0.001, &config);
+    const cosim::RecordedOptions o =
+        recorded::FitConfig(seq, 1e-3 * static_cast<double>(state.range(1)), &config);
     cosim::CoSimulation cs(config, {modes, 0},
                            [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                              return std::make_unique<cosim::RecordedSource>(seq, o);
@@ -126,6 +128,12 @@ void BM_Recorded(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_Recorded)->Arg(1)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Recorded)
+    ->Args({1, 1})
+    ->Args({3, 1})
+    ->Args({1, 70})
+    ->Args({3, 70})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 BENCHMARK_MAIN();
