@@ -29,6 +29,12 @@ find_package(PkgConfig REQUIRED)
 if(NOT TARGET PkgConfig::CAIRO)
   pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET GLOBAL cairo)
 endif()
+# Recorded data (dualgrid::recorded): RadarScenes' HDF5 files through the C library of Debian's
+# libhdf5-dev, by its pkg-config file (CMake's FindHDF5 needs the C language enabled, which
+# neither this project nor a C++ consumer has).
+if(NOT TARGET PkgConfig::HDF5)
+  pkg_check_modules(HDF5 REQUIRED IMPORTED_TARGET GLOBAL hdf5)
+endif()
 find_path(RANDOM123_INCLUDE_DIR Random123/philox.h)
 if(NOT RANDOM123_INCLUDE_DIR)
   message(FATAL_ERROR "Random123 not found (Random123/philox.h): install the Debian package "

@@ -16,6 +16,16 @@ CoSimulation::CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions 
   snapshots_.resize(options.modes.size());
 }
 
+CoSimulation::CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options,
+                           const Pipeline::SourceFactory& make_source)
+    : pipeline_(config, options.modes, make_source), threads_(options.threads) {
+  for (filter::WeightMode m : options.modes) {
+    mode_names_.emplace_back(filter::ToString(m));
+    scorers_.emplace_back(config.evaluation);
+  }
+  snapshots_.resize(options.modes.size());
+}
+
 void CoSimulation::Start(const std::filesystem::path& network_dir,
                          const std::filesystem::path& work_dir) {
   pipeline_.Start(network_dir, work_dir);
@@ -57,6 +67,12 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   omp_set_max_active_levels(per_filter > 1 ? 2 : 1);
   const sim::Frame& f = pipeline_.frame();
   const OrientedBox ego_box = pipeline_.grid_frame().ToGrid(f.ego.box);
+  // Labelled recorded points, scored per mode at their cells.
+  const bool score_points = pipeline_.source().has_labels();
+  point_positions_.clear();
+  if (score_points)
+    for (const radar::Detection& d : pipeline_.detections())
+      point_positions_.push_back(pipeline_.grid_frame().ToGrid(d.position_world));
   // Exceptions must not leave a parallel region: kept per mode, rethrown after it.
   std::vector<std::exception_ptr> errors(modes);
   std::exception_ptr truth_error;
@@ -100,6 +116,9 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
         if (m > 0) TakeSnapshot(pipeline_.grid(m), with_velocities, snapshots_[m]);
         scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
                              ego_box);
+        if (score_points)
+          scorers_[m].AddPoints(pipeline_.grid(m), snapshots_[m], point_positions_,
+                                pipeline_.labels(), ego_box);
       });
     }
   }
@@ -109,8 +128,9 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
 }
 
 bool CoSimulation::finished() const {
-  return pipeline_.started() && steps_ > 0 && pipeline_.simulation().reached_end() &&
-         !pipeline_.simulation().ego_left();
+  const sim::SumoSimulation* sumo = pipeline_.sumo();
+  return pipeline_.started() && steps_ > 0 && pipeline_.source().reached_end() &&
+         !(sumo && sumo->ego_left());
 }
 
 std::vector<eval::ScenarioMetrics> CoSimulation::Metrics() const {

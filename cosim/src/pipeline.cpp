@@ -51,34 +51,40 @@ Pipeline::Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::W
     std::string error;
     if (!s.IsValid(&error)) throw std::invalid_argument("sensor '" + s.name + "': " + error);
   }
+  MakeFilters(true);
+  source_ = std::make_unique<SumoSource>(config_, ids_);
+}
+
+Pipeline::Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::WeightMode> modes,
+                   const SourceFactory& make_source)
+    : config_(config), modes_(std::move(modes)) {
+  CheckFilterMemory(config_, modes_.size());
+  MakeFilters(false);
+  source_ = make_source(config_, ids_);
+  if (!source_) throw std::logic_error("Pipeline: the source factory returned no source");
+}
+
+void Pipeline::MakeFilters(bool cycle_is_step) {
   for (filter::WeightMode m : modes_) {
     filter::FilterParams p = config_.FilterFor(m);
+    if (!cycle_is_step) p.cycle = config_.filter.cycle;
     // The same seed for every mode: birth and prediction noise are identical across modes until
     // their particle sets differ, so the comparison isolates the weights.
     filters_.push_back(std::make_unique<filter::DynamicGrid>(p, config_.sim.seed));
   }
-  for (const auto& g : config_.sim.guard_rails)
-    static_scene_.polylines.push_back({ids_.Id(g.id), g.points, g.rcs_dbsm_per_metre});
-  for (const auto& p : config_.sim.parked)
-    static_scene_.targets.push_back({ids_.Id(p.id), p.box, Velocity::Zero(), 0.0, p.rcs_dbsm});
 }
 
 void Pipeline::Start(const std::filesystem::path& network_dir,
                      const std::filesystem::path& work_dir) {
-  if (simulation_) throw std::logic_error("Pipeline::Start called twice");
-  simulation_ = std::make_unique<sim::SumoSimulation>(
-      config_.sim, sim::ResolveNetwork(config_.sim.network, network_dir), work_dir);
+  if (source_->started()) throw std::logic_error("Pipeline::Start called twice");
+  source_->Start(network_dir, work_dir);
 }
 
-void Pipeline::Finish() {
-  if (simulation_) simulation_->Close();
-}
+void Pipeline::Finish() { source_->Finish(); }
 
-radar::Scene Pipeline::BuildScene() {
-  radar::Scene scene = static_scene_;
-  for (const sim::VehicleState& v : frame().vehicles)
-    scene.targets.push_back({ids_.Id(v.id), v.box, v.velocity, v.yaw_rate, v.rcs_dbsm});
-  return scene;
+const sim::SumoSimulation& Pipeline::simulation() const {
+  if (!source_->sumo()) throw std::logic_error("Pipeline::simulation: this run has no SUMO");
+  return *source_->sumo();
 }
 
 void Pipeline::UpdateFilter(std::size_t i) {
@@ -91,7 +97,7 @@ void Pipeline::UpdateFilter(std::size_t i) {
                       coverage_, dt_);
 }
 
-void Pipeline::FixFrameAndRig(const sim::Frame& f) {
+void Pipeline::FixFrame(const sim::Frame& f) {
   // GridYawAlong: a road along a world axis keeps an exactly world-aligned grid (SUMO's headings
   // carry ~1e-6 deg of rounding). The grid that follows the road starts along the ego's lane,
   // the one that stays fixed along its heading.
@@ -101,23 +107,18 @@ void Pipeline::FixFrameAndRig(const sim::Frame& f) {
                           : frame == Frame::kHeading ? GridYawAlong(ego_.pose.yaw)
                                                      : GridYawAlong(f.ego.lane_yaw));
   centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
-  // The default radars sit on the ego's box as SUMO simulates it: an ego of the user's route
-  // files may not have the scenario type's box (a 5 m SUMO car put the front radar inside it).
-  scenario::RadarConfig rig = config_.radar;
-  scenario::PlaceRigOn(&rig, f.ego.box.length, f.ego.box.width);
-  radar_.emplace(rig.sensors, rig.options, config_.sim.seed);
 }
 
 bool Pipeline::Advance() {
-  if (!simulation_) throw std::logic_error("Pipeline::Advance before Start");
-  if (!simulation_->Step()) return false;
+  if (!source_->started()) throw std::logic_error("Pipeline::Advance before Start");
+  if (!source_->Advance(ids_)) return false;
   const sim::Frame& f = frame();
-  ego_ = {f.EgoPose(), f.ego.velocity, f.ego.yaw_rate, f.ego.box.length, f.ego.box.width};
+  ego_ = source_->ego();
   // The first filter cycle (the ego may depart late) predicts over one step.
-  dt_ = last_time_ > 0.0 ? f.time - last_time_ : config_.sim.step_length;
+  dt_ = !first_step_ ? f.time - last_time_ : source_->first_dt();
   realign_angle_ = 0.0;
-  if (!radar_) {
-    FixFrameAndRig(f);
+  if (first_step_) {
+    FixFrame(f);
   } else if (config_.grid.frame == scenario::GridPlacement::Frame::kFollow) {
     // The road has turned: the grid turns with it (the filters follow in UpdateFilter).
     if (const auto yaw =
@@ -127,11 +128,10 @@ bool Pipeline::Advance() {
       ++realignments_;
     }
   }
+  first_step_ = false;
   last_time_ = f.time;
 
-  detections_ = radar_->Scan(ego_, BuildScene(), static_cast<std::uint64_t>(f.step), f.time,
-                             config_.sim.step_length);
-  scanned_ = radar_->SensorsDue(f.time, config_.sim.step_length);
+  source_->Scan(ids_, &detections_, &scanned_);
 
   if (filters_.empty()) return true;
   measurements_.clear();
@@ -147,8 +147,8 @@ bool Pipeline::Advance() {
   }
   coverage_.clear();
   for (int s : scanned_) {
-    const radar::SensorParams& p = radar_->sensors()[s];
-    const Pose2 pose = radar_->SensorPose(s, ego_.pose);
+    const radar::SensorParams& p = radar().sensors()[s];
+    const Pose2 pose = radar().SensorPose(s, ego_.pose);
     coverage_.push_back(
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
@@ -169,7 +169,7 @@ OrientedBox Pipeline::GridFootprint() const {
 
 std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) const {
   std::vector<eval::TruthObject> out;
-  const auto poses = radar_->SensorPoses(ego_.pose);
+  const auto poses = radar().SensorPoses(ego_.pose);
   // Sources of this step's detections inside the grid: the t_d clock starts at a vehicle's first.
   std::vector<int> detected;
   const GridFrame& g = grid_frame_;
@@ -185,7 +185,7 @@ std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid&
     o.velocity = g.VectorToGrid(v.velocity);
     o.in_grid = grid.CellOf(o.box.center).has_value();
     for (std::size_t s = 0; s < poses.size() && !o.in_coverage; ++s) {
-      const radar::SensorParams& p = radar_->sensors()[s];
+      const radar::SensorParams& p = radar().sensors()[s];
       const Position local = poses[s].ToLocal(v.box.center);
       const double r = local.norm();
       o.in_coverage = r >= p.min_range && r <= p.max_range &&

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "dualgrid/cosim/recorded_source.hpp"
+
 namespace dualgrid::cosim {
 
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s) {
@@ -121,9 +123,26 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   cells_.AddFrame(predicted_, truth_classes, snapshot.observed);
 }
 
+void ModeScorer::AddPoints(const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
+                           const std::vector<Position>& positions, const std::vector<int>& labels,
+                           const OrientedBox& ego_box) {
+  if (!points_) points_.emplace();
+  const BoxTest ego(ego_box);
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if (labels[i] < 0 || ego.Contains(positions[i])) continue;
+    const auto cell = grid.CellOf(positions[i]);
+    const bool dynamic =
+        cell && snapshot.dynamic[static_cast<std::size_t>(cell->y) * snapshot.cells_x + cell->x] >
+                    config_.dynamic_threshold;
+    points_->Add(IsMovingLabel(labels[i]), cell.has_value(), dynamic);
+  }
+  points_->EndFrame();
+}
+
 eval::ScenarioMetrics ModeScorer::Result() const {
   eval::ScenarioMetrics m = tracking_.Result();
   m.cells = cells_.Result();
+  if (points_) m.points = points_->Result();
   return m;
 }
 

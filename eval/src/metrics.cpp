@@ -226,6 +226,7 @@ void to_json(nlohmann::json& j, const ScenarioMetrics& m) {
                      {"duplicate_clusters_per_scan", m.duplicate_clusters_per_scan},
                      {"cells", m.cells ? nlohmann::json(*m.cells) : nlohmann::json(nullptr)},
                      {"objects", m.objects}};
+  if (m.points) j["points"] = *m.points;  // recorded data only: co-simulation files unchanged
 }
 
 void from_json(const nlohmann::json& j, ScenarioMetrics& m) {
@@ -249,6 +250,11 @@ void from_json(const nlohmann::json& j, ScenarioMetrics& m) {
     m.cells = cells->get<CellMetrics>();
   else
     m.cells.reset();
+  const auto points = j.find("points");
+  if (points != j.end() && !points->is_null())
+    m.points = points->get<PointMetrics>();
+  else
+    m.points.reset();
   j.at("objects").get_to(m.objects);
 }
 

@@ -87,6 +87,7 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
+  cycle_params_ = ForCycle(params_, dt);         // per-cycle factors for this dt
   PredictAndSort(dt);                            // 2. prediction, 3. assignment
   BuildMeasurementGrid(measurements, coverage);  // 4. measurement grid
   if (params_.birth_velocity == BirthVelocity::kDopplerFit ||

@@ -102,6 +102,19 @@ double FilterParams::MemoryBytes() const {
   return 93.0 * cells + 88.0 * num_particles + 44.0 * num_birth;
 }
 
+FilterParams ForCycle(const FilterParams& p, double dt) {
+  FilterParams c = p;
+  // The reference cycle keeps the factors bit for bit (no pow(x, 1.0) round trip).
+  if (std::abs(dt - p.cycle) <= 1e-9 * p.cycle) return c;
+  const double r = dt / p.cycle;
+  c.persistence = std::pow(p.persistence, r);
+  c.static_persistence = std::pow(p.static_persistence, r);
+  c.free_decay = std::pow(p.free_decay, r);
+  c.decay_eps = 1.0 - std::pow(1.0 - p.decay_eps, r);
+  c.birth_probability = 1.0 - std::pow(1.0 - p.birth_probability, r);
+  return c;
+}
+
 bool FilterParams::IsValid(std::string* error) const {
   FieldCheck c;
   c.Positive("resolution", resolution, "m");
@@ -145,6 +158,7 @@ bool FilterParams::IsValid(std::string* error) const {
   c.NonNegative("static_gain", static_gain);
   c.NonNegative("static_speed", static_speed, "m/s");
   c.InRange("decay_eps", decay_eps, 0.0, 1.0, Interval::kRightOpen);
+  c.Expect(std::isfinite(cycle) && cycle > 0.0, "cycle", cycle, "finite and > 0 s");
   const auto check_enum = [&](std::string_view field, auto value, std::string_view name,
                               std::string_view expected) {
     c.Expect(name != "unknown", field, std::to_string(static_cast<int>(value)), expected);

@@ -40,7 +40,8 @@ void DynamicGrid::PredictAndSort(double dt) {
       const std::int64_t chunk_hi = (k + 1) * n / chunks;
       for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
         const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
-        detail::PredictRange(particles_, b0, b1, dt, sp, sv, params_.persistence, seed_, step_);
+        detail::PredictRange(particles_, b0, b1, dt, sp, sv, cycle_params_.persistence, seed_,
+                             step_);
         for (std::int64_t i = b0; i < b1; ++i) {
           const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
           const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);

@@ -12,7 +12,8 @@ namespace dualgrid::filter {
 using namespace detail;
 
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
-  const FilterParams& p = params_;
+  // This cycle's factors (persistence, decay, birth probability scaled to dt).
+  const FilterParams& p = cycle_params_;
   const double inv_2sf2 = 0.5 / (p.sigma_f * p.sigma_f);
   const double inv_sd2 = 1.0 / (p.sigma_static_distance * p.sigma_static_distance);
   const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);

@@ -33,6 +33,7 @@ from ._dualgrid import (
     get_num_threads,
     preset,
     preset_names,
+    run_recorded,
     set_num_threads,
 )
 from ._dualgrid import run_scenario as _run_scenario
@@ -139,6 +140,7 @@ __all__ = [
     "installed_network_dir",
     "preset",
     "preset_names",
+    "run_recorded",
     "run_scenario",
     "set_num_threads",
 ]

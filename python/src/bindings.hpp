@@ -14,6 +14,8 @@ void BindRadar(py::module_& m);
 
 /// run_scenario on dualgrid::cosim (cosim_bindings.cpp).
 void BindCosim(py::module_& m);
+/// run_recorded (recorded_bindings.cpp): the filters on a recorded sequence.
+void BindRecorded(py::module_& m);
 
 /// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
 /// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel

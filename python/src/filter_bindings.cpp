@@ -121,6 +121,8 @@ Enum-like fields are strings.)doc");
   Field(cls, names, "static_speed", &FilterParams::static_speed,
         "Particles slower than this vote static [m/s].");
   Field(cls, names, "decay_eps", &FilterParams::decay_eps, "eps of eqs. (7), (8) [1].");
+  Field(cls, names, "cycle", &FilterParams::cycle,
+        "Cycle the per-cycle factors refer to; other dt scale them (ForCycle) [s].");
   EnumField(
       cls, names, "mode", &FilterParams::mode, &filter::ParseWeightMode,
       {filter::WeightMode::kPosition, filter::WeightMode::kVelocity, filter::WeightMode::kDual},

@@ -55,4 +55,5 @@ PYBIND11_MODULE(_dualgrid, m) {
   BindRadar(m);
 
   BindCosim(m);
+  BindRecorded(m);
 }

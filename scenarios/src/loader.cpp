@@ -667,6 +667,8 @@ std::string_view ToString(GridPlacement::Frame f) {
 filter::FilterParams ScenarioConfig::FilterFor(filter::WeightMode mode) const {
   filter::FilterParams p = filter;
   p.mode = mode;
+  // The co-simulation's cycle is its step: the per-cycle factors are per step, as given.
+  p.cycle = sim.step_length;
   if (const auto it = birth_velocity_by_mode.find(mode); it != birth_velocity_by_mode.end())
     p.birth_velocity = it->second;
   return p;

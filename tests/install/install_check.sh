@@ -26,6 +26,7 @@ cmake --build "$work/consumer-build" -j 2 >"$work/consumer-build.log" 2>&1 ||
 out=$("$work/consumer-build/consumer") || fail "the consumer program failed: $out"
 echo "$out"
 grep -q "^filter ok$" <<<"$out" || fail "consumer: no 'filter ok'"
+grep -q "^recorded ok$" <<<"$out" || fail "consumer: no 'recorded ok'"
 grep -Eq "^steps=([1-9][0-9]*) of \1$" <<<"$out" || fail "consumer: the run did not reach its duration"
 grep -Eq "^dual objects=[1-9][0-9]* matches=[1-9]" <<<"$out" || fail "consumer: dual scored nothing"
 grep -q "$moved/share/dualgrid/networks" "$work/consumer-build/CMakeCache.txt" "$work/consumer-build/CMakeFiles/consumer.dir/flags.make" ||

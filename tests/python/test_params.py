@@ -16,7 +16,8 @@ FILTER_FIELDS = [
     "max_speed", "birth_sigma_radial", "sigma_f", "sigma_static_distance",
     "sigma_static_velocity", "sigma_v", "cutoff_sigmas", "occupied_mass", "free_mass",
     "free_mass_no_return", "free_angle_bin", "free_bin_dilation", "free_decay",
-    "static_persistence", "static_gain", "static_speed", "decay_eps", "mode", "birth_velocity",
+    "static_persistence", "static_gain", "static_speed", "decay_eps", "cycle", "mode",
+    "birth_velocity",
     "zero_likelihood", "velocity_likelihood", "normalisation"
 ]
 SWITCHES = ["birth_velocity", "zero_likelihood", "velocity_likelihood", "normalisation"]

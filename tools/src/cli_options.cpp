@@ -24,7 +24,7 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
       ->check(OverrideSpec());
 }
 
-CLI::Validator DetectionFormat() { return CLI::IsMember({"none", "csv", "csv.gz"}); }
+CLI::Validator DetectionFormat() { return CLI::IsMember({"none", "csv", "csv.gz", "exact"}); }
 
 void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
   cmd->add_option("--modes", o->modes,
@@ -45,7 +45,8 @@ void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
   cmd->add_flag_callback(
       "--write-detections", [o] { o->detections = "csv"; }, "Same as --detections csv");
   Opt(cmd, "--detections", &o->detections,
-      "Write the radar detections: none, csv, or csv.gz (gzip, about 3.5x smaller)")
+      "Write the radar detections: none, csv, csv.gz (gzip, about 3.5x smaller), or exact (17 "
+      "digits and scans.csv: the input of `dualgrid filter` and `dualgrid export`)")
       ->check(DetectionFormat());
   cmd->add_flag("--write-particles", o->write_particles,
                 "Write every particle beside each grid picture (figures/particles_*.csv, several "

@@ -38,6 +38,8 @@ Command AddTangentialCommand(CLI::App& app, const CliContext& ctx);
 Command AddRegressCommand(CLI::App& app, const CliContext& ctx);
 Command AddSweepCommand(CLI::App& app, const CliContext& ctx);
 Command AddCollectCommand(CLI::App& app, const CliContext& ctx);
+Command AddFilterCommand(CLI::App& app, const CliContext& ctx);
+Command AddExportCommand(CLI::App& app, const CliContext& ctx);
 
 /// An option whose default is shown in --help.
 template <typename T>

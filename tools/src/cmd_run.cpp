@@ -14,6 +14,7 @@
 #include "figures.hpp"
 #include "output.hpp"
 #include "progress.hpp"
+#include "run_loop.hpp"
 #include "run_observers.hpp"
 #include "run_outputs.hpp"
 #include "signals.hpp"
@@ -70,15 +71,23 @@ std::vector<double> SnapshotTimes(const FilterRunOptions& options,
 int RunFilters(const FilterRunOptions& options) {
   const std::vector<filter::WeightMode> modes = ParseModes(options.modes);
   scenario::ScenarioConfig config = LoadConfig(options.run);
-  const std::vector<double> snapshot_times = SnapshotTimes(options, config);
-  const auto detections_path = DetectionPath(options.run.out, options.detections);
+  SnapshotTimes(options, config);                      // bad --snapshots: before SUMO
+  DetectionPath(options.run.out, options.detections);  // and before the filters' memory
   // Validates (memory, sensors) before anything is written; SUMO starts below.
   cosim::CoSimulation cosim(config, {modes, options.threads});
+  return RunLoop(cosim, config, options, nullptr);
+}
+
+int RunLoop(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
+            const FilterRunOptions& options, const RecordedRun* recorded_run) {
+  const std::vector<filter::WeightMode> modes = ParseModes(options.modes);
+  const std::vector<double> snapshot_times = SnapshotTimes(options, config);
+  const auto detections_path = DetectionPath(options.run.out, options.detections);
   const std::vector<std::string>& mode_names = cosim.mode_names();
   const auto& out = options.run.out;
   PrepareOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
-  CopyScenario(config, out);
+  if (!recorded_run || !config.file.empty()) CopyScenario(config, out);
   WriteTextFile(out / "config.json", ConfigJson(config, options).dump(2) + "\n");
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -89,7 +98,7 @@ int RunFilters(const FilterRunOptions& options) {
   const auto dual = std::find(modes.begin(), modes.end(), filter::WeightMode::kDual);
   const std::size_t trace_mode = dual != modes.end() ? dual - modes.begin() : modes.size() - 1;
   RunFilesObserver files(out, detections_path, config.radar.options.multipath.enabled, trace_mode,
-                         config.evaluation.focus_object);
+                         config.evaluation.focus_object, ExactDetections(options.detections));
   cosim.AddObserver(&files);
   std::optional<RecordingObserver> recording;
   if (options.record) {
@@ -104,7 +113,8 @@ int RunFilters(const FilterRunOptions& options) {
   PictureObserver pictures(out, snapshot_times, options, &warnings);
   cosim.AddObserver(&pictures);
 
-  Progress progress("run " + config.sim.name + " seed " + std::to_string(config.sim.seed),
+  Progress progress((recorded_run ? "filter " : "run ") + config.sim.name + " seed " +
+                        std::to_string(config.sim.seed),
                     config.sim.StepCount(), !options.run.quiet);
   while (!StopSignal() && cosim.Step())
     progress.Update(cosim.steps(), "t=" + FormatFixed(cosim.pipeline().frame().time, 1) + " s");
@@ -145,6 +155,9 @@ int RunFilters(const FilterRunOptions& options) {
   for (std::string& note :
        UnscoredNotes(metrics, ids, config.evaluation.tracking.min_frames_in_grid))
     table.AddNote(std::move(note));
+  if (recorded_run)
+    for (std::string note : RecordedNotes(*recorded_run, mode_names, metrics))
+      table.AddNote(std::move(note));
   WriteTables(table, out);
   const WeightTraces& traces = files.traces();
   const std::string focus = traces.Focus();
@@ -222,13 +235,15 @@ int RunFilters(const FilterRunOptions& options) {
                                             {"x", s.mount.position.x()},
                                             {"y", s.mount.position.y()},
                                             {"yaw_deg", RadToDeg(s.mount.yaw)}});
+  if (recorded_run) summary["input"] = recorded_run->input;
   summary["digests"] = OutputDigests(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!status.empty())
     std::cerr << "dualgrid: " << status << "; results in " << out.string() << "\n";
   if (stop) return StopExitCode();
   if (!options.run.quiet)
-    std::cout << config.sim.name << ": " << steps << " steps in " << FormatFixed(wall, 1)
+    std::cout << config.sim.name << ": " << steps
+              << (recorded_run ? " filter cycles in " : " steps in ") << FormatFixed(wall, 1)
               << " s; results in " << out.string()
               << (warnings.empty() ? ""
                                    : " (" + std::to_string(warnings.size()) +

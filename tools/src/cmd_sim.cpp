@@ -33,7 +33,11 @@ int RunSim(const SimOptions& sim_options) {
   GroundTruthWriter truth(options.out / "ground_truth.csv");
   std::unique_ptr<DetectionWriter> detections;
   const bool multipath = config.radar.options.multipath.enabled;
-  if (detections_path) detections = std::make_unique<DetectionWriter>(*detections_path, multipath);
+  const bool exact = ExactDetections(sim_options.detections);
+  if (detections_path)
+    detections = std::make_unique<DetectionWriter>(*detections_path, multipath, exact);
+  std::unique_ptr<ScanWriter> scans;
+  if (exact) scans = std::make_unique<ScanWriter>(options.out / "scans.csv");
   WriteObstacles(spec, options.out / "obstacles.csv");
 
   struct Seen {
@@ -48,6 +52,7 @@ int RunSim(const SimOptions& sim_options) {
     const sim::Frame& f = pipeline.frame();
     truth.Write(f);
     if (detections) detections->Write(pipeline);
+    if (scans) scans->Write(pipeline);
     detection_count += pipeline.detections().size();
     for (const auto& d : pipeline.detections()) {
       clutter_count += d.is_clutter ? 1 : 0;
@@ -67,6 +72,7 @@ int RunSim(const SimOptions& sim_options) {
   progress.Finish();
   truth.Close();
   if (detections) detections->Close();
+  if (scans) scans->Close();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
@@ -116,7 +122,8 @@ Command AddSimCommand(CLI::App& app, const CliContext& ctx) {
       "sim", "Run SUMO and the radar model; write ground truth and detections (CSV)");
   AddRunOptions(cmd, &o->run, "Output folder", true);
   Opt(cmd, "--detections", &o->detections,
-      "Write the radar detections: none, csv, or csv.gz (gzip, about 3.5x smaller)")
+      "Write the radar detections: none, csv, csv.gz (gzip, about 3.5x smaller), or exact (17 "
+      "digits and scans.csv: the input of `dualgrid filter` and `dualgrid export`)")
       ->check(DetectionFormat());
   return {cmd, [o] { return RunSim(*o); }};
 }

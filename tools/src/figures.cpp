@@ -88,8 +88,8 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
     for (Position& p : points) p = rel(p);
     return points;
   };
-  for (const auto& lane : pipeline.simulation().LaneShapes())
-    view.DrawLane(to_rel(lane.points), lane.width);
+  if (const sim::SumoSimulation* sumo = pipeline.sumo())  // recorded data have no lanes
+    for (const auto& lane : sumo->LaneShapes()) view.DrawLane(to_rel(lane.points), lane.width);
   for (const auto& rail : pipeline.config().sim.guard_rails)
     view.DrawGuardRail(to_rel(rail.points));
   for (const auto& p : pipeline.config().sim.parked) {

@@ -87,7 +87,8 @@ int main(int argc, char** argv) {
   const std::vector<Command> commands = {
       AddSimCommand(app, ctx),     AddSnapshotCommand(app, ctx),   AddRunCommand(app, ctx),
       AddReplayCommand(app, ctx),  AddExperimentCommand(app, ctx), AddTangentialCommand(app, ctx),
-      AddRegressCommand(app, ctx), AddSweepCommand(app, ctx),      AddCollectCommand(app, ctx)};
+      AddRegressCommand(app, ctx), AddSweepCommand(app, ctx),      AddCollectCommand(app, ctx),
+      AddFilterCommand(app, ctx),  AddExportCommand(app, ctx)};
 
   try {
     app.parse(argc, argv);

@@ -195,10 +195,11 @@ void WriteTextFile(const std::filesystem::path& path, const std::string& text) {
 
 std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& dir,
                                                    const std::string& format) {
-  if (format == "csv") return dir / "detections.csv";
+  if (format == "csv" || format == "exact") return dir / "detections.csv";
   if (format == "csv.gz") return dir / "detections.csv.gz";
   if (format == "none") return std::nullopt;
-  throw std::invalid_argument("--detections: expected none, csv or csv.gz, got '" + format + "'");
+  throw std::invalid_argument("--detections: expected none, csv, csv.gz or exact, got '" + format +
+                              "'");
 }
 
 GroundTruthWriter::GroundTruthWriter(const std::filesystem::path& path) : out_(path) {
@@ -245,13 +246,18 @@ void GridPoseWriter::Write(const cosim::Pipeline& p) {
   out_.MaybeFlush();
 }
 
-DetectionWriter::DetectionWriter(const std::filesystem::path& path, bool multipath)
-    : out_(path), multipath_(multipath) {
+DetectionWriter::DetectionWriter(const std::filesystem::path& path, bool multipath, bool exact)
+    : out_(path), multipath_(multipath), exact_(exact) {
   out_.buffer() +=
       "step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,"
       "radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter";
   // Only with multipath on: without it the file is the same as before multipath existed.
-  out_.buffer() += multipath_ ? ",path,bounces,reflector,ghost_of\n" : "\n";
+  if (multipath_) out_.buffer() += ",path,bounces,reflector,ghost_of";
+  out_.buffer() += exact_ ? ",vclass\n" : "\n";
+}
+
+std::string DetectionWriter::Number(double v, int decimals) const {
+  return exact_ ? FormatSignificant(v, 17) : FormatFixed(v, decimals);
 }
 
 void DetectionWriter::Write(const cosim::Pipeline& p) {
@@ -259,26 +265,61 @@ void DetectionWriter::Write(const cosim::Pipeline& p) {
   std::ostringstream os;
   os.precision(10);
   for (const auto& d : p.detections()) {
-    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << d.sensor << ','
-       << p.radar().sensors()[d.sensor].name << ',' << FormatFixed(d.range, 4) << ','
-       << FormatFixed(d.azimuth, 6) << ',' << FormatFixed(d.range_rate, 4) << ','
-       << FormatFixed(d.snr_db, 2) << ',' << FormatFixed(d.position_ego.x(), 4) << ','
-       << FormatFixed(d.position_ego.y(), 4) << ',' << FormatFixed(d.position_world.x(), 4) << ','
-       << FormatFixed(d.position_world.y(), 4) << ',' << FormatFixed(d.radial_speed_compensated, 4)
-       << ',' << FormatFixed(d.radial_velocity_world.x(), 4) << ','
-       << FormatFixed(d.radial_velocity_world.y(), 4) << ','
-       << FormatFixed(d.sensor_position_world.x(), 4) << ','
-       << FormatFixed(d.sensor_position_world.y(), 4) << ',' << p.ids().Name(d.source_id) << ','
-       << (d.is_clutter ? 1 : 0);
+    os << f.step << ',' << Number(f.time, 3) << ',' << d.sensor << ','
+       << p.radar().sensors()[d.sensor].name << ',' << Number(d.range, 4) << ','
+       << Number(d.azimuth, 6) << ',' << Number(d.range_rate, 4) << ',' << Number(d.snr_db, 2)
+       << ',' << Number(d.position_ego.x(), 4) << ',' << Number(d.position_ego.y(), 4) << ','
+       << Number(d.position_world.x(), 4) << ',' << Number(d.position_world.y(), 4) << ','
+       << Number(d.radial_speed_compensated, 4) << ',' << Number(d.radial_velocity_world.x(), 4)
+       << ',' << Number(d.radial_velocity_world.y(), 4) << ','
+       << Number(d.sensor_position_world.x(), 4) << ',' << Number(d.sensor_position_world.y(), 4)
+       << ',' << p.ids().Name(d.source_id) << ',' << (d.is_clutter ? 1 : 0);
     if (multipath_) {
       const bool ghost = d.path != radar::Path::kDirect;
       os << ',' << (d.is_clutter ? "clutter" : radar::ToString(d.path)) << ',' << d.bounces << ','
          << (ghost ? p.ids().Name(d.reflector_id) : "") << ','
          << (ghost ? p.ids().Name(d.ghost_of) : "");
     }
+    if (exact_) {
+      // The source vehicle's vClass (its type's, for the scenario's own types; "unknown" for
+      // types of the user's route files); empty for clutter, ghosts and static obstacles.
+      std::string vclass;
+      const std::string& name = p.ids().Name(d.source_id);
+      const auto v = std::lower_bound(
+          f.vehicles.begin(), f.vehicles.end(), name,
+          [](const sim::VehicleState& a, const std::string& id) { return a.id < id; });
+      if (d.source_id >= 0 && v != f.vehicles.end() && v->id == name) {
+        const auto t = p.config().sim.vehicle_types.find(v->type);
+        vclass = t != p.config().sim.vehicle_types.end() ? t->second.vclass : "unknown";
+      }
+      os << ',' << vclass;
+    }
     os << '\n';
   }
   out_.buffer() += os.str();
+  out_.MaybeFlush();
+}
+
+ScanWriter::ScanWriter(const std::filesystem::path& path) : out_(path) {
+  out_.buffer() +=
+      "step,time,sensor,sensor_name,ego_x,ego_y,ego_yaw,ego_vx,ego_vy,ego_yaw_rate,ego_length,"
+      "ego_width,lane_yaw,mount_x,mount_y,mount_yaw,fov,min_range,max_range\n";
+}
+
+void ScanWriter::Write(const cosim::Pipeline& p) {
+  const sim::Frame& f = p.frame();
+  const radar::EgoMotion& e = p.ego_motion();
+  auto n = [](double v) { return FormatSignificant(v, 17); };
+  std::string& b = out_.buffer();
+  for (int s : p.scanned()) {
+    const radar::SensorParams& r = p.radar().sensors()[s];
+    b += std::to_string(f.step) + ',' + n(f.time) + ',' + std::to_string(s) + ',' + r.name + ',' +
+         n(e.pose.position.x()) + ',' + n(e.pose.position.y()) + ',' + n(e.pose.yaw) + ',' +
+         n(e.velocity.x()) + ',' + n(e.velocity.y()) + ',' + n(e.yaw_rate) + ',' + n(e.length) +
+         ',' + n(e.width) + ',' + n(f.ego.lane_yaw) + ',' + n(r.mount.position.x()) + ',' +
+         n(r.mount.position.y()) + ',' + n(r.mount.yaw) + ',' + n(r.fov) + ',' + n(r.min_range) +
+         ',' + n(r.max_range) + '\n';
+  }
   out_.MaybeFlush();
 }
 
@@ -297,7 +338,7 @@ void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& 
 
 void NoteAutoEgo(const cosim::Pipeline& pipeline, bool quiet) {
   const sim::ScenarioSpec& spec = pipeline.config().sim;
-  if (quiet || !spec.ego_from_routes || spec.ego.id != sim::kAutoEgo) return;
+  if (quiet || !spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return;
   std::cerr << "dualgrid: ego: auto chose '" << pipeline.simulation().ego_id()
             << "' (the road vehicle of the route files longest in the run; docs/scenarios.md)\n";
 }
@@ -305,7 +346,7 @@ void NoteAutoEgo(const cosim::Pipeline& pipeline, bool quiet) {
 nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status) {
   const sim::ScenarioSpec& spec = cs.config().sim;
   const bool started = cs.pipeline().started() && cs.steps() > 0;
-  const sim::SumoSimulation* sumo = started ? &cs.pipeline().simulation() : nullptr;
+  const sim::SumoSimulation* sumo = started ? cs.pipeline().sumo() : nullptr;
   const double last = started ? cs.pipeline().frame().time : 0.0;
   const double first = started ? last - (cs.steps() - 1) * spec.step_length : 0.0;
   // The ego leaving the network ends the scenario: the run is complete, `end` says how it ended.

@@ -76,18 +76,42 @@ class GridPoseWriter {
 /// detections.csv (or detections.csv.gz): one row per radar detection per step. With
 /// `multipath` (sensors.multipath on) four columns more name each detection's path: path
 /// (direct, type1, type2, clutter), bounces, reflector and ghost_of (docs/output.md).
+/// With `exact` (`--detections exact`) every number has 17 significant digits (it reads back as
+/// the same double) and a last column `vclass` names the source vehicle's SUMO vClass: the input
+/// of `dualgrid filter RUN_DIR` and `dualgrid export` (docs/recorded-data.md).
 class DetectionWriter {
  public:
-  explicit DetectionWriter(const std::filesystem::path& path, bool multipath = false);
+  explicit DetectionWriter(const std::filesystem::path& path, bool multipath = false,
+                           bool exact = false);
+  void Write(const cosim::Pipeline& pipeline);
+  void Close() { out_.Close(); }
+
+ private:
+  std::string Number(double v, int decimals) const;
+
+  OutputFile out_;
+  bool multipath_;
+  bool exact_;
+};
+
+/// scans.csv (with `--detections exact`): one row per step and scanning sensor, every number
+/// with 17 significant digits: the ego's state (box centre, heading, velocity, yaw rate, box,
+/// its lane's direction) and the sensor's mount, field of view and ranges.
+class ScanWriter {
+ public:
+  explicit ScanWriter(const std::filesystem::path& path);
   void Write(const cosim::Pipeline& pipeline);
   void Close() { out_.Close(); }
 
  private:
   OutputFile out_;
-  bool multipath_;
 };
 
-/// The detection file for a `--detections` format ("csv" or "csv.gz"); empty for "none".
+/// `--detections exact`: detections.csv with 17 digits, and scans.csv.
+inline bool ExactDetections(const std::string& format) { return format == "exact"; }
+
+/// The detection file for a `--detections` format ("csv", "csv.gz" or "exact"); empty for
+/// "none".
 std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& dir,
                                                    const std::string& format);
 

@@ -20,19 +20,22 @@ double ResidentMegabytes() {
 
 RunFilesObserver::RunFilesObserver(const std::filesystem::path& out,
                                    const std::optional<std::filesystem::path>& detections,
-                                   bool multipath, std::size_t trace_mode, const std::string& focus)
+                                   bool multipath, std::size_t trace_mode, const std::string& focus,
+                                   bool exact)
     : truth_(out / "ground_truth.csv"),
       grid_(out / "grid.csv"),
       clusters_(out / "clusters.csv"),
       trace_mode_(trace_mode),
       traces_(focus) {
-  if (detections) detections_ = std::make_unique<DetectionWriter>(*detections, multipath);
+  if (detections) detections_ = std::make_unique<DetectionWriter>(*detections, multipath, exact);
+  if (detections && exact) scans_ = std::make_unique<ScanWriter>(out / "scans.csv");
 }
 
 void RunFilesObserver::OnStep(const cosim::StepView& v) {
   truth_.Write(v.frame);
   grid_.Write(v.pipeline);
   if (detections_) detections_->Write(v.pipeline);
+  if (scans_) scans_->Write(v.pipeline);
   for (std::size_t m = 0; m < v.scorers.size(); ++m)
     clusters_.Write(v.frame, v.pipeline.grid_frame(), v.mode_names[m], v.scorers[m], v.objects,
                     v.pipeline.ids());
@@ -43,6 +46,7 @@ void RunFilesObserver::Close() {
   truth_.Close();
   grid_.Close();
   if (detections_) detections_->Close();
+  if (scans_) scans_->Close();
   clusters_.Close();
 }
 

@@ -20,8 +20,8 @@
 
 namespace dualgrid::tools {
 
-/// ground_truth.csv, grid.csv, detections (optional), clusters.csv, and the weight traces of one
-/// mode.
+/// ground_truth.csv, grid.csv, detections (optional; with `exact` also scans.csv), clusters.csv,
+/// and the weight traces of one mode.
 class RunFilesObserver : public cosim::StepObserver {
  public:
   /// `detections`: the file for --detections, none if empty; `multipath`: the scenario's
@@ -29,7 +29,7 @@ class RunFilesObserver : public cosim::StepObserver {
   /// whose particles give the weight traces (paper Fig. 4); `focus`: the scenario's focus object.
   RunFilesObserver(const std::filesystem::path& out,
                    const std::optional<std::filesystem::path>& detections, bool multipath,
-                   std::size_t trace_mode, const std::string& focus);
+                   std::size_t trace_mode, const std::string& focus, bool exact = false);
   void OnStep(const cosim::StepView& v) override;
   /// Checks every write (throws std::runtime_error naming the file).
   void Close();
@@ -39,6 +39,7 @@ class RunFilesObserver : public cosim::StepObserver {
   GroundTruthWriter truth_;
   GridPoseWriter grid_;
   std::unique_ptr<DetectionWriter> detections_;
+  std::unique_ptr<ScanWriter> scans_;  // with --detections exact
   ClusterWriter clusters_;
   std::size_t trace_mode_;
   WeightTraces traces_;

@@ -62,6 +62,10 @@ class CoSimulation {
   /// Validates (memory, sensors; std::invalid_argument) and allocates the filters. SUMO is not
   /// started: nothing is written until Start().
   CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options = {});
+  /// The same loop on another detection source (a recorded sequence: recorded_source.hpp).
+  /// With labelled points, every mode also gets the point-level scores (ScenarioMetrics::points).
+  CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options,
+               const Pipeline::SourceFactory& make_source);
 
   /// Starts SUMO (Pipeline::Start): `work_dir` receives sumo.log.
   void Start(const std::filesystem::path& network_dir, const std::filesystem::path& work_dir);
@@ -81,7 +85,7 @@ class CoSimulation {
   const std::vector<ModeScorer>& scorers() const { return scorers_; }
   /// Steps done so far.
   int steps() const { return steps_; }
-  /// Simulated time of the steps done [s].
+  /// Simulated time of the steps done [s] (recorded data: steps x their mean cycle).
   double simulated() const { return steps_ * config().sim.step_length; }
   /// SUMO reached the scenario's duration with the ego in the network (its frames start at the
   /// ego's departure, so a late departure still finishes). False while running, and when the
@@ -100,6 +104,7 @@ class CoSimulation {
   std::vector<GridSnapshot> snapshots_;  // storage reused every step
   std::vector<eval::TruthObject> objects_;
   std::vector<std::uint8_t> truth_classes_;
+  std::vector<Position> point_positions_;  // this step's detections, grid frame (labelled data)
   std::vector<StepObserver*> observers_;
   int threads_ = 0;
   int steps_ = 0;

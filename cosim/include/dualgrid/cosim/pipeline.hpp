@@ -1,9 +1,11 @@
-// One co-simulation's data path: SUMO steps, the radar model scans the ground truth, and the
-// detections become the inputs of any number of grid filters (one per weight mode), in the grid
-// frame. CoSimulation (cosimulation.hpp) runs the filters and the scoring on top of it.
+// One run's data path: a detection source (SUMO and the radar model, or a recorded sequence:
+// detection_source.hpp) gives each step's detections, and they become the inputs of any number
+// of grid filters (one per weight mode), in the grid frame. CoSimulation (cosimulation.hpp) runs
+// the filters and the scoring on top of it.
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "dualgrid/core/grid_frame.hpp"
+#include "dualgrid/cosim/detection_source.hpp"
 #include "dualgrid/eval/association.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/radar_model/radar_model.hpp"
@@ -41,11 +44,19 @@ void CheckFilterMemory(const scenario::ScenarioConfig& config, std::size_t modes
 
 /// Lifetime: construct (validates and allocates the filters; SUMO not started), Start() (SUMO),
 /// then Advance() / UpdateFilter() per step. Not copyable; one SUMO instance per process
-/// (libsumo is a process-wide singleton), so one started Pipeline at a time.
+/// (libsumo is a process-wide singleton), so one started Pipeline on SUMO at a time.
 class Pipeline {
  public:
-  /// Throws std::invalid_argument for a configuration that cannot run (memory, sensors).
+  /// The co-simulation (SumoSource). Throws std::invalid_argument for a configuration that
+  /// cannot run (memory, sensors). The filters' cycle is the step length (FilterFor).
   Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::WeightMode> modes);
+  /// Another source (a recorded sequence): `make_source` builds it from the pipeline's copy of
+  /// `config` and its IdRegistry. The filters' per-cycle factors refer to config.filter.cycle
+  /// (FilterParams::cycle), not to the step length.
+  using SourceFactory = std::function<std::unique_ptr<DetectionSource>(
+      const scenario::ScenarioConfig& config, IdRegistry& ids)>;
+  Pipeline(const scenario::ScenarioConfig& config, std::vector<filter::WeightMode> modes,
+           const SourceFactory& make_source);
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
@@ -54,7 +65,7 @@ class Pipeline {
   /// (sumo.log). Throws std::invalid_argument for a missing network, std::runtime_error for a
   /// SUMO error. Call once.
   void Start(const std::filesystem::path& network_dir, const std::filesystem::path& work_dir);
-  bool started() const { return simulation_ != nullptr; }
+  bool started() const { return source_->started(); }
   /// Ends SUMO (sim::SumoSimulation::Close: its outputs are written); everything read from the
   /// last step stays readable, Advance() must not be called again. No-op before Start().
   void Finish();
@@ -70,12 +81,19 @@ class Pipeline {
   /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
   const scenario::ScenarioConfig& config() const { return config_; }
   /// Ground truth of the last Advance(). Needs Start().
-  const sim::Frame& frame() const { return simulation_->frame(); }
-  const sim::SumoSimulation& simulation() const { return *simulation_; }
+  const sim::Frame& frame() const { return source_->frame(); }
+  /// SUMO; throws std::logic_error for a source without it (recorded data): see sumo().
+  const sim::SumoSimulation& simulation() const;
+  /// SUMO, or nullptr for a recorded sequence.
+  const sim::SumoSimulation* sumo() const { return source_->sumo(); }
+  const DetectionSource& source() const { return *source_; }
   /// The radars as mounted on the ego's box as SUMO simulates it: built once, at the ego's
-  /// departure (the first Advance()). Needs one Advance().
-  const radar::RadarModel& radar() const { return *radar_; }
-  bool has_radar() const { return radar_.has_value(); }
+  /// departure (the first Advance()); for recorded data as the sequence's sensors say. Needs one
+  /// Advance().
+  const radar::RadarModel& radar() const { return source_->radar(); }
+  bool has_radar() const { return source_->has_radar(); }
+  /// Labels of the last step's detections (recorded data; empty otherwise).
+  const PointLabels& labels() const { return source_->labels(); }
   /// Detections of the last step (only sensors that were due), world frame.
   const std::vector<radar::Detection>& detections() const { return detections_; }
   /// Sensors that scanned in the last step.
@@ -107,23 +125,22 @@ class Pipeline {
   std::vector<eval::TruthObject> TruthObjects(const filter::DynamicGrid& grid) const;
 
  private:
-  radar::Scene BuildScene();
-  // At the ego's departure: the grid frame and the radars on the ego's simulated box.
-  void FixFrameAndRig(const sim::Frame& f);
+  // At the first step: the grid frame.
+  void FixFrame(const sim::Frame& f);
+  void MakeFilters(bool cycle_is_step);
 
   scenario::ScenarioConfig config_;
   IdRegistry ids_;
-  std::unique_ptr<sim::SumoSimulation> simulation_;
-  std::optional<radar::RadarModel> radar_;
+  std::unique_ptr<DetectionSource> source_;
   std::vector<filter::WeightMode> modes_;
   std::vector<std::unique_ptr<filter::DynamicGrid>> filters_;
-  radar::Scene static_scene_;
   radar::EgoMotion ego_;
   std::vector<radar::Detection> detections_;
   std::vector<int> scanned_;
   std::vector<filter::Measurement> measurements_;
   std::vector<filter::SensorCoverage> coverage_;
   double last_time_ = 0.0;
+  bool first_step_ = true;
   double dt_ = 0.0;  // of the last Advance() [s]
   GridFrame grid_frame_;
   double realign_angle_ = 0.0;  // the grid frame's turn in the last Advance() [rad]

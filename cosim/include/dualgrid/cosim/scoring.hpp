@@ -46,6 +46,12 @@ class ModeScorer {
   void AddFrame(double time, const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
                 const std::vector<eval::TruthObject>& objects,
                 const std::vector<std::uint8_t>& truth_classes, const OrientedBox& ego_box);
+  /// Scores this cycle's labelled points (recorded data; eval/point_metrics.hpp): `positions` in
+  /// the grid frame, `labels` RadarScenes label ids (-1: unlabelled, not counted); points inside
+  /// `ego_box` are not counted (the filter never sees them). After AddFrame of the same cycle.
+  void AddPoints(const filter::DynamicGrid& grid, const GridSnapshot& snapshot,
+                 const std::vector<Position>& positions, const std::vector<int>& labels,
+                 const OrientedBox& ego_box);
   eval::ScenarioMetrics Result() const;
   /// Clusters of the last frame and their association.
   const std::vector<eval::Cluster>& clusters() const { return clusters_; }
@@ -56,6 +62,7 @@ class ModeScorer {
   eval::ParticleClusterer clusterer_;
   eval::TrackingMetricsAccumulator tracking_;
   eval::CellClassificationAccumulator cells_;
+  std::optional<eval::PointClassificationAccumulator> points_;
   std::vector<eval::WeightedParticle> dynamic_particles_;
   std::vector<eval::Cluster> clusters_;
   eval::AssociationResult association_;

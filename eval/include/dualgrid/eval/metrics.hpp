@@ -39,6 +39,7 @@
 
 #include "dualgrid/eval/association.hpp"
 #include "dualgrid/eval/cell_metrics.hpp"
+#include "dualgrid/eval/point_metrics.hpp"
 
 namespace dualgrid::eval {
 
@@ -96,7 +97,10 @@ struct ScenarioMetrics {
   double clusters_per_scan = 0.0;
   double false_clusters_per_scan = 0.0;
   double duplicate_clusters_per_scan = 0.0;
-  std::optional<CellMetrics> cells;    ///< filled by the caller from CellClassificationAccumulator
+  std::optional<CellMetrics> cells;  ///< filled by the caller from CellClassificationAccumulator
+  /// Point-level dynamic classification, for labelled recorded data only (point_metrics.hpp);
+  /// absent from the JSON when empty.
+  std::optional<PointMetrics> points;
   std::vector<ObjectMetrics> objects;  ///< every object ever in_grid, ascending id
 };
 

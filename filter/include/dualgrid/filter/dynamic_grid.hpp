@@ -160,6 +160,8 @@ class DynamicGrid {
   std::pair<int, int> BucketOf(double px, double py) const;
 
   FilterParams params_;
+  // params_ with the per-cycle factors of this cycle's dt (ForCycle): what steps 2-7 read.
+  FilterParams cycle_params_;
   std::uint64_t seed_;
   std::uint64_t step_ = 0;
   bool initialized_ = false;

@@ -119,6 +119,11 @@ struct FilterParams {
 
   // Particle weights.
   double decay_eps = 0.05;  ///< eps of eqs. (7), (8).
+  /// The cycle [s] that every per-cycle factor above refers to (persistence, birth_probability,
+  /// free_decay, static_persistence, decay_eps). A cycle of another length dt scales them
+  /// (ForCycle; docs/algorithm.md, "Asynchronous sensors"). The co-simulation sets it to its
+  /// step length (ScenarioConfig::FilterFor), so its cycles take the factors as given.
+  double cycle = 0.05;
   WeightMode mode = WeightMode::kDual;
 
   // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset,
@@ -143,6 +148,13 @@ struct FilterParams {
   /// True when every field is usable; otherwise names the offending field in *error.
   bool IsValid(std::string* error) const;
 };
+
+/// `p` with its per-cycle factors for a filter cycle of `dt` [s] (>= 0), with r = dt / p.cycle:
+/// persistence^r, static_persistence^r, free_decay^r, (1 - decay_eps)^r kept (decay_eps =
+/// 1 - (1 - eps)^r) and a birth probability 1 - (1 - p_B)^r: the survival (or no-birth)
+/// probability of r reference cycles. When dt equals p.cycle within 1e-9 relative, `p` is
+/// returned unchanged, bit for bit (the co-simulation's synchronous cycles). Other fields as given.
+FilterParams ForCycle(const FilterParams& p, double dt);
 
 /// Named parameter sets. "paper": every switch at its literal reading of the paper (the paper's
 /// experiment as written); "dualgrid": the setting this project recommends (docs/results.md);

@@ -1,0 +1,100 @@
+// Where a Pipeline's detections come from, step by step: SUMO and the radar model (SumoSource,
+// the co-simulation) or a recorded sequence (RecordedSource, recorded_source.hpp). The Pipeline
+// owns one and does the rest, the same for both: the grid frame, the filters' inputs and
+// cycles, the ground truth as scored. Everything a source gives is in the world frame (for
+// recorded data the sequence's frame).
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "dualgrid/radar_model/radar_model.hpp"
+#include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/sim/ground_truth.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
+
+namespace dualgrid::cosim {
+
+class IdRegistry;
+
+/// Per detection of a recorded step: its RadarScenes label (0-10 a moving road user's class,
+/// 11 static, -1 unlabelled). Empty when the source has no labels.
+using PointLabels = std::vector<int>;
+inline constexpr int kStaticLabel = 11;
+
+/// One step's worth of detections and the ego's state. Lifetime: Start() once, then Advance()
+/// until it returns false; Finish() at the end. Not copyable.
+class DetectionSource {
+ public:
+  virtual ~DetectionSource() = default;
+
+  /// Prepares the source (SUMO starts; `work_dir` receives its log). Called by Pipeline::Start.
+  virtual void Start(const std::filesystem::path& network_dir,
+                     const std::filesystem::path& work_dir) = 0;
+  virtual bool started() const = 0;
+  /// Ends the source (SUMO writes its outputs); what was read stays readable.
+  virtual void Finish() {}
+
+  /// Advances one step: frame(), ego() and radar() then describe it. False at the end. `ids`
+  /// receives every named object of the step (vehicles, tracks) in a deterministic order.
+  virtual bool Advance(IdRegistry& ids) = 0;
+  /// Scans the sensors due in the step just advanced: `detections` (world frame, ordered by
+  /// sensor) and the sensors that scanned. Called once per Advance, after it.
+  virtual void Scan(IdRegistry& ids, std::vector<radar::Detection>* detections,
+                    std::vector<int>* scanned) = 0;
+
+  /// The step: time, the ego (box centre, heading, lane direction) and the other objects where
+  /// known (SUMO's vehicles; for recorded data the labelled tracks, estimated from their points).
+  virtual const sim::Frame& frame() const = 0;
+  virtual const radar::EgoMotion& ego() const = 0;
+  /// The radars as mounted; valid from the first Advance().
+  virtual const radar::RadarModel& radar() const = 0;
+  virtual bool has_radar() const = 0;
+  /// The filter cycle of the first step [s] (later cycles: the time between steps).
+  virtual double first_dt() const = 0;
+  /// SUMO, for a co-simulation; nullptr for recorded data.
+  virtual const sim::SumoSimulation* sumo() const { return nullptr; }
+  /// Labels of the last Scan()'s detections, in their order; empty without labels.
+  virtual const PointLabels& labels() const {
+    static const PointLabels kNone;
+    return kNone;
+  }
+  /// The source's data say whether points are labelled (recorded data with label_id).
+  virtual bool has_labels() const { return false; }
+  /// The source reached its own end (SUMO: the duration; recorded: the last scan).
+  virtual bool reached_end() const = 0;
+};
+
+/// The co-simulation: SUMO steps, the radar model scans the ground truth. The radars are mounted
+/// on the ego's box as SUMO simulates it, at the ego's departure (the first Advance).
+class SumoSource : public DetectionSource {
+ public:
+  /// `config` must outlive the source. Registers the scenario's static obstacles in `ids` (they
+  /// take the first ids).
+  SumoSource(const scenario::ScenarioConfig& config, IdRegistry& ids);
+  void Start(const std::filesystem::path& network_dir,
+             const std::filesystem::path& work_dir) override;
+  bool started() const override { return simulation_ != nullptr; }
+  void Finish() override;
+  bool Advance(IdRegistry& ids) override;
+  void Scan(IdRegistry& ids, std::vector<radar::Detection>* detections,
+            std::vector<int>* scanned) override;
+  const sim::Frame& frame() const override { return simulation_->frame(); }
+  const radar::EgoMotion& ego() const override { return ego_; }
+  const radar::RadarModel& radar() const override { return *radar_; }
+  bool has_radar() const override { return radar_.has_value(); }
+  double first_dt() const override { return config_.sim.step_length; }
+  const sim::SumoSimulation* sumo() const override { return simulation_.get(); }
+  bool reached_end() const override { return simulation_ && simulation_->reached_end(); }
+
+ private:
+  const scenario::ScenarioConfig& config_;
+  std::unique_ptr<sim::SumoSimulation> simulation_;
+  std::optional<radar::RadarModel> radar_;
+  radar::Scene static_scene_;
+  radar::EgoMotion ego_;
+};
+
+}  // namespace dualgrid::cosim
