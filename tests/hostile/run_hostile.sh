@@ -130,6 +130,9 @@ else
   printf 'FAIL sumo:comment: a valid route file with a 3 MB comment did not run: %s\n' "$out"
 fi
 
+# 5.-10. What dualgrid reads back, sweeps, suites, step lengths, experiments (issue 26).
+source "$here/read_back_cases.sh"
+
 # 3. Hostile command lines.
 mkdir -p "$work/existing/x.png"
 n=0

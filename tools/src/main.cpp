@@ -20,7 +20,8 @@ using namespace dualgrid::tools;
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (SUMO error, an output not written); 2 bad input "
     "(command line, scenario or network file; nothing simulated); 3 experiment: some seed runs "
-    "failed (the others are aggregated), regress: a case did not run; regress: 1 a check failed; "
+    "failed (the others are aggregated), regress: a case did not run, sweep/collect: runs are "
+    "missing; regress: 1 a check failed; "
     "130/143 stopped by SIGINT/SIGTERM (results of the "
     "simulated part written, marked incomplete). Details: docs/cli.md.";
 
@@ -93,6 +94,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A first word that is no subcommand: CLI11 would only say that one is required.
+    if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-') {
+      std::string names;
+      for (const Command& c : commands) names += (names.empty() ? "" : ", ") + c.app->get_name();
+      std::cerr << "dualgrid: error: unknown command '" << OneLine(argv[1])
+                << "' (expected one of " << names << "; see dualgrid --help)\n";
+      return kExitBadInput;
+    }
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << " (see " << HelpHint(app) << ")\n";
     return kExitBadInput;
   }
