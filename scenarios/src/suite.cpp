@@ -127,8 +127,7 @@ RegressionSuite LoadSuite(const std::filesystem::path& file) {
     constexpr std::uint64_t kMaxSeed = (std::uint64_t{1} << 53) - 1;
     if (rc.first_seed > kMaxSeed - static_cast<std::uint64_t>(rc.seeds - 1))
       c.Fail("first_seed", "expected a whole number with first_seed + seeds - 1 <= " +
-                               std::to_string(kMaxSeed) + ", got " +
-                               std::to_string(rc.first_seed));
+                               std::to_string(kMaxSeed) + ", got " + std::to_string(rc.first_seed));
     c.Read("digest", &rc.digest);
     c.Read("record", &rc.record);
     for (const std::string& m : rc.record) {

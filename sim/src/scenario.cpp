@@ -71,8 +71,7 @@ bool ScenarioSpec::IsValid(std::string* error) const {
     c.InRange(f + ".rcs_dbsm", t.rcs_dbsm, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed, "dBsm");
   }
   for (const auto& [type, rcs] : type_rcs)
-    c.InRange("traffic.rcs_dbsm." + type, rcs, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed,
-              "dBsm");
+    c.InRange("traffic.rcs_dbsm." + type, rcs, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed, "dBsm");
   for (const auto& [name, edges] : routes) {
     c.Expect(ValidSumoId(name), "routes." + name, Quoted(name),
              std::string("a route name ") + kIdRule);

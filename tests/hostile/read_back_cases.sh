@@ -26,6 +26,26 @@ check "sweep:generator_1e6" 2 "more than 10000 settings" \
   "$dualgrid" sweep tangential --set tangential.angle=0:0.1:99.9 --set tangential.range=1:0.2:200 \
   -q --emit list --out "$rb/big4"
 
+# The first SIGTERM stops a sweep while it validates its settings (it was ignored until every
+# setting was checked): 10,000 settings take tens of seconds to check; the stop comes after 2 s
+# and must end the sweep with 143 within 10 s, before anything ran or runs.txt was written.
+start=$(date +%s)
+(cd "$work" && exec "$dualgrid" sweep "$S" --set filter.sigma_v=1:1:100 --set filter.sigma_f=1:1:100 \
+  -q --out "$rb/term") >"$rb/term.out" 2>&1 &
+term_pid=$!
+sleep 2
+kill -TERM "$term_pid"
+wait "$term_pid"
+term_rc=$?
+elapsed=$(($(date +%s) - start))
+if [ "$term_rc" -eq 143 ] && [ "$elapsed" -le 10 ] && [ ! -e "$rb/term/runs.txt" ]; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1))
+  printf 'FAIL sweep:sigterm_while_checking: exit %s after %s s (expected 143 within 10 s, no runs.txt): %s\n' \
+    "$term_rc" "$elapsed" "$(cat "$rb/term.out")"
+fi
+
 # --- 6. A sweep folder whose plan.json is damaged: `sweep` (resuming) and `collect` both refuse
 # it naming the file and the key. ---
 "$dualgrid" sweep "$S" --set filter.sigma_v=0.5,1 --seeds 1 --duration 0.2 -q --emit list \
@@ -184,6 +204,10 @@ replay_case flipped_bytes "frames.bin: frame 2 (index.json's frames[2].blob) is 
   'python3 -c "b = bytearray(open(\"frames.bin\", \"rb\").read()); b[len(b) // 2] ^= 0xFF; b[len(b) // 2 + 7] ^= 0x5A; open(\"frames.bin\", \"wb\").write(b)"'
 replay_case frames_truncated "frames.bin: shorter than" '' 'truncate -s 100 frames.bin'
 replay_case frames_missing_file "frames.bin: shorter than" '' 'rm frames.bin'
+replay_case frames_is_folder "frames.bin: the recording's frames are not a regular file (a directory)" '' \
+  'rm frames.bin && mkdir frames.bin'
+replay_case frames_dev_zero "frames.bin: the recording's frames are not a regular file (a device" '' \
+  'ln -sf /dev/zero frames.bin'
 replay_case index_not_json "index.json: not valid JSON" '' 'head -c 300 index.json > i && mv i index.json'
 replay_case index_is_folder "index.json: replay index is a directory" '' 'rm index.json && mkdir index.json'
 replay_case index_dev_zero "index.json: replay index is a device" '' 'ln -sf /dev/zero index.json'

@@ -170,8 +170,8 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
       CHECK(d.particles[m].size() <= 2 * index["max_particles"].get<std::size_t>());
       for (std::size_t k = 0; k < d.free[m].size(); ++k) {
         REQUIRE(d.free[m][k] + d.stat[m][k] + d.dyn[m][k] <= 264);
-        REQUIRE((two_percent(d.free[m][k]) && two_percent(d.stat[m][k]) &&
-                 two_percent(d.dyn[m][k])));
+        REQUIRE(
+            (two_percent(d.free[m][k]) && two_percent(d.stat[m][k]) && two_percent(d.dyn[m][k])));
         REQUIRE((d.vx[m][k] % 20 == 0 && d.vy[m][k] % 20 == 0));
         if (d.dyn[m][k] < 13) REQUIRE((d.vx[m][k] == 0 && d.vy[m][k] == 0));
       }

@@ -45,8 +45,11 @@ pid_t StartChild(std::vector<std::string> args, const std::filesystem::path& log
     setpgid(0, 0);
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent) _exit(143);  // the parent died before prctl took effect
-    // O_APPEND: the parent appends the child's stderr to the same file.
-    const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND, 0644);
+    // O_APPEND: the parent appends the child's stderr to the same file. A log that cannot be
+    // created (a full disk) does not stop a child whose stderr goes to the parent: it runs with
+    // stdout discarded, and its error (the reason) still reaches the parent.
+    int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND, 0644);
+    if (fd < 0 && stderr_pipe) fd = open("/dev/null", O_WRONLY);
     if (fd < 0) _exit(126);
     dup2(fd, 1);
     dup2(stderr_pipe ? fds[1] : fd, 2);  // (dup2 clears O_CLOEXEC on the copies)
@@ -87,7 +90,10 @@ void ChildPool::Drain(Child& c) {
     }
     // Into the log (appended after the child opened it; a failed write, e.g. a full disk, loses
     // only the log's copy) and into the last line kept in memory.
-    if (c.log_fd < 0) c.log_fd = open(c.log.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    if (c.log_fd == -1) {  // once: -2 marks a log that cannot be opened
+      c.log_fd = open(c.log.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+      if (c.log_fd < 0) c.log_fd = -2;
+    }
     if (c.log_fd >= 0) (void)!write(c.log_fd, buf, static_cast<std::size_t>(n));
     c.tail.append(buf, static_cast<std::size_t>(n));
     if (c.tail.size() > 8192) c.tail.erase(0, c.tail.size() - 4096);
@@ -113,15 +119,20 @@ std::optional<ChildPool::Ended> ChildPool::Wait() {
       forwarded_ = true;
     }
     if (running_.empty()) return std::nullopt;
-    // The children's stderr is read as it comes (a full pipe would block them) while waiting.
+    // The children's stderr is read as it comes (a full pipe would block them) while waiting;
+    // once every pipe is closed, a blocking wait (a signal interrupts it: no SA_RESTART).
     std::vector<pollfd> fds;
     for (const auto& [pid, c] : running_)
       if (c.err >= 0) fds.push_back({c.err, POLLIN, 0});
-    if (poll(fds.data(), fds.size(), 200) < 0 && errno != EINTR)
-      throw std::runtime_error("lost track of " + what_ + ": " + std::strerror(errno));
-    for (auto& [pid, c] : running_) Drain(c);
+    if (!fds.empty()) {
+      // A child's end closes its pipe (POLLHUP); the timeout only bounds the wait for a child
+      // whose pipe outlives it (held by a process it started).
+      if (poll(fds.data(), fds.size(), 200) < 0 && errno != EINTR)
+        throw std::runtime_error("lost track of " + what_ + ": " + std::strerror(errno));
+      for (auto& [pid, c] : running_) Drain(c);
+    }
     int status = 0;
-    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    const pid_t pid = waitpid(-1, &status, fds.empty() ? 0 : WNOHANG);
     if (pid == 0) continue;
     if (pid < 0) {
       if (errno == EINTR) continue;  // a signal: forwarded above
@@ -156,6 +167,14 @@ std::string LastLine(const std::filesystem::path& p) {
   while (std::getline(in, line))
     if (!line.empty()) last = line;
   return last;
+}
+
+std::string ChildFailure(const ChildPool::Ended& ended, const std::filesystem::path& log) {
+  if (ended.signal) return "killed by signal " + std::to_string(ended.signal);
+  std::string why = ended.last_line.empty() ? LastLine(log) : ended.last_line;
+  const std::string prefix = "dualgrid: error: ";
+  if (why.rfind(prefix, 0) == 0) why.erase(0, prefix.size());
+  return why.empty() ? "exit code " + std::to_string(ended.code) : why;
 }
 
 std::string Exact(double v) { return FormatSignificant(v, 17); }

@@ -39,8 +39,8 @@ class ChildPool {
   void Start(std::size_t tag, std::vector<std::string> args, const std::filesystem::path& log);
   struct Ended {
     std::size_t tag = 0;
-    int code = 0;    ///< the exit code, or 128 + the signal that killed it
-    int signal = 0;  ///< the signal that killed it, 0 if it exited
+    int code = 0;           ///< the exit code, or 128 + the signal that killed it
+    int signal = 0;         ///< the signal that killed it, 0 if it exited
     std::string last_line;  ///< the last non-empty line it wrote to stderr
   };
   /// Waits for the next child to end; std::nullopt when none is running. Throws
@@ -51,8 +51,8 @@ class ChildPool {
   struct Child {
     std::size_t tag = 0;
     std::filesystem::path log;
-    int err = -1;     ///< read end of its stderr pipe
-    int log_fd = -1;  ///< the log, opened for appending at the first stderr bytes
+    int err = -1;      ///< read end of its stderr pipe
+    int log_fd = -1;   ///< the log, opened for appending at the first stderr bytes (-2: cannot)
     std::string tail;  ///< the end of its stderr
     std::string LastLine() const;
   };
@@ -69,6 +69,12 @@ bool RunComplete(const std::filesystem::path& dir);
 
 /// The last non-empty line of a file (a run's log: its error message); "" if none.
 std::string LastLine(const std::filesystem::path& path);
+
+/// Why a child ended without finishing, in one line: the signal that killed it, else the last
+/// line of its stderr as the pool read it (kept though `log` could not be written, e.g. on a
+/// full disk) without its "dualgrid: error: " prefix, else the last line of `log`, else its exit
+/// code.
+std::string ChildFailure(const ChildPool::Ended& ended, const std::filesystem::path& log);
 
 /// Exact decimal text of a double (std::to_string rounds to 6 decimals).
 std::string Exact(double v);

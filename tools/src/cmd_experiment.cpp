@@ -124,10 +124,7 @@ int RunExperiment(const ExperimentOptions& o) {
       cut_short.push_back(seed);
     } else {
       // Its stderr as the pool read it: the log may not have been writable (a full disk).
-      std::string why = ended->last_line;
-      if (why.empty()) why = LastLine(LogPath(seed_dir(seed)));
-      if (ended->signal) why = "killed by signal " + std::to_string(ended->signal);
-      if (why.empty()) why = "exit code " + std::to_string(code);
+      const std::string why = ChildFailure(*ended, LogPath(seed_dir(seed)));
       failed.emplace_back(seed, why);
       if (code == kExitBadInput && !ended->signal) {
         if (bad_input.empty()) bad_input = why;
@@ -152,11 +149,7 @@ int RunExperiment(const ExperimentOptions& o) {
     std::cerr << "dualgrid: " << stop_status << "\n";
     if (finished.empty()) return StopExitCode();
   }
-  if (finished.empty() && !bad_input.empty()) {
-    const std::string prefix = "dualgrid: error: ";
-    throw std::invalid_argument(bad_input.rfind(prefix, 0) == 0 ? bad_input.substr(prefix.size())
-                                                                 : bad_input);
-  }
+  if (finished.empty() && !bad_input.empty()) throw std::invalid_argument(bad_input);
   if (!bad_input.empty())
     std::cerr << "dualgrid: a seed run refused its input: " << bad_input << "\n";
   // Every finished seed's results, read back; a seed whose files cannot be read is a failed seed.
@@ -223,7 +216,7 @@ int RunExperiment(const ExperimentOptions& o) {
         std::string key = std::to_string(obj.id);
         const auto it = object_names.find(key);
         obj.id = names.Id(it != object_names.end() && it->is_string() ? it->get<std::string>()
-                                                                       : key.insert(0, 1, '#'));
+                                                                      : key.insert(0, 1, '#'));
       }
       r.seeds.push_back(std::move(m));
     }
@@ -272,8 +265,7 @@ int RunExperiment(const ExperimentOptions& o) {
                                 config.sim.name + ": " + (v ? "D_v" : "D") +
                                     " per object, mean and 95 % CI over " +
                                     std::to_string(finished.size()) + " seeds",
-                                "tracked share " + what + " [%]", p, errors,
-                                o.run.figure_captions);
+                                "tracked share " + what + " [%]", p, errors, o.run.figure_captions);
           },
           &warnings);
     }

@@ -271,7 +271,8 @@ int RunSweep(const SweepOptions& o) {
       throw std::invalid_argument("setting " + std::string(id) + " (" + label + "): " + e.what());
     }
     // A generated scenario is named relative to the sweep folder: a copied folder uses its own.
-    plan.settings.push_back({id, values, label, generator ? generated.string() : scenario.string()});
+    plan.settings.push_back(
+        {id, values, label, generator ? generated.string() : scenario.string()});
     for (int k = 0; k < o.seeds; ++k) {
       const std::uint64_t seed = o.first_seed + k;
       const fs::path folder = RunFolder(out, id, seed);
@@ -361,10 +362,7 @@ int RunSweep(const SweepOptions& o) {
       ++failed;
       if (!StopSignal())
         std::cerr << "dualgrid: run " << runs[i].second.string()
-                  << " failed: "
-                  << (ended->last_line.empty() ? LastLine(runs[i].second.string() + ".log")
-                                               : ended->last_line)
-                  << "\n";
+                  << " failed: " << ChildFailure(*ended, runs[i].second.string() + ".log") << "\n";
     }
     progress.Update(done, std::to_string(done) + "/" + std::to_string(todo.size()) + " runs");
   }
@@ -446,9 +444,8 @@ int RunCollect(const CollectOptions& o) {
     const auto& values = setting_of.at(sid)->values;
     agg << sid;
     for (const auto& val : values) agg << "," << CsvCell(val);
-    agg << "," << CsvCell(mode) << "," << CsvCell(metric) << "," << CsvCell(unit_of[metric])
-        << "," << s.n << "," << Exact(s.mean) << ","
-        << (s.half_width ? Exact(*s.half_width) : "") << "\n";
+    agg << "," << CsvCell(mode) << "," << CsvCell(metric) << "," << CsvCell(unit_of[metric]) << ","
+        << s.n << "," << Exact(s.mean) << "," << (s.half_width ? Exact(*s.half_width) : "") << "\n";
     aj.push_back({{"setting", sid},
                   {"values", values},
                   {"mode", mode},

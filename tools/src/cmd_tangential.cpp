@@ -147,11 +147,12 @@ int RunTangential(const TangentialOptions& o) {
     if (!o.quiet) {
       // Its network is written beside it (the scenario names it relative to itself): say so.
       const std::filesystem::path base = o.out.parent_path() / o.out.stem();
-      std::cout << "wrote " << o.out.string() << " (" << what << ") and its network beside it: "
-                << base.string() << ".net.xml (netconvert, from " << base.filename().string()
-                << ".nod.xml and " << base.filename().string() << ".edg.xml; log "
-                << base.filename().string() << ".netconvert.log); run it with: dualgrid run "
-                << o.out.string() << " --out run/" << o.out.stem().string() << "\n";
+      std::cout << "wrote " << o.out.string() << " (" << what
+                << ") and its network beside it: " << base.string() << ".net.xml (netconvert, from "
+                << base.filename().string() << ".nod.xml and " << base.filename().string()
+                << ".edg.xml; log " << base.filename().string()
+                << ".netconvert.log); run it with: dualgrid run " << o.out.string() << " --out run/"
+                << o.out.stem().string() << "\n";
     }
     return 0;
   }

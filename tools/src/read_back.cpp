@@ -43,7 +43,8 @@ std::string Child(const std::string& key, const std::string& name) {
 }  // namespace
 
 void JsonAt::Fail(const std::string& expected) const {
-  throw std::invalid_argument(*file_ + ": " + (key_.empty() ? "the document" : "key '" + key_ + "'") +
+  throw std::invalid_argument(*file_ + ": " +
+                              (key_.empty() ? "the document" : "key '" + key_ + "'") +
                               ": expected " + expected + ", found " + Describe(*value_));
 }
 
@@ -75,8 +76,7 @@ std::vector<JsonAt> JsonAt::Items(std::size_t max) const {
 }
 
 JsonAt JsonAt::Item(std::size_t i) const {
-  if (!value_->is_array() || value_->size() <= i)
-    Fail("a list of more than " + std::to_string(i));
+  if (!value_->is_array() || value_->size() <= i) Fail("a list of more than " + std::to_string(i));
   return JsonAt((*value_)[i], file_, key_ + "[" + std::to_string(i) + "]");
 }
 
@@ -95,10 +95,9 @@ std::vector<std::pair<std::string, JsonAt>> JsonAt::Members() const {
 
 double JsonAt::Number(double lo, double hi) const {
   const auto range = [&] {
-    return lo <= -1e300 && hi >= 1e300
-               ? std::string("a finite number")
-               : "a number in [" + FormatSignificant(lo, 10) + ", " + FormatSignificant(hi, 10) +
-                     "]";
+    return lo <= -1e300 && hi >= 1e300 ? std::string("a finite number")
+                                       : "a number in [" + FormatSignificant(lo, 10) + ", " +
+                                             FormatSignificant(hi, 10) + "]";
   };
   if (!value_->is_number()) Fail(range());
   const double v = value_->get<double>();
@@ -185,8 +184,8 @@ JsonFile ParseJsonText(const std::string& text, const std::string& file) {
       byte = e.byte;
     } catch (const std::exception&) {
     }
-    throw std::invalid_argument(file + ": not valid JSON (at byte " + std::to_string(byte) + " of " +
-                                std::to_string(text.size()) + "; truncated or damaged?)");
+    throw std::invalid_argument(file + ": not valid JSON (at byte " + std::to_string(byte) +
+                                " of " + std::to_string(text.size()) + "; truncated or damaged?)");
   }
   return JsonFile(std::move(doc), file);
 }

@@ -179,13 +179,18 @@ namespace {
 // that a damaged or hostile index cannot make the video or the viewer allocate without end.
 constexpr std::int64_t kMaxCellsPerAxis = 1000000;
 constexpr std::uint64_t kMaxFrameBytes = std::uint64_t{1} << 30;  // one frame, inflated
-constexpr std::int64_t kMaxParticles = 1000000;                    // as --record-particles
+constexpr std::int64_t kMaxParticles = 1000000;                   // as --record-particles
 constexpr std::size_t kMaxModes = 3, kMaxSensors = 64, kMaxFrames = 10000000;
 
 Box BoxAt(const JsonAt& j) {
   const auto v = j.Tuple(8);
-  return {static_cast<int>(v[0].Integer(-1, INT32_MAX)), v[1].Number(), v[2].Number(),
-          v[3].Number(), v[4].Number(0.0, 1e6), v[5].Number(0.0, 1e6), v[6].Number(),
+  return {static_cast<int>(v[0].Integer(-1, INT32_MAX)),
+          v[1].Number(),
+          v[2].Number(),
+          v[3].Number(),
+          v[4].Number(0.0, 1e6),
+          v[5].Number(0.0, 1e6),
+          v[6].Number(),
           v[7].Number()};
 }
 
@@ -200,8 +205,8 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
         index_path.string() +
         ": missing (the run was made with --no-record or --no-figures, or did not finish; "
         "rerun `dualgrid run` without them)");
-  index_file_ = std::make_unique<JsonFile>(
-      ReadJsonFile(index_path, "replay index", kMaxStreamedInputBytes));
+  index_file_ =
+      std::make_unique<JsonFile>(ReadJsonFile(index_path, "replay index", kMaxStreamedInputBytes));
   const JsonAt root = index_file_->Root();
   const std::string where = index_path.string();
   if (!root.raw().is_object()) root.Fail("an object (a dualgrid replay index)");
@@ -233,10 +238,10 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   const std::uint64_t cells = static_cast<std::uint64_t>(h.cells_x) * h.cells_y;
   if ((cells * 7 + 4 * static_cast<std::uint64_t>(h.max_particles)) * h.modes.size() >
       kMaxFrameBytes)
-    throw std::invalid_argument(where + ": keys 'cells_x', 'cells_y', 'max_particles': a frame of " +
-                                std::to_string(h.cells_x) + " x " + std::to_string(h.cells_y) +
-                                " cells and " + std::to_string(h.max_particles) +
-                                " particles per mode, expected at most 1 GiB per frame");
+    throw std::invalid_argument(
+        where + ": keys 'cells_x', 'cells_y', 'max_particles': a frame of " +
+        std::to_string(h.cells_x) + " x " + std::to_string(h.cells_y) + " cells and " +
+        std::to_string(h.max_particles) + " particles per mode, expected at most 1 GiB per frame");
   for (const JsonAt& b : root["parked"].Items()) h.parked.push_back(BoxAt(b));
   for (const JsonAt& r : root["rails"].Items()) {
     h.rails.emplace_back();
@@ -253,7 +258,14 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   // a damaged index fails here with its key named, not later in the middle of a video.
   const fs::path bin = dir_ / "frames.bin";
   std::error_code ec;
-  const std::uint64_t bin_size = fs::is_regular_file(bin, ec) ? fs::file_size(bin, ec) : 0;
+  const fs::file_status bin_status = fs::status(bin, ec);
+  if (fs::exists(bin_status) && !fs::is_regular_file(bin_status))
+    throw std::invalid_argument(
+        bin.string() + ": the recording's frames are not a regular file (" +
+        (fs::is_directory(bin_status) ? "a directory" : "a device or pipe") +
+        "), expected the frames.bin a run writes");
+  const std::uint64_t bin_size = fs::is_regular_file(bin_status) ? fs::file_size(bin, ec) : 0;
+  if (ec) throw std::invalid_argument(bin.string() + ": cannot read its size: " + ec.message());
   for (const JsonAt& f : list) {
     times_.push_back(f["t"].Number());
     f["yaw"].Number();
@@ -262,7 +274,7 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
     if (length > bin_size || offset > bin_size - length)
       throw std::invalid_argument(bin.string() + ": shorter than " + where + "'s " +
                                   f["blob"].key() + " says (" +
-                                  (fs::exists(bin) ? "truncated copy?" : "missing") + ")");
+                                  (fs::exists(bin_status) ? "truncated copy?" : "missing") + ")");
     blobs_.push_back({offset, length});
     const auto modes = f["modes"].Tuple(h.modes.size());
     for (const JsonAt& m : modes) m["np"].Integer(0, h.max_particles);
@@ -304,10 +316,10 @@ Frame Reader::Load(std::size_t i) const {
     if (!d.raw().is_array() || (d.raw().size() != 6 && d.raw().size() != 7))
       d.Fail("a detection [sensor, x, y, vx, vy, clutter] or [..., path]");
     const auto v = d.Items();
-    f.detections.push_back({static_cast<int>(v[0].Integer(0, std::max<std::int64_t>(sensors - 1, 0))),
-                            v[1].Number(), v[2].Number(), v[3].Number(), v[4].Number(),
-                            v[5].Integer(0, 1) != 0,
-                            v.size() > 6 ? static_cast<int>(v[6].Integer(0, 2)) : 0});
+    f.detections.push_back(
+        {static_cast<int>(v[0].Integer(0, std::max<std::int64_t>(sensors - 1, 0))), v[1].Number(),
+         v[2].Number(), v[3].Number(), v[4].Number(), v[5].Integer(0, 1) != 0,
+         v.size() > 6 ? static_cast<int>(v[6].Integer(0, 2)) : 0});
   }
   const auto modes = j["modes"].Tuple(h.modes.size());
   f.modes.resize(h.modes.size());
@@ -317,11 +329,10 @@ Frame Reader::Load(std::size_t i) const {
     ModeFrame& mf = f.modes[m];
     for (const JsonAt& c : modes[m]["cl"].Items()) {
       const auto v = c.Tuple(11);
-      mf.clusters.push_back({v[0].Number(), v[1].Number(), v[2].Number(), v[3].Number(),
-                             v[4].Number(), v[5].Number(), v[6].Number(), v[7].Number(),
-                             static_cast<int>(v[8].Integer(0, 2)),
-                             static_cast<int>(v[9].Integer(-1, INT32_MAX)),
-                             v[10].Integer(0, 1) != 0});
+      mf.clusters.push_back(
+          {v[0].Number(), v[1].Number(), v[2].Number(), v[3].Number(), v[4].Number(), v[5].Number(),
+           v[6].Number(), v[7].Number(), static_cast<int>(v[8].Integer(0, 2)),
+           static_cast<int>(v[9].Integer(-1, INT32_MAX)), v[10].Integer(0, 1) != 0});
     }
     const auto l = modes[m]["live"].Tuple(7);
     mf.live = {static_cast<int>(l[0].Integer(0, INT32_MAX)),
@@ -347,7 +358,8 @@ Frame Reader::Load(std::size_t i) const {
     Take(raw, at, n, mf.vx_cm, where);
     Take(raw, at, n, mf.vy_cm, where);
   }
-  for (std::size_t m = 0; m < f.modes.size(); ++m) Take(raw, at, 2 * np[m], f.modes[m].particles, where);
+  for (std::size_t m = 0; m < f.modes.size(); ++m)
+    Take(raw, at, 2 * np[m], f.modes[m].particles, where);
   for (ModeFrame& mf : f.modes) {
     Take(raw, at, n, mf.free, where);
     Take(raw, at, n, mf.static_occ, where);

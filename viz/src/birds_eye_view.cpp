@@ -1,9 +1,9 @@
 #include "dualgrid/viz/birds_eye_view.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
 #include "draw.hpp"
@@ -316,9 +316,12 @@ void BirdsEyeView::DrawVehicle(const OrientedBox& box, const VehicleStyle& style
         cairo_stroke(cr);
         cairo_restore(cr);
       }
-      DrawText(
-          cr, style.label, cx, at->y1 - 0.2 * h,
-          {.size = sm, .bold = style.ego, .h = HAlign::kCenter, .v = VAlign::kBottom, .halo = true});
+      DrawText(cr, style.label, cx, at->y1 - 0.2 * h,
+               {.size = sm,
+                .bold = style.ego,
+                .h = HAlign::kCenter,
+                .v = VAlign::kBottom,
+                .halo = true});
     } else {
       ++impl_->labels_left_out;
     }
