@@ -227,6 +227,21 @@ suite_case first_seed_2_64 "cases[0].first_seed" 18446744073709551615
 suite_case first_seed_2_60 "first_seed + seeds - 1 <= 9007199254740991" 1152921504606846976
 suite_case first_seed_edge "first_seed + seeds - 1 <= 9007199254740991" 9007199254740991 2
 suite_case first_seed_negative "cases[0].first_seed" -1
+# A case that does not run (SUMO refuses its route) exits 3 and says why on stderr, also under -q
+# (it used to exit 3 with nothing said); the report itself goes to stdout.
+sed 's/east_2/no_such_edge/' "$S" >"$rb/bad_edge.yaml"
+printf 'cases:\n  - name: c\n    scenario: %s\n    seeds: 1\n    duration: 0.5\n' "$rb/bad_edge.yaml" \
+  >"$rb/suite_not_run.yaml"
+(cd "$work" && timeout 60 "$dualgrid" regress "$rb/suite_not_run.yaml" --out "$rb/suite_out_not_run" -q \
+  >/dev/null 2>"$rb/not_run.err")
+not_run_rc=$?
+if [ "$not_run_rc" -eq 3 ] && [ "$(wc -l <"$rb/not_run.err")" -eq 1 ] &&
+  grep -q "^dualgrid: error: regress: case c did not run: .*no_such_edge" "$rb/not_run.err"; then
+  passed=$((passed + 1))
+else
+  failed=$((failed + 1))
+  printf 'FAIL regress:case_not_run_quiet: exit %s, stderr: %s\n' "$not_run_rc" "$(cat "$rb/not_run.err")"
+fi
 mkfifo "$rb/suite_fifo.yaml"
 check "regress:suite_fifo" 2 "suite file is a FIFO" "$dualgrid" regress "$rb/suite_fifo.yaml" --out "$rb/sf" -q
 check "regress:suite_dev_zero" 2 "suite file is a device" "$dualgrid" regress /dev/zero --out "$rb/sz" -q

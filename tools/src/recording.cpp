@@ -264,8 +264,11 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
         bin.string() + ": the recording's frames are not a regular file (" +
         (fs::is_directory(bin_status) ? "a directory" : "a device or pipe") +
         "), expected the frames.bin a run writes");
-  const std::uint64_t bin_size = fs::is_regular_file(bin_status) ? fs::file_size(bin, ec) : 0;
-  if (ec) throw std::invalid_argument(bin.string() + ": cannot read its size: " + ec.message());
+  std::error_code size_ec;
+  const std::uint64_t bin_size =
+      fs::is_regular_file(bin_status) ? fs::file_size(bin, size_ec) : 0;  // 0: missing
+  if (size_ec)
+    throw std::invalid_argument(bin.string() + ": cannot read its size: " + size_ec.message());
   for (const JsonAt& f : list) {
     times_.push_back(f["t"].Number());
     f["yaw"].Number();
