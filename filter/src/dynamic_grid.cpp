@@ -99,6 +99,12 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   ++step_;
 }
 
+double DynamicGrid::NewbornMass() const {
+  double total = 0.0;
+  for (const double b : born_) total += b;
+  return total;
+}
+
 std::optional<std::string> DynamicGrid::CheckInvariants() const {
   constexpr double kEps = 1e-9;
   double dynamic_total = 0.0;

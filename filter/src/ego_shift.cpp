@@ -38,7 +38,7 @@ void DynamicGrid::ResetColumn(std::int64_t gx) {
   const std::int64_t sx = Mod(gx, nx_);
   for (std::int64_t sy = 0; sy < ny_; ++sy) {
     const std::int64_t s = sy * nx_ + sx;
-    free_[s] = static_[s] = dynamic_[s] = 0.0;
+    free_[s] = static_[s] = dynamic_[s] = born_[s] = 0.0;
   }
 }
 
@@ -47,6 +47,7 @@ void DynamicGrid::ResetRow(std::int64_t gy) {
   std::fill_n(free_.begin() + sy * nx_, nx_, 0.0);
   std::fill_n(static_.begin() + sy * nx_, nx_, 0.0);
   std::fill_n(dynamic_.begin() + sy * nx_, nx_, 0.0);
+  std::fill_n(born_.begin() + sy * nx_, nx_, 0.0);
 }
 
 std::array<std::int64_t, 2> DynamicGrid::OriginFor(const Position& ego) const {
@@ -64,6 +65,7 @@ void DynamicGrid::ShiftTo(const Position& ego) {
     std::fill(free_.begin(), free_.end(), 0.0);
     std::fill(static_.begin(), static_.end(), 0.0);
     std::fill(dynamic_.begin(), dynamic_.end(), 0.0);
+    std::fill(born_.begin(), born_.end(), 0.0);
   } else {
     for (std::int64_t c = 0; c < std::abs(dx); ++c)
       ResetColumn(dx > 0 ? origin_gx_ + nx_ + c : gx + c);

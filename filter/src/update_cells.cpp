@@ -69,6 +69,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   double* const free_l = free_.data();
   double* const static_l = static_.data();
   double* const dynamic_l = dynamic_.data();
+  double* const born_l = born_.data();
   // Blocks of cells in parallel; dynamic scheduling only balances load, every value is computed by
   // one thread from the same inputs, so results do not depend on the thread count.
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
@@ -97,6 +98,9 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       free_l[s] = fast ? nf : fr;
       static_l[s] = fast ? ns : st;
       dynamic_l[s] = fast ? 0.0 : dynamic_l[s];
+      // No detection near a fast cell: no birth (a_birth is 0 without one). Cleared here as the
+      // general path below sets it, so that no cell keeps an earlier cycle's new-born mass.
+      born_l[s] = fast ? 0.0 : born_l[s];
     }
     // Cells with birth mass, in cell order (Birth reads only these).
     std::int64_t* const born_list = born_cells_.data() + c_lo;

@@ -64,7 +64,8 @@ bool SensorParams::IsValid(std::string* error) const {
     c.InRange(Indexed("off_boresight_accuracy", k), off_boresight_accuracy[k], 1.0, 1000.0);
   }
   c.Positive("reference_range", reference_range, "m");
-  c.Finite("reference_rcs_dbsm", reference_rcs_dbsm, "dBsm");
+  // 10^(rcs / 10) must stay finite (1e300 dBsm gave NaN weights); the scenario bounds too.
+  c.InRange("reference_rcs_dbsm", reference_rcs_dbsm, -60.0, 80.0, Interval::kClosed, "dBsm");
   c.InRange("false_alarm_rate", false_alarm_rate, 0.0, 0.5, Interval::kOpen);
   c.Expect(reference_pd > false_alarm_rate && reference_pd < 1.0, "reference_pd", reference_pd,
            "in (false_alarm_rate = " + FormatShort(false_alarm_rate) + ", 1)");

@@ -122,6 +122,12 @@ RegressionSuite LoadSuite(const std::filesystem::path& file) {
     c.Read("seeds", &rc.seeds);
     if (rc.seeds < 1 || rc.seeds > 10000) c.Fail("seeds", "expected a whole number in [1, 10000]");
     c.Read("first_seed", &rc.first_seed);
+    // Seeds run as `experiment` runs them: first_seed .. first_seed + seeds - 1, each at most
+    // 2^53 - 1 (a seed is exact in JSON and in every tool that reads the outputs).
+    constexpr std::uint64_t kMaxSeed = (std::uint64_t{1} << 53) - 1;
+    if (rc.first_seed > kMaxSeed - static_cast<std::uint64_t>(rc.seeds - 1))
+      c.Fail("first_seed", "expected a whole number with first_seed + seeds - 1 <= " +
+                               std::to_string(kMaxSeed) + ", got " + std::to_string(rc.first_seed));
     c.Read("digest", &rc.digest);
     c.Read("record", &rc.record);
     for (const std::string& m : rc.record) {

@@ -68,8 +68,10 @@ bool ScenarioSpec::IsValid(std::string* error) const {
     c.InRange(f + ".max_speed", t.max_speed, 0.0, kMaxTrafficSpeed, Interval::kLeftOpen, "m/s");
     c.Positive(f + ".accel", t.accel, "m/s^2");
     c.Positive(f + ".decel", t.decel, "m/s^2");
-    c.Finite(f + ".rcs_dbsm", t.rcs_dbsm, "dBsm");
+    c.InRange(f + ".rcs_dbsm", t.rcs_dbsm, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed, "dBsm");
   }
+  for (const auto& [type, rcs] : type_rcs)
+    c.InRange("traffic.rcs_dbsm." + type, rcs, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed, "dBsm");
   for (const auto& [name, edges] : routes) {
     c.Expect(ValidSumoId(name), "routes." + name, Quoted(name),
              std::string("a route name ") + kIdRule);
@@ -137,6 +139,8 @@ bool ScenarioSpec::IsValid(std::string* error) const {
     const auto& pts = guard_rails[i].points;
     c.Expect(pts.size() >= 2, f + ".points", std::to_string(pts.size()) + " points",
              "at least 2 points");
+    c.InRange(f + ".rcs_dbsm_per_metre", guard_rails[i].rcs_dbsm_per_metre, kMinRcsDbsm,
+              kMaxRcsDbsm, Interval::kClosed, "dBsm per metre");
     for (std::size_t k = 1; k < pts.size(); ++k)
       c.Expect((pts[k] - pts[k - 1]).norm() > 1e-3, Indexed(f + ".points", k),
                FormatTuple({pts[k].x(), pts[k].y()}),
@@ -147,6 +151,8 @@ bool ScenarioSpec::IsValid(std::string* error) const {
     const std::string f = Indexed("obstacles.parked", i);
     c.Positive(f + ".length", b.length, "m");
     c.Positive(f + ".width", b.width, "m");
+    c.InRange(f + ".rcs_dbsm", parked[i].rcs_dbsm, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed,
+              "dBsm");
   }
   return c.Done(error);
 }

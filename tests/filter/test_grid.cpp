@@ -211,3 +211,39 @@ TEST_CASE("output is bit-identical with 1 and 2 OpenMP threads", "[filter][deter
   for (std::size_t i = 0; i < one.size(); ++i) mismatches += one[i] != two[i];
   CHECK(mismatches == 0);
 }
+
+TEST_CASE("new-born mass belongs to the last update only, in every path and after a shift",
+          "[filter][grid][birth]") {
+  const std::uint64_t seed = GENERATE(range(1, 5));
+  FilterParams fp;
+  fp.num_particles = 4000;
+  fp.num_birth = 400;
+  DynamicGrid g(fp, seed);
+  CHECK(g.NewbornMass() == 0.0);
+  Pose2 ego;
+  CounterRng rng(seed, RngPurpose::kTest, 2000, 0);
+  ego.position = {rng.Uniform(-1000.0, 1000.0), rng.Uniform(-1000.0, 1000.0)};
+  const auto detect = [&](int step) {
+    const auto cov = Sensors(ego);
+    g.Update({ego, {20, 0}}, RandomDetections(ego, seed, step, cov), cov, 0.05);
+    // Not vacuous: detections give birth mass.
+    REQUIRE(g.NewbornMass() > 0.0);
+  };
+  const auto nothing = [&] {
+    const auto cov = Sensors(ego);
+    g.Update({ego, {20, 0}}, {}, cov, 0.05);
+    // Without detections there is no birth (a_birth = 0 everywhere): any mass left is an earlier
+    // cycle's, in cells the fast path or a shift passed over.
+    CHECK(g.NewbornMass() == 0.0);
+    CHECK_FALSE(g.CheckInvariants());
+  };
+  detect(0);
+  detect(1);
+  nothing();  // in place: fast-path cells
+  detect(2);
+  ego.position += Vector2(3.2, 1.1);  // a shift by whole cells
+  nothing();
+  detect(3);
+  ego.position += Vector2(5000.0, 0.0);  // beyond the grid: every cell is new
+  nothing();
+}

@@ -120,6 +120,15 @@ check "sumo:include_loop" 2 "<include href> nested more than 8 levels deep" \
 ego: {from_routes: v0}')" --no-figures -q --out "$work/s7"
 check "sumo:binary_net" 2 "net.bin" \
   "$dualgrid" run "$(printf 'sumo_config: binary_net.sumocfg\nego: {from_routes: v0}\n' >"$sumo/c8.yaml"; echo "$sumo/c8.yaml")" --no-figures -q --out "$work/s8"
+# A radar cross-section that overflows 10^(rcs / 10) (1e300 dBsm gave NaN weights), for a vType
+# of the route files.
+routes '<vType id="lorry" length="12" vClass="truck"/>' >"$sumo/typed.rou.xml"
+check "sumo:traffic_rcs_huge" 2 "traffic.rcs_dbsm.lorry" \
+  "$dualgrid" run "$(sumo_case traffic_rcs_huge 'traffic: {route_files: [typed.rou.xml], rcs_dbsm: {lorry: 1e300}}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s10"
+check "sumo:traffic_rcs_tiny" 2 "traffic.rcs_dbsm.lorry" \
+  "$dualgrid" run "$(sumo_case traffic_rcs_tiny 'traffic: {route_files: [typed.rou.xml], rcs_dbsm: {lorry: -1e300}}
+ego: {from_routes: v0}')" --no-figures -q --out "$work/s11"
 # The 3 MB comment is read in linear time: the run itself succeeds well within the time limit.
 if out=$(cd "$work" && timeout 60 "$dualgrid" run "$(sumo_case comment 'duration: 1
 traffic: {route_files: [comment.rou.xml]}
@@ -129,6 +138,9 @@ else
   failed=$((failed + 1))
   printf 'FAIL sumo:comment: a valid route file with a 3 MB comment did not run: %s\n' "$out"
 fi
+
+# 5.-10. What dualgrid reads back, sweeps, suites, step lengths, experiments (issue 26).
+source "$here/read_back_cases.sh"
 
 # 3. Hostile command lines.
 mkdir -p "$work/existing/x.png"
@@ -142,6 +154,7 @@ while IFS= read -r line; do
   args=${args//@OUT/$work/cli_out_$n}
   args=${args//@S/$repo/scenarios/highway.yaml}
   args=${args//@T/$work/existing}
+  text=${text//@S/$repo/scenarios/highway.yaml}
   eval "set -- $args"
   check "cli:$n: $args" "$code" "$text" "$dualgrid" "$@"
 done <"$here/cli_cases.txt"

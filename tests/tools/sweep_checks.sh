@@ -18,7 +18,7 @@ for f in plan.json runs.txt tidy.csv aggregate.csv sweep.json; do
   [[ -s $WORK/a/$f ]] || check "sweep wrote no $f"
 done
 [[ $(ls "$WORK/a/figures" | wc -l) -ge 5 ]] || check "fewer than 5 figures"
-grep -q '^s002,front,90,1,dual,D_v,2,' "$WORK/a/aggregate.csv" || check "aggregate row missing"
+grep -q '^s002,front,90,1,dual,D_v,%,2,' "$WORK/a/aggregate.csv" || check "aggregate row missing"
 cp "$WORK/a/aggregate.csv" "$WORK/first.csv"
 
 # A rerun skips every finished run and rewrites the same tables.

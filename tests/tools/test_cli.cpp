@@ -386,7 +386,10 @@ TEST_CASE("Every figure a user gets is readable at one column and says what it s
   all("tracked_share_v", "One run: no confidence interval");
   all("experiment_tracked_share", "whiskers: 95 % confidence interval");
   all("experiment_tracked_share_v", "alongside_truck");
-  all("sweep", "error bars: 95 % confidence interval");
+  // The sweep figure's caption says what is drawn: lines through the means, and (two seeds)
+  // error bars.
+  all("sweep", "Lines: the mean over the seeds");
+  all("sweep", "Error bars: 95 % confidence interval");
 }
 
 // The weights figure explains its shares for the likelihood the run used: with the paper preset

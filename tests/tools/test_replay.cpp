@@ -66,12 +66,13 @@ Dense Decode(const json& index, const std::string& bin, std::size_t i) {
   return d;
 }
 
-// A short highway run with a recording; made once for the test cases below.
+// A short highway run with a recording of ten frames per second (the default is two); made once
+// for the test cases below.
 const fs::path& RecordedRun() {
   static const fs::path dir = [] {
     const fs::path d = TempDir("replay", "run");
     const auto r = Run("run scenarios/highway.yaml --out " + (d / "run").string() +
-                       " --duration 4 --figure-formats png -q");
+                       " --duration 4 --figure-formats png --record-interval 0.1 -q");
     INFO(r.output);
     REQUIRE(r.code == 0);
     return d / "run";
@@ -155,15 +156,23 @@ TEST_CASE("a run's recording agrees with its ground truth, clusters and per-obje
             static_cast<std::size_t>(clusters[{stamp, index["modes"][m].get<std::string>()}]));
       clusters_checked += f["modes"][m]["cl"].size();
     }
-    // Dense data: masses of a cell sum to at most one; each is rounded to a whole per cent (the
-    // three per cents then sum to at most 101) and then to 1/255 (each byte at most 0.5 above
-    // per cent x 2.55): at most 101 x 2.55 + 1.5 = 259. No velocity where the recording says
-    // there is too little dynamic mass.
+    // Dense data: masses of a cell sum to at most one; each is rounded to 2 per cent (the three
+    // then sum to at most 103 %) and then to 1/255 (each byte at most 0.5 above steps x 5.1): at
+    // most 103 x 2.55 + 1.5 = 264; every byte decodes to a whole number of 2 % steps (value /
+    // 255 rounded to two decimals, docs/replay.md). Velocities are whole 0.2 m/s steps, none
+    // where the recording says there is too little dynamic mass.
     const Dense d = Decode(index, bin, i);
+    const auto two_percent = [](std::uint8_t b) {
+      const long percent = std::lround(b / 2.55);
+      return percent % 2 == 0 && std::abs(b - percent * 2.55) <= 0.51;
+    };
     for (std::size_t m = 0; m < modes; ++m) {
       CHECK(d.particles[m].size() <= 2 * index["max_particles"].get<std::size_t>());
       for (std::size_t k = 0; k < d.free[m].size(); ++k) {
-        REQUIRE(d.free[m][k] + d.stat[m][k] + d.dyn[m][k] <= 259);
+        REQUIRE(d.free[m][k] + d.stat[m][k] + d.dyn[m][k] <= 264);
+        REQUIRE(
+            (two_percent(d.free[m][k]) && two_percent(d.stat[m][k]) && two_percent(d.dyn[m][k])));
+        REQUIRE((d.vx[m][k] % 20 == 0 && d.vy[m][k] % 20 == 0));
         if (d.dyn[m][k] < 13) REQUIRE((d.vx[m][k] == 0 && d.vy[m][k] == 0));
       }
     }
@@ -202,6 +211,11 @@ TEST_CASE("the recording is the same whatever the thread count", "[cli][replay]"
   }
   CHECK(Slurp(d / "1" / "replay" / "frames.bin") == Slurp(d / "2" / "replay" / "frames.bin"));
   CHECK(Slurp(d / "1" / "replay" / "index.json") == Slurp(d / "2" / "replay" / "index.json"));
+  // The defaults (docs/replay.md, "The recording"): two frames per second, 500 particles.
+  const json index = json::parse(Slurp(d / "1" / "replay" / "index.json"));
+  CHECK(index["interval"].get<double>() == Approx(0.5));
+  CHECK(index["max_particles"] == 500);
+  CHECK(index["frames"].size() == 4);
 }
 
 TEST_CASE("replay: an H.264 video whose frames show the run, a preview and the viewer page",
@@ -344,7 +358,24 @@ TEST_CASE("replay: bad input gets one line and exit code 2", "[cli][replay]") {
   bad["frames"] = json::array();
   std::ofstream(d / "copy" / "replay" / "index.json") << bad.dump();
   one_line_2(Run("replay " + (d / "copy").string()), "'frames'");
+  // A malformed detection: the viewer page is refused as the video is (the page was written).
+  // (The copied run may hold a page an earlier test case wrote.)
+  fs::remove(d / "copy" / "replay.html");
+  bad = index;
+  bad["frames"][5]["det"] = json::array({json::array({0, 1.0, 2.0})});
+  std::ofstream(d / "copy" / "replay" / "index.json") << bad.dump();
+  one_line_2(Run("replay " + (d / "copy").string() + " --html"), "'frames[5].det[0]'");
+  CHECK_FALSE(fs::exists(d / "copy" / "replay.html"));
   std::ofstream(d / "copy" / "replay" / "index.json") << index.dump();
+  // Flipped bytes in a frame's zlib data: refused by --html too, naming the frame.
+  {
+    std::string frames = Slurp(d / "copy" / "replay" / "frames.bin");
+    const std::size_t at = index["frames"][7]["blob"][0].get<std::size_t>() + 40;
+    frames[at] = static_cast<char>(frames[at] ^ 0xff);
+    frames[at + 9] = static_cast<char>(frames[at + 9] ^ 0x5a);
+    std::ofstream(d / "copy" / "replay" / "frames.bin", std::ios::binary) << frames;
+  }
+  one_line_2(Run("replay " + (d / "copy").string() + " --html"), "frames[7].blob");
   fs::resize_file(d / "copy" / "replay" / "frames.bin", 1000);
   one_line_2(Run("replay " + (d / "copy").string()), "frames.bin");
   // Options the viewer would ignore, and a video into a folder that does not exist.

@@ -1,6 +1,7 @@
 #include <cairo.h>
 
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdint>
@@ -972,4 +973,44 @@ TEST_CASE("the font record catches text too small for one column", "[viz][fonts]
     CHECK(inner.records().size() == 1);
   }
   CHECK(audit.records().size() == 2);
+}
+
+TEST_CASE("BirdsEyeView: vehicle labels never overlap each other or the ego", "[viz]") {
+  BirdsEyeOptions opt;
+  opt.pixel_width = 900;
+  opt.png_scale = 1.0;
+  BirdsEyeView view({{-40.0, -12.0}, {80.0, 12.0}}, opt);
+  VehicleStyle ego;
+  ego.label = "ego";
+  ego.ego = true;
+  const OrientedBox ego_box{Position(0, 0), 0.0, 4.6, 1.9};
+  view.DrawVehicle(ego_box, ego);
+  // A jam: three lanes of cars 6 m apart with long names, far more than fit above and below.
+  int drawn = 1;  // the ego's own label
+  for (int lane = -1; lane <= 1; ++lane)
+    for (double x = -30.0; x <= 70.0; x += 6.0) {
+      if (lane == 0 && std::abs(x) < 5.0) continue;  // the ego's place
+      VehicleStyle car;
+      car.label = "flow_east." + std::to_string(drawn);
+      view.DrawVehicle({Position(x, 3.5 * lane), 0.0, 4.5, 1.8}, car);
+      ++drawn;
+    }
+  view.KeepLabelsOff(ego_box);
+  const auto boxes = view.label_boxes();
+  // The ego's box (first, and again last: kept clear) and every label placed; the others are
+  // counted as left out.
+  const int placed = static_cast<int>(boxes.size()) - 2;
+  CHECK(placed + view.labels_left_out() == drawn);
+  // Not vacuous: several labels found a place, and the jam is too dense for all of them.
+  CHECK(placed > 3);
+  CHECK(view.labels_left_out() > 0);
+  const auto overlap = [](const std::array<double, 4>& a, const std::array<double, 4>& b) {
+    return std::min(a[2], b[2]) - std::max(a[0], b[0]) > 1e-6 &&
+           std::min(a[3], b[3]) - std::max(a[1], b[1]) > 1e-6;
+  };
+  int overlaps = 0;
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (std::size_t j = i + 1; j < boxes.size(); ++j)
+      if (!(i == 0 && j == boxes.size() - 1)) overlaps += overlap(boxes[i], boxes[j]);
+  CHECK(overlaps == 0);
 }

@@ -579,7 +579,8 @@ def record(binary, work):
     page. Returns (run folder, page)."""
     run, html = os.path.join(work, "run"), os.path.join(work, "replay.html")
     for cmd in ([binary, "run", "scenarios/simple_road.yaml", "--out", run, "--duration", "6",
-                 "--figure-formats", "png", "--set", "sensors.multipath=on", "--quiet"],
+                 "--figure-formats", "png", "--set", "sensors.multipath=on", "--record-interval", "0.1",
+                 "--quiet"],
                 [binary, "replay", run, "--html", "--html-out", html, "--quiet"]):
         print("$", " ".join(cmd), flush=True)
         try:

@@ -13,19 +13,21 @@ Box ToBox(int id, const OrientedBox& b, const Velocity& v) {
   return {id, b.center.x(), b.center.y(), b.yaw, b.length, b.width, v.x(), v.y()};
 }
 
-// Velocity in cm/s, rounded to 0.1 m/s: finer steps only add noise that zlib cannot compress
-// (measured on the highway: the velocity arrays shrink 2.7x).
+// Velocity in cm/s, rounded to 0.2 m/s: finer steps only add noise that zlib cannot compress
+// (measured on the highway: 0.1 m/s steps made the velocity arrays 2.7x smaller than cm/s, 0.2
+// m/s another ~10 %; a colour hue or a read-out does not show the difference).
 std::int16_t Centimetres(float v) {
-  const double dm = std::round(static_cast<double>(v) * 10.0);
-  return static_cast<std::int16_t>(std::clamp(dm * 10.0, -32760.0, 32760.0));
+  const double steps = std::round(static_cast<double>(v) * 5.0);
+  return static_cast<std::int16_t>(std::clamp(steps * 20.0, -32760.0, 32760.0));
 }
 
-// A mass in 1/255 steps, rounded to a whole per cent first: a read-out shows two decimals, and
-// 101 levels compress ~25 % better than 256.
+// A mass in 1/255 steps, rounded to 2 per cent first: 51 levels compress the mass arrays ~20 %
+// better than whole per cents (docs/replay.md, "Cost"), and a picture's grey levels or a
+// read-out of two decimals lose nothing a reader compares.
 std::uint8_t Quantise(float mass) {
   // Non-negative, so adding 0.5 and truncating rounds (std::lround was 2 % of a recorded run).
-  const int percent = static_cast<int>(std::clamp(mass, 0.0f, 1.0f) * 100.0f + 0.5f);
-  return static_cast<std::uint8_t>(static_cast<int>(percent * 2.55f + 0.5f));
+  const int steps = static_cast<int>(std::clamp(mass, 0.0f, 1.0f) * 50.0f + 0.5f);
+  return static_cast<std::uint8_t>(static_cast<int>(steps * 5.1f + 0.5f));
 }
 
 // Below this quantised dynamic mass (0.05) a cell's mean velocity is not recorded: its colour

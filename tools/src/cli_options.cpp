@@ -24,6 +24,13 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
       ->check(OverrideSpec());
 }
 
+void AddCaptionOption(CLI::App* cmd, bool* captions) {
+  cmd->add_option_function<std::string>(
+         "--figure-captions", [captions](const std::string& v) { *captions = v == "on"; },
+         "Captions under the figures: on (default) or off (for a paper that sets its own)")
+      ->check(CLI::IsMember({"on", "off"}));
+}
+
 CLI::Validator DetectionFormat() { return CLI::IsMember({"none", "csv", "csv.gz", "exact"}); }
 
 void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
@@ -42,6 +49,7 @@ void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
                   "(default: all three)")
       ->delimiter(',')
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
+  AddCaptionOption(cmd, &o->figure_captions);
   cmd->add_flag_callback(
       "--write-detections", [o] { o->detections = "csv"; }, "Same as --detections csv");
   Opt(cmd, "--detections", &o->detections,

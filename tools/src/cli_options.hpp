@@ -53,6 +53,8 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
 /// The options of the commands that run the filters (run, experiment); `*no_figures` receives
 /// --no-figures.
 void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures);
+/// `--figure-captions on|off` into `*captions`.
+void AddCaptionOption(CLI::App* cmd, bool* captions);
 /// none, csv or csv.gz.
 CLI::Validator DetectionFormat();
 

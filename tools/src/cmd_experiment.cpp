@@ -22,6 +22,7 @@
 #include "figures.hpp"
 #include "output.hpp"
 #include "progress.hpp"
+#include "read_back.hpp"
 #include "run_outputs.hpp"
 #include "signals.hpp"
 
@@ -61,6 +62,7 @@ std::vector<std::string> RunArgs(const ExperimentOptions& o, std::uint64_t seed,
   std::string formats;
   for (const auto& f : o.run.figure_formats) formats += (formats.empty() ? "" : ",") + f;
   if (figures) args.insert(args.end(), {"--figure-formats", formats});
+  if (figures && !o.run.figure_captions) args.insert(args.end(), {"--figure-captions", "off"});
   if (o.run.write_particles) args.push_back("--write-particles");
   if (o.run.check_invariants) args.push_back("--check-invariants");
   args.insert(args.end(), {"--threads", std::to_string(threads)});
@@ -98,9 +100,12 @@ int RunExperiment(const ExperimentOptions& o) {
   std::vector<std::uint64_t> finished;
   std::vector<std::pair<std::uint64_t, std::string>> failed;  // seed, its error
   int next = 0, done = 0;
+  // A seed run that refused its input (exit code 2): every seed has the same input, so no more
+  // are started, and if none finished the experiment reports that one error as its own.
+  std::string bad_input;
   std::vector<std::uint64_t> cut_short;  // stopped by a signal: partial, not aggregated
   while (true) {
-    while (pool.Free() && next < o.seeds) {
+    while (pool.Free() && next < o.seeds && bad_input.empty()) {
       const std::uint64_t seed = o.first_seed + next++;
       const auto dir = seed_dir(seed);
       std::filesystem::create_directories(dir.parent_path());
@@ -118,11 +123,14 @@ int RunExperiment(const ExperimentOptions& o) {
     } else if (StopSignal() && (code == 130 || code == 143)) {
       cut_short.push_back(seed);
     } else {
-      std::string why = LastLine(LogPath(seed_dir(seed)));
-      if (ended->signal) why = "killed by signal " + std::to_string(ended->signal);
-      if (why.empty()) why = "exit code " + std::to_string(code);
+      // Its stderr as the pool read it: the log may not have been writable (a full disk).
+      const std::string why = ChildFailure(*ended, LogPath(seed_dir(seed)));
       failed.emplace_back(seed, why);
-      std::cerr << "dualgrid: seed " << seed << " failed: " << why << "\n";
+      if (code == kExitBadInput && !ended->signal) {
+        if (bad_input.empty()) bad_input = why;
+      } else {
+        std::cerr << "dualgrid: seed " << seed << " failed: " << why << "\n";
+      }
     }
     progress.Update(done, std::to_string(done) + "/" + std::to_string(o.seeds) + " seeds");
   }
@@ -141,6 +149,47 @@ int RunExperiment(const ExperimentOptions& o) {
     std::cerr << "dualgrid: " << stop_status << "\n";
     if (finished.empty()) return StopExitCode();
   }
+  if (finished.empty() && !bad_input.empty()) throw std::invalid_argument(bad_input);
+  if (!bad_input.empty())
+    std::cerr << "dualgrid: a seed run refused its input: " << bad_input << "\n";
+  // Every finished seed's results, read back; a seed whose files cannot be read is a failed seed.
+  struct SeedResult {
+    std::uint64_t seed;
+    nlohmann::json metrics;
+    double wall_s;
+    std::string end;
+    double ended_s;
+  };
+  std::vector<SeedResult> results;
+  for (const std::uint64_t seed : finished) {
+    const auto dir = seed_dir(seed);
+    try {
+      const JsonFile metrics = ReadJsonFile(dir / "metrics.json", "run metrics");
+      const JsonFile run_summary = ReadJsonFile(dir / "summary.json", "run summary");
+      const JsonAt rs = run_summary.Root();
+      SeedResult r{seed, metrics.doc(), 0.0, "", 0.0};
+      if (const auto w = rs.Find("wall_s")) r.wall_s = w->Number(0.0);
+      if (const auto e = rs.Find("end")) r.end = e->Text();
+      if (const auto e = rs.Find("ended_s")) r.ended_s = e->Number();
+      const JsonAt modes = metrics.Root()["modes"];
+      for (const auto& mode : o.run.modes) {
+        const JsonAt m = modes[mode];
+        try {
+          (void)m.raw().get<eval::ScenarioMetrics>();
+        } catch (const nlohmann::json::exception&) {
+          m.Fail("the metrics of a dualgrid run (docs/output.md)");
+        }
+      }
+      if (!metrics.Root()["object_names"].raw().is_object())
+        metrics.Root()["object_names"].Fail("an object");
+      results.push_back(std::move(r));
+    } catch (const std::invalid_argument& e) {
+      failed.emplace_back(seed, e.what());
+      std::cerr << "dualgrid: seed " << seed << " failed: " << e.what() << "\n";
+    }
+  }
+  finished.clear();
+  for (const auto& r : results) finished.push_back(r.seed);
   if (finished.empty())
     throw std::runtime_error("all " + std::to_string(o.seeds) +
                              " seed runs failed; the first: " + failed.front().second +
@@ -153,19 +202,22 @@ int RunExperiment(const ExperimentOptions& o) {
   for (const auto& m : o.run.modes) runs.push_back({m, {}});
   double wall = 0.0;
   std::vector<std::string> ended_early;  // seeds whose ego left the network before the duration
-  for (const std::uint64_t seed : finished) {
-    const auto dir = seed_dir(seed);
-    nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "metrics.json"));
-    const nlohmann::json run_summary = nlohmann::json::parse(std::ifstream(dir / "summary.json"));
-    wall += run_summary.value("wall_s", 0.0);
-    if (run_summary.value("end", "") == "ego_left")
-      ended_early.push_back("seed " + std::to_string(seed) +
-                            " at t = " + FormatFixed(run_summary.value("ended_s", 0.0), 2) + " s");
+  for (const SeedResult& result : results) {
+    const nlohmann::json& j = result.metrics;
+    wall += result.wall_s;
+    if (result.end == "ego_left")
+      ended_early.push_back("seed " + std::to_string(result.seed) +
+                            " at t = " + FormatFixed(result.ended_s, 2) + " s");
     for (auto& r : runs) {
       eval::ScenarioMetrics m = j.at("modes").at(r.mode).get<eval::ScenarioMetrics>();
-      for (auto& obj : m.objects)
-        obj.id = names.Id(
-            j.at("object_names").value(std::to_string(obj.id), "#" + std::to_string(obj.id)));
+      // (checked above: "modes" holds every mode's metrics, "object_names" is an object)
+      const nlohmann::json& object_names = j.at("object_names");
+      for (auto& obj : m.objects) {
+        std::string key = std::to_string(obj.id);
+        const auto it = object_names.find(key);
+        obj.id = names.Id(it != object_names.end() && it->is_string() ? it->get<std::string>()
+                                                                      : key.insert(0, 1, '#'));
+      }
       r.seeds.push_back(std::move(m));
     }
   }
@@ -213,7 +265,7 @@ int RunExperiment(const ExperimentOptions& o) {
                                 config.sim.name + ": " + (v ? "D_v" : "D") +
                                     " per object, mean and 95 % CI over " +
                                     std::to_string(finished.size()) + " seeds",
-                                "tracked share " + what, p, errors);
+                                "tracked share " + what + " [%]", p, errors, o.run.figure_captions);
           },
           &warnings);
     }

@@ -16,6 +16,7 @@
 #include "dualgrid/scenario/suite.hpp"
 #include "exit_codes.hpp"
 #include "output.hpp"
+#include "read_results.hpp"
 #include "signals.hpp"
 
 namespace dualgrid::tools {
@@ -28,41 +29,22 @@ namespace fs = std::filesystem;
 // took (summary.json) or where (config.json holds paths).
 constexpr const char* kDigestFiles[] = {"clusters.csv", "objects.csv", "table.csv"};
 
-nlohmann::json ReadJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path.string() + ": cannot read");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(path.string() + ": not valid JSON: " + e.what());
-  }
-}
-
 // mode.metric -> value, from an experiment's table.json.
 std::map<std::string, eval::MetricValue> ReadTable(const std::filesystem::path& table) {
   std::map<std::string, eval::MetricValue> out;
-  const nlohmann::json doc = ReadJson(table);  // (a temporary would die before the loop)
-  for (const auto& m : doc.at("metrics")) {
-    for (const auto& [mode, v] : m.at("values").items()) {
-      if (!v.contains("mean") || v.at("mean").is_null()) continue;  // undefined in this run
-      eval::MetricValue mv;
-      mv.mean = v.at("mean").get<double>();
-      if (v.contains("ci95_half_width") && !v.at("ci95_half_width").is_null())
-        mv.half_width = v.at("ci95_half_width").get<double>();
-      mv.n = v.value("n", 0);
-      out[mode + "." + m.at("key").get<std::string>()] = mv;
-    }
-  }
+  for (const TableMetric& m : ReadTableJson(table))
+    for (const auto& [mode, v] : m.modes) out[mode + "." + m.key] = v;
   return out;
 }
 
 // FNV-1a 64 over "file=digest;" of the fingerprint files of the first seed's run folder.
 std::string CaseDigest(const std::filesystem::path& seed_dir) {
-  const nlohmann::json summary = ReadJson(seed_dir / "summary.json");
-  const nlohmann::json& digests = summary.at("digests");
+  const JsonFile summary = ReadJsonFile(seed_dir / "summary.json", "run summary");
+  const JsonAt digests = summary.Root()["digests"];
   std::uint64_t h = 1469598103934665603ull;
   for (const char* f : kDigestFiles) {
-    const std::string part = std::string(f) + "=" + digests.value(f, std::string("missing")) + ";";
+    const std::string part =
+        std::string(f) + "=" + (digests.Has(f) ? digests[f].Text() : std::string("missing")) + ";";
     for (unsigned char c : part) {
       h ^= c;
       h *= 1099511628211ull;
@@ -175,9 +157,13 @@ int RunRegress(const RegressOptions& o) {
       }
     }
     if (!r.ran) r.digest_status = "—";
-    if (!o.quiet)
-      std::cerr << "regress: case " << c.name << (r.ran ? " done" : " FAILED: " + r.error) << " in "
-                << static_cast<int>(r.wall_s) << " s\n";
+    // A case that did not run is an error, said even under -q (which only silences progress).
+    if (!r.ran)
+      std::cerr << "dualgrid: error: regress: case " << c.name << " did not run: " << r.error
+                << "\n";
+    else if (!o.quiet)
+      std::cerr << "regress: case " << c.name << " done in " << static_cast<int>(r.wall_s)
+                << " s\n";
     results.push_back(r);
   }
   const bool stopped = StopSignal() != 0;

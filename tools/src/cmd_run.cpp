@@ -173,7 +173,7 @@ int RunLoop(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
           png, options.figure_formats,
           [&](const auto& p) {
             RenderWeightTrace(traces.by_vehicle.at(focus), focus, mode_names[trace_mode],
-                              config.filter.velocity_likelihood, p);
+                              config.filter.velocity_likelihood, p, options.figure_captions);
           },
           &warnings);
     }
@@ -186,7 +186,7 @@ int RunLoop(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
             RenderTrackedShares(mode_names, RunTrackedShares(metrics, ids, v),
                                 config.sim.name + ": tracked share " + what + " per object (seed " +
                                     std::to_string(config.sim.seed) + ")",
-                                "tracked share " + what, p);
+                                "tracked share " + what + " [%]", p, {}, options.figure_captions);
           },
           &warnings);
     }

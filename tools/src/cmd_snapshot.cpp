@@ -37,7 +37,8 @@ int RunSnapshot(const SnapshotOptions& options) {
     throw std::runtime_error("the ego never departed before t = " + FormatFixed(options.time, 2) +
                              " s: nothing to draw");
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
-  RenderScene(pipeline, png, options.behind, options.ahead, options.half_width);
+  RenderScene(pipeline, png, options.behind, options.ahead, options.half_width,
+              options.figure_captions);
   if (!run.quiet)
     std::cout << "wrote " << png.string() << " (t = " << FormatFixed(pipeline.frame().time, 2)
               << " s, " << pipeline.detections().size() << " detections)\n";
@@ -59,6 +60,7 @@ Command AddSnapshotCommand(CLI::App& app, const CliContext& ctx) {
   Opt(cmd, "--ahead", &o->ahead, "View ahead of the ego [m]")->check(Number(0.0, 2000.0, true));
   Opt(cmd, "--half-width", &o->half_width, "View to each side of the ego [m]")
       ->check(Number(0.0, 1000.0, true));
+  AddCaptionOption(cmd, &o->figure_captions);
   return {cmd, [o] { return RunSnapshot(*o); }};
 }
 

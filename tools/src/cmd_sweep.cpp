@@ -26,6 +26,7 @@
 #include "figures.hpp"
 #include "output.hpp"
 #include "progress.hpp"
+#include "read_results.hpp"
 #include "signals.hpp"
 #include "sweep_spec.hpp"
 
@@ -42,6 +43,56 @@ std::string MetricUnit(const std::string& metric) {
   if (metric == "delta_x") return "m";
   if (metric == "delta_v") return "m/s";
   return "s";
+}
+
+// The unit of a swept key, for the figures' x axis: the generator's options (docs/stress.md) and
+// the scenario keys with a unit (docs/scenarios.md, FilterParams); "" for a key without one
+// (a count, a name, a switch) or one not listed here.
+std::string SweepKeyUnit(const std::string& key) {
+  static const std::map<std::string, std::string> kUnits = {
+      {"tangential.angle", "deg"},
+      {"tangential.range", "m"},
+      {"tangential.speed", "m/s"},
+      {"tangential.ego_speed", "m/s"},
+      {"tangential.interval", "s"},
+      {"tangential.grid_width", "m"},
+      {"tangential.first_distance", "m"},
+      {"tangential.spacing", "m"},
+      {"duration", "s"},
+      {"step_length", "s"},
+      {"filter.length_x", "m"},
+      {"filter.width_y", "m"},
+      {"filter.resolution", "m"},
+      {"filter.ahead", "m"},
+      {"filter.left", "m"},
+      {"filter.realign_deg", "deg"},
+      {"filter.process_noise_position", "m/sqrt(s)"},
+      {"filter.process_noise_velocity", "m/s/sqrt(s)"},
+      {"filter.birth_max_tangential_speed", "m/s"},
+      {"filter.birth_sigma_radial", "m/s"},
+      {"filter.max_speed", "m/s"},
+      {"filter.sigma_f", "m"},
+      {"filter.sigma_static_distance", "m"},
+      {"filter.sigma_static_velocity", "m/s"},
+      {"filter.sigma_v", "m/s"},
+      {"filter.free_angle_bin", "rad"},
+      {"filter.static_speed", "m/s"},
+      {"ego.speed", "m/s"},
+      {"ego.position", "m"},
+  };
+  const auto it = kUnits.find(key);
+  return it == kUnits.end() ? "" : it->second;
+}
+
+// What a sweep figure draws (viz::RenderLineChart: lines through the means, error bars, no
+// markers), for its caption.
+std::string SweepCaption(int most_seeds) {
+  std::string c =
+      "Lines: the mean over the seeds of each setting, joined from setting to setting (a setting "
+      "without a finished run is left out); colour: the filter's weight mode.";
+  c += most_seeds > 1 ? " Error bars: 95 % confidence interval of the mean (Student t)."
+                      : " No error bars: one seed per setting.";
+  return c;
 }
 
 }  // namespace
@@ -139,28 +190,44 @@ int RunSweep(const SweepOptions& o) {
     if (!generator && a.key.rfind("tangential.", 0) == 0)
       throw std::invalid_argument("--set " + a.key + ": generator keys need the scenario '" +
                                   std::string(kGenerator) + "'");
+  // Counted before anything is built: a product of a million settings is refused at once, not
+  // after minutes of validation (or an allocation failure).
+  std::size_t count = 1;
+  std::string shape;
+  for (const auto& a : axes) {
+    count = count > kMaxSweepSettings ? count : count * a.values.size();
+    shape += (shape.empty() ? "" : " x ") + std::to_string(a.values.size());
+  }
+  if (count > kMaxSweepSettings)
+    throw std::invalid_argument("--set: " + shape + " values make more than " +
+                                std::to_string(kMaxSweepSettings) +
+                                " settings, expected at most that many (split the study into "
+                                "several sweeps)");
+  if (count * static_cast<std::size_t>(o.seeds) > kMaxSweepRuns)
+    throw std::invalid_argument("--set, --seeds: " + std::to_string(count) + " settings x " +
+                                std::to_string(o.seeds) + " seeds, expected at most " +
+                                std::to_string(kMaxSweepRuns) + " runs");
   const auto settings = SweepSettings(axes);
   const fs::path out = fs::absolute(o.out);
   // Resumable: an earlier sweep folder is kept (its finished runs are skipped), but only if it
   // was a sweep of the same plan.
-  nlohmann::json plan;
-  plan["scenario"] = generator ? std::string(kGenerator) : fs::absolute(o.scenario).string();
-  for (const auto& a : axes) plan["axes"].push_back({{"key", a.key}, {"values", a.values}});
-  plan["seeds"] = o.seeds;
-  plan["first_seed"] = o.first_seed;
-  plan["modes"] = o.modes;
-  plan["duration"] = o.duration ? nlohmann::json(*o.duration) : nlohmann::json(nullptr);
+  SweepPlan plan;
+  plan.scenario = generator ? std::string(kGenerator) : fs::absolute(o.scenario).string();
+  for (const auto& a : axes) plan.axes.push_back({a.key, a.values});
+  plan.seeds = o.seeds;
+  plan.first_seed = o.first_seed;
+  plan.modes = o.modes;
+  plan.duration = o.duration;
   const fs::path plan_file = out / "plan.json";
   if (fs::exists(plan_file)) {
-    nlohmann::json old;
+    SweepPlan old;
     try {
-      old = nlohmann::json::parse(std::ifstream(plan_file));
-    } catch (const std::exception&) {
+      old = ReadSweepPlan(plan_file);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string(e.what()) +
+                                  " (an earlier sweep's plan; use a new --out or remove it)");
     }
-    nlohmann::json cmp = old;
-    cmp.erase("settings");
-    cmp.erase("runs");
-    if (cmp != plan)
+    if (SweepPlanIdentity(old) != SweepPlanIdentity(plan))
       throw std::invalid_argument(out.string() +
                                   " holds a sweep of another plan (plan.json differs); use a new "
                                   "--out or remove it");
@@ -168,16 +235,20 @@ int RunSweep(const SweepOptions& o) {
     PrepareOutputFolder(out);
   }
 
-  // Scenarios and run commands; every setting is validated before anything runs.
+  // Scenarios and run commands; every setting is validated before anything runs (a stop signal
+  // ends the validation at once: nothing has run).
   std::ostringstream list;
   std::vector<std::pair<std::vector<std::string>, fs::path>> runs;  // args, folder
+  Progress checking("sweep: checking settings", static_cast<int>(settings.size()), !o.quiet);
   for (std::size_t si = 0; si < settings.size(); ++si) {
+    if (StopSignal()) return StopExitCode();
+    checking.Update(static_cast<int>(si));
     const auto& values = settings[si];
-    char id[16];
+    char id[24];
     std::snprintf(id, sizeof id, "s%03zu", si + 1);
     const std::string label = SettingLabel(axes, values);
-    fs::path scenario =
-        generator ? out / "scenarios" / (std::string(id) + ".yaml") : fs::absolute(o.scenario);
+    const fs::path generated = fs::path("scenarios") / (std::string(id) + ".yaml");
+    const fs::path scenario = generator ? out / generated : fs::absolute(o.scenario);
     std::vector<std::string> sets;
     TangentialOptions gen;
     gen.kind = "aspect";
@@ -199,11 +270,12 @@ int RunSweep(const SweepOptions& o) {
     } catch (const std::exception& e) {
       throw std::invalid_argument("setting " + std::string(id) + " (" + label + "): " + e.what());
     }
-    plan["settings"].push_back(
-        {{"id", id}, {"values", values}, {"label", label}, {"scenario", scenario.string()}});
+    // A generated scenario is named relative to the sweep folder: a copied folder uses its own.
+    plan.settings.push_back(
+        {id, values, label, generator ? generated.string() : scenario.string()});
     for (int k = 0; k < o.seeds; ++k) {
       const std::uint64_t seed = o.first_seed + k;
-      const fs::path folder = out / "runs" / id / ("seed_" + std::to_string(seed));
+      const fs::path folder = RunFolder(out, id, seed);
       std::vector<std::string> args = {o.executable,
                                        "run",
                                        scenario.string(),
@@ -225,14 +297,15 @@ int RunSweep(const SweepOptions& o) {
       std::string line;
       for (const auto& a : args) line += (line.empty() ? "" : " ") + ShellQuote(a);
       list << line << " > " << ShellQuote(folder.string() + ".log") << " 2>&1\n";
-      plan["runs"].push_back({{"setting", id}, {"seed", seed}, {"folder", folder.string()}});
+      plan.runs.push_back({id, seed});
       runs.emplace_back(std::move(args), folder);
     }
   }
+  checking.Finish();
   // Every setting is valid: now the run folders' parents (logs sit beside the folders, and
   // runs.txt redirects into them).
   for (const auto& run : runs) fs::create_directories(run.second.parent_path());
-  WriteTextFile(plan_file, plan.dump(2) + "\n");
+  WriteTextFile(plan_file, SweepPlanJson(plan).dump(2) + "\n");
   WriteTextFile(out / "runs.txt", list.str());
 
   if (o.emit == "slurm") {
@@ -268,7 +341,7 @@ int RunSweep(const SweepOptions& o) {
               << " seeds = " << runs.size() << " runs, " << split.Describe() << "\n";
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < runs.size(); ++i)
-    if (!RunComplete(runs[i].second)) todo.push_back(i);
+    if (!ReadRunState(runs[i].second).complete) todo.push_back(i);
   if (!o.quiet && todo.size() < runs.size())
     std::cerr << "sweep: " << runs.size() - todo.size() << " runs finished earlier, skipped\n";
   Progress progress("sweep", static_cast<int>(todo.size()), !o.quiet);
@@ -285,67 +358,76 @@ int RunSweep(const SweepOptions& o) {
     if (!ended) break;
     const std::size_t i = ended->tag;
     ++done;
-    if (!RunComplete(runs[i].second)) {
+    if (!ReadRunState(runs[i].second).complete) {
       ++failed;
       if (!StopSignal())
         std::cerr << "dualgrid: run " << runs[i].second.string()
-                  << " failed: " << LastLine(runs[i].second.string() + ".log") << "\n";
+                  << " failed: " << ChildFailure(*ended, runs[i].second.string() + ".log") << "\n";
     }
     progress.Update(done, std::to_string(done) + "/" + std::to_string(todo.size()) + " runs");
   }
   progress.Finish();
-  const int collected = RunCollect(CollectOptions{out, o.quiet});
+  const int collected = RunCollect(CollectOptions{out, o.quiet, o.figure_captions});
   if (StopSignal()) return StopExitCode();
   return failed > 0 ? kExitSomeSeedsFailed : collected;
 }
 
 int RunCollect(const CollectOptions& o) {
   const fs::path out = fs::absolute(o.dir);
-  nlohmann::json plan;
-  try {
-    plan = nlohmann::json::parse(std::ifstream(out / "plan.json"));
-  } catch (const std::exception&) {
-    throw std::invalid_argument(out.string() + ": no readable plan.json (not a sweep folder)");
-  }
+  if (!fs::exists(out / "plan.json"))
+    throw std::invalid_argument(out.string() + ": no plan.json (not a sweep folder)");
+  const SweepPlan plan = ReadSweepPlan(out / "plan.json");
   std::vector<std::string> keys;
-  for (const auto& a : plan.at("axes")) keys.push_back(a.at("key"));
-  std::map<std::string, nlohmann::json> setting_of;
-  for (const auto& s : plan.at("settings")) setting_of[s.at("id")] = s;
+  for (const auto& a : plan.axes) keys.push_back(a.key);
+  std::map<std::string, const SweepPlan::Setting*> setting_of;
+  for (const auto& s : plan.settings) setting_of[s.id] = &s;
   // Tidy rows: setting x seed x mode x metric.
   std::ostringstream tidy;
   tidy << "setting";
   for (const auto& k : keys) tidy << "," << CsvCell(k);
-  tidy << ",seed,mode,metric,value\n";
+  tidy << ",seed,mode,metric,unit,value\n";
   // (setting, mode, metric) -> samples
   std::map<std::tuple<std::string, std::string, std::string>, std::vector<double>> samples;
+  std::map<std::string, std::string> unit_of;  // metric -> unit, as the tables say
   std::vector<std::string> missing;
   int complete = 0;
-  for (const auto& r : plan.at("runs")) {
-    const fs::path folder = r.at("folder").get<std::string>();
-    const std::string sid = r.at("setting");
-    if (!RunComplete(folder)) {
-      std::string why = LastLine(folder.string() + ".log");
-      missing.push_back(folder.string() + (why.empty() ? " (not run)" : ": " + why));
+  for (const auto& r : plan.runs) {
+    const fs::path folder = RunFolder(out, r.setting, r.seed);
+    const RunState state = ReadRunState(folder);
+    if (!state.complete) {
+      const std::string log = LastLine(folder.string() + ".log");
+      const std::string why = state.why == "not run" && !log.empty() ? log : state.why;
+      missing.push_back(folder.string() + ": " + why);
+      continue;
+    }
+    // A run counts as complete only once its table is read: a damaged table.json is a missing
+    // run, not a setting without rows.
+    std::vector<TableMetric> table;
+    try {
+      table = ReadTableJson(folder / "table.json");
+      for (const TableMetric& m : table)
+        for (const std::string& mode : plan.modes)
+          if (!m.modes.count(mode) && m.key != "t_d")
+            throw std::invalid_argument((folder / "table.json").string() + ": metric '" + m.key +
+                                        "' has no value for mode '" + mode +
+                                        "', expected one (the plan runs it)");
+      if (table.empty())
+        throw std::invalid_argument((folder / "table.json").string() +
+                                    ": key 'metrics': expected at least one metric");
+    } catch (const std::invalid_argument& e) {
+      missing.push_back(e.what());
       continue;
     }
     ++complete;
-    nlohmann::json table;
-    try {
-      table = nlohmann::json::parse(std::ifstream(folder / "table.json"));
-    } catch (const std::exception& e) {
-      missing.push_back(folder.string() + ": table.json unreadable");
-      continue;
-    }
-    const auto& values = setting_of.at(sid).at("values");
-    for (const auto& m : table.at("metrics")) {
-      for (const auto& [mode, v] : m.at("values").items()) {
-        if (!v.contains("mean") || v.at("mean").is_null()) continue;
-        const double x = v.at("mean").get<double>();
-        tidy << sid;
-        for (const auto& val : values) tidy << "," << CsvCell(val.get<std::string>());
-        tidy << "," << r.at("seed").get<std::uint64_t>() << "," << mode << ","
-             << m.at("key").get<std::string>() << "," << Exact(x) << "\n";
-        samples[{sid, mode, m.at("key").get<std::string>()}].push_back(x);
+    const auto& values = setting_of.at(r.setting)->values;
+    for (const TableMetric& m : table) {
+      unit_of[m.key] = m.unit.empty() ? MetricUnit(m.key) : m.unit;
+      for (const auto& [mode, v] : m.modes) {
+        tidy << r.setting;
+        for (const auto& val : values) tidy << "," << CsvCell(val);
+        tidy << "," << r.seed << "," << CsvCell(mode) << "," << CsvCell(m.key) << ","
+             << CsvCell(unit_of[m.key]) << "," << Exact(v.mean) << "\n";
+        samples[{r.setting, mode, m.key}].push_back(v.mean);
       }
     }
   }
@@ -354,26 +436,27 @@ int RunCollect(const CollectOptions& o) {
   std::ostringstream agg;
   agg << "setting";
   for (const auto& k : keys) agg << "," << CsvCell(k);
-  agg << ",mode,metric,n,mean,ci95_half_width\n";
+  agg << ",mode,metric,unit,n,mean,ci95_half_width\n";
   nlohmann::json aj = nlohmann::json::array();
   for (const auto& [key, xs] : samples) {
     const auto& [sid, mode, metric] = key;
     const eval::Summary s = eval::Summarize(xs);
+    const auto& values = setting_of.at(sid)->values;
     agg << sid;
-    for (const auto& val : setting_of.at(sid).at("values"))
-      agg << "," << CsvCell(val.get<std::string>());
-    agg << "," << mode << "," << metric << "," << s.n << "," << Exact(s.mean) << ","
-        << (s.half_width ? Exact(*s.half_width) : "") << "\n";
+    for (const auto& val : values) agg << "," << CsvCell(val);
+    agg << "," << CsvCell(mode) << "," << CsvCell(metric) << "," << CsvCell(unit_of[metric]) << ","
+        << s.n << "," << Exact(s.mean) << "," << (s.half_width ? Exact(*s.half_width) : "") << "\n";
     aj.push_back({{"setting", sid},
-                  {"values", setting_of.at(sid).at("values")},
+                  {"values", values},
                   {"mode", mode},
                   {"metric", metric},
+                  {"unit", unit_of[metric]},
                   {"n", s.n},
                   {"mean", s.mean},
                   {"ci95_half_width", s.half_width ? nlohmann::json(*s.half_width) : nullptr}});
   }
   WriteTextFile(out / "aggregate.csv", agg.str());
-  const int total = static_cast<int>(plan.at("runs").size());
+  const int total = static_cast<int>(plan.runs.size());
   nlohmann::json summary = {{"complete", complete == total},
                             {"runs", total},
                             {"runs_complete", complete},
@@ -384,13 +467,13 @@ int RunCollect(const CollectOptions& o) {
   // Figures: each metric against the first numeric axis with several values, one line per mode
   // (mean) with 95 % CI error bars; one figure per combination of the other axes.
   std::vector<std::string> warnings;
-  const auto axes = plan.at("axes");
+  const auto& axes = plan.axes;
   int xaxis = -1;
   for (std::size_t i = 0; i < axes.size() && xaxis < 0; ++i) {
-    bool numeric = axes[i].at("values").size() > 1;
-    for (const auto& v : axes[i].at("values")) {
+    bool numeric = axes[i].values.size() > 1;
+    for (const auto& v : axes[i].values) {
       double d;
-      numeric = numeric && ParseNumber(v.get<std::string>(), &d);
+      numeric = numeric && ParseNumber(v, &d);
     }
     if (numeric) xaxis = static_cast<int>(i);
   }
@@ -402,27 +485,26 @@ int RunCollect(const CollectOptions& o) {
     std::map<std::string, std::vector<std::string>> groups;  // label of others -> setting ids
     // The same label for a title: spaced, so that a long one wraps between the pairs.
     std::map<std::string, std::string> titles;
-    for (const auto& s : plan.at("settings")) {
+    for (const auto& s : plan.settings) {
       std::string others, title;
       for (std::size_t i = 0; i < keys.size(); ++i)
-        if (static_cast<int>(i) != xaxis && axes[i].at("values").size() > 1) {
-          const std::string value = s.at("values")[i].get<std::string>();
+        if (static_cast<int>(i) != xaxis && axes[i].values.size() > 1) {
+          const std::string& value = s.values[i];
           others += (others.empty() ? "" : "_") + keys[i] + "=" + value;
           title += (title.empty() ? "" : ", ") + keys[i] + " = " + value;
         }
-      groups[others].push_back(s.at("id"));
+      groups[others].push_back(s.id);
       titles[others] = title;
     }
+    const std::string x_unit = SweepKeyUnit(keys[xaxis]);
     for (const char* metric : kMetrics) {
       for (const auto& [others, ids] : groups) {
         viz::LineChart chart;
         chart.title = std::string(metric) + " vs " + keys[xaxis] +
                       (others.empty() ? "" : " (" + titles.at(others) + ")");
-        chart.x_label = keys[xaxis];
+        chart.x_label = keys[xaxis] + (x_unit.empty() ? "" : " [" + x_unit + "]");
         chart.y_label = std::string(metric) + " [" + MetricUnit(metric) + "]";
-        chart.caption =
-            "Points: mean over the seeds of each setting; error bars: 95 % confidence interval "
-            "of the mean (Student t), none with one seed. Colour: the filter's weight mode.";
+        int most_seeds = 0;
         bool any = false;
         for (const char* mode : {"position", "velocity", "dual"}) {
           viz::LineSeries mean;
@@ -431,7 +513,8 @@ int RunCollect(const CollectOptions& o) {
             const auto it = samples.find({sid, mode, metric});
             if (it == samples.end()) continue;
             const eval::Summary s = eval::Summarize(it->second);
-            mean.x.push_back(std::stod(setting_of.at(sid).at("values")[xaxis].get<std::string>()));
+            most_seeds = std::max(most_seeds, static_cast<int>(s.n));
+            mean.x.push_back(std::stod(setting_of.at(sid)->values[xaxis]));
             mean.y.push_back(s.mean);
             mean.errors.push_back(s.half_width.value_or(std::nan("")));
           }
@@ -440,6 +523,7 @@ int RunCollect(const CollectOptions& o) {
           chart.series.push_back(std::move(mean));
         }
         if (!any) continue;
+        if (o.figure_captions) chart.caption = SweepCaption(most_seeds);
         std::string name =
             std::string(metric) + "_vs_" + keys[xaxis] + (others.empty() ? "" : "__" + others);
         for (char& ch : name)
@@ -458,7 +542,12 @@ int RunCollect(const CollectOptions& o) {
     std::cerr << "\n";
     for (const auto& m : missing) std::cerr << "collect: missing " << m << "\n";
   }
-  return complete == total ? kExitOk : kExitSomeSeedsFailed;
+  if (complete == total) return kExitOk;
+  // Said even under -q: a sweep with missing runs is not a result to use silently.
+  std::cerr << "dualgrid: error: collect: " << total - complete << " of " << total
+            << " runs missing or unreadable (the first: " << missing.front() << "); listed in "
+            << (out / "sweep.json").string() << "\n";
+  return kExitSomeSeedsFailed;
 }
 
 Command AddSweepCommand(CLI::App& app, const CliContext& ctx) {
@@ -497,6 +586,7 @@ Command AddSweepCommand(CLI::App& app, const CliContext& ctx) {
   Opt(cmd, "--network-dir", &o->network_dir, "Folder of the built networks")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
+  AddCaptionOption(cmd, &o->figure_captions);
   return {cmd, [o] { return RunSweep(*o); }};
 }
 
@@ -506,6 +596,7 @@ Command AddCollectCommand(CLI::App& app, const CliContext&) {
       "collect", "Merge the finished runs of a sweep folder into tables and figures");
   cmd->add_option("dir", o->dir, "Sweep folder")->required()->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No summary output");
+  AddCaptionOption(cmd, &o->figure_captions);
   return {cmd, [o] { return RunCollect(*o); }};
 }
 

@@ -144,9 +144,16 @@ int RunTangential(const TangentialOptions& o) {
     if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
     const std::string what = WriteAspectCase(c, o.out);
     scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
-    if (!o.quiet)
-      std::cout << "wrote " << o.out.string() << " (" << what << "); run it with: dualgrid run "
-                << o.out.string() << " --out run/" << o.out.stem().string() << "\n";
+    if (!o.quiet) {
+      // Its network is written beside it (the scenario names it relative to itself): say so.
+      const std::filesystem::path base = o.out.parent_path() / o.out.stem();
+      std::cout << "wrote " << o.out.string() << " (" << what
+                << ") and its network beside it: " << base.string() << ".net.xml (netconvert, from "
+                << base.filename().string() << ".nod.xml and " << base.filename().string()
+                << ".edg.xml; log " << base.filename().string()
+                << ".netconvert.log); run it with: dualgrid run " << o.out.string() << " --out run/"
+                << o.out.stem().string() << "\n";
+    }
     return 0;
   }
   if (o.kind == "guardrail") {
@@ -265,7 +272,9 @@ Command AddTangentialCommand(CLI::App& app, const CliContext&) {
       ->check(Number(0.0, 600.0, true));
   Opt(cmd, "--seed", &o->seed, "Scenario seed")
       ->check(WholeNumber(0, static_cast<long long>(kMaxSeed)));
-  cmd->add_option("--out,-o", o->out, "Scenario file to write (.yaml)")
+  cmd->add_option("--out,-o", o->out,
+                  "Scenario file to write (.yaml); --kind aspect also writes its network beside "
+                  "it: NAME.net.xml, NAME.nod.xml, NAME.edg.xml and NAME.netconvert.log")
       ->required()
       ->check(NonEmptyPath());
   cmd->add_flag("--quiet,-q", o->quiet, "No summary");

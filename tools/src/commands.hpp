@@ -38,6 +38,8 @@ struct FilterRunOptions {
   bool figures = true;
   /// Formats every figure is written in: "png", "svg", "pdf" (`--figure-formats`).
   std::vector<std::string> figure_formats = {"png", "svg", "pdf"};
+  /// Captions under the figures (`--figure-captions on|off`; off for a paper that sets its own).
+  bool figure_captions = true;
   /// detections.csv: "none", "csv" or "csv.gz" (gzip-compressed, about 3.5x smaller).
   std::string detections = "none";
   /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).
@@ -51,8 +53,10 @@ struct FilterRunOptions {
   /// [s] (rounded to whole steps) with up to `record_particles` particles per mode. On with
   /// figures unless `--no-record`.
   bool record = true;
-  double record_interval = 0.1;
-  int record_particles = 1000;
+  /// Two frames per simulated second and 500 particles: about 8 MB per simulated minute of the
+  /// highway (docs/replay.md, "Cost"); --record-interval 0.1 for every tenth of a second.
+  double record_interval = 0.5;
+  int record_particles = 500;
   /// After the results: the replay video (`--video`) and the interactive viewer (`--viewer`),
   /// as `dualgrid replay` would write them with its defaults.
   bool video = false;
@@ -88,6 +92,7 @@ struct ExperimentOptions {
 /// `dualgrid snapshot`: bird's-eye picture of one time of a scenario.
 struct SnapshotOptions {
   RunOptions run;                                          ///< run.out is the PNG to write
+  bool figure_captions = true;                             ///< as FilterRunOptions
   double time = 10.0;                                      ///< [s]
   double behind = 60.0, ahead = 140.0, half_width = 22.0;  ///< view around the ego [m]
 };
@@ -149,11 +154,13 @@ struct SweepOptions {
   std::filesystem::path network_dir;
   bool quiet = false;
   std::string executable;
+  bool figure_captions = true;  ///< of collect's figures, as FilterRunOptions
 };
 /// `dualgrid collect`.
 struct CollectOptions {
   std::filesystem::path dir;
   bool quiet = false;
+  bool figure_captions = true;  ///< as FilterRunOptions
 };
 
 /// Sets the generator option `key` (a `tangential.KEY` of sweeps and suites, without the

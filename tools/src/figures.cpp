@@ -60,7 +60,7 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
 }
 
 void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
-                 double ahead, double half_width) {
+                 double ahead, double half_width, bool captions) {
   const sim::Frame& f = pipeline.frame();
   const GridFrame& g = pipeline.grid_frame();
   // Drawn relative to the ego in the grid frame, like the grid figures: the axes read as metres
@@ -82,7 +82,9 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
       AxesNote(g) + " Arrows: motion over ground in " + FormatFixed(kArrowSeconds, 1) +
       " s; black: a vehicle's velocity (SUMO); coloured: a detection's radial velocity, ego "
       "motion compensated (short where a vehicle moves across the line of sight). Colour: the "
-      "radar (field of view outline, its detections).";
+      "radar (field of view outline, its detections). A label that finds no free place is left "
+      "out; one set apart from its box has a leader line.";
+  if (!captions) options.caption.clear();
   viz::BirdsEyeView view({Position(-behind, -half_width), Position(ahead, half_width)}, options);
   auto to_rel = [&](std::vector<Position> points) {
     for (Position& p : points) p = rel(p);
@@ -92,6 +94,7 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
     for (const auto& lane : sumo->LaneShapes()) view.DrawLane(to_rel(lane.points), lane.width);
   for (const auto& rail : pipeline.config().sim.guard_rails)
     view.DrawGuardRail(to_rel(rail.points));
+  view.KeepLabelsOff(rel_box(f.ego.box));  // drawn last, on top; no label may cover it
   for (const auto& p : pipeline.config().sim.parked) {
     viz::VehicleStyle style;
     style.fill = viz::colors::kGuardRail;
@@ -141,7 +144,8 @@ viz::GridRaster ToRaster(const cosim::GridSnapshot& s) {
 void RenderGridFigure(const std::vector<std::string>& modes,
                       const std::vector<cosim::GridSnapshot>& snapshots,
                       const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
-                      const sim::Frame& frame, double time, const std::filesystem::path& path) {
+                      const sim::Frame& frame, double time, const std::filesystem::path& path,
+                      bool captions) {
   // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
   // not with the network's (often UTM-sized) coordinates.
   const Position ego = g.ToGrid(frame.ego.box.center);
@@ -182,6 +186,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
       "matched to a vehicle, orange duplicate, magenta false) with their estimated velocity; "
       "black arrows: true velocity. Arrows: motion over ground in " +
       FormatFixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
+  if (!captions) options.caption.clear();
   viz::RenderGridPanels(panels, path.string(), options);
 }
 
@@ -202,7 +207,8 @@ TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics
 
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
-                         const std::filesystem::path& path, const TrackedShares& errors) {
+                         const std::filesystem::path& path, const TrackedShares& errors,
+                         bool captions) {
   viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
   chart.x_label = "object (SUMO vehicle id)";
@@ -221,6 +227,7 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
       (errors.empty() ? "One run: no confidence interval."
                       : "Bars: mean over the seeds; whiskers: 95 % confidence interval of the "
                         "mean (Student t), none where fewer than two seeds scored the object.");
+  if (!captions) chart.caption.clear();
   for (const auto& [name, row] : shares) chart.categories.push_back(name);
   for (std::size_t m = 0; m < modes.size(); ++m) {
     viz::BarSeries s;
@@ -233,10 +240,13 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 }
 
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
-                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path) {
+                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path,
+                       bool captions) {
   viz::LineChart chart;
-  chart.title = "Weights on " + object + " (" + mode + " filter, paper Fig. 4)";
-  chart.y_label = "share within " + FormatFixed(WeightTrace::kGoodVelocity, 0) + " m/s";
+  // Not titled as the paper's Fig. 4: it plots another quantity (the caption compares them).
+  chart.title = "Weight shares on " + object + " (" + mode + " filter)";
+  chart.y_label =
+      "share within " + FormatFixed(WeightTrace::kGoodVelocity, 0) + " m/s [fraction of weight]";
   chart.y_min = 0.0;
   chart.y_max = 1.0;
   // Not the paper's Fig. 4 quantity (one particle's weights): readers compare the two, so the
@@ -280,6 +290,7 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
   }
   if (!chart.spans.empty())
     chart.caption += " Shaded: most of the object's detections see less than half its speed.";
+  if (!captions) chart.caption.clear();
   viz::RenderLineChart(chart, path.string());
 }
 

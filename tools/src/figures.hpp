@@ -32,8 +32,10 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
 /// fields of view and the step's detections with their radial-velocity arrows, drawn in the grid
 /// frame (pipeline.grid_frame(): the world turned so that the grid's axes are the picture's). The
 /// view spans [ego.x - behind, ego.x + ahead] x [ego.y - half_width, ego.y + half_width] there.
+/// Every Render* below writes its caption under the figure unless `captions` is false
+/// (`--figure-captions off`, for a paper that sets its own).
 void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
-                 double ahead, double half_width);
+                 double ahead, double half_width, bool captions = true);
 
 /// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined; in the
 /// grid frame, whose axes are the grid's.
@@ -42,7 +44,8 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
 void RenderGridFigure(const std::vector<std::string>& modes,
                       const std::vector<cosim::GridSnapshot>& snapshots,
                       const std::vector<cosim::ModeScorer>& scorers, const GridFrame& grid_frame,
-                      const sim::Frame& frame, double time, const std::filesystem::path& path);
+                      const sim::Frame& frame, double time, const std::filesystem::path& path,
+                      bool captions = true);
 
 /// D per object (name) and mode; NaN where a mode did not score the object.
 using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
@@ -52,7 +55,8 @@ using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
 /// `shares`) and mode the 95 % CI half-width over seeds, drawn as whiskers.
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
-                         const std::filesystem::path& path, const TrackedShares& errors = {});
+                         const std::filesystem::path& path, const TrackedShares& errors = {},
+                         bool captions = true);
 
 /// The scored objects' D (or D_v, `velocity_aware`) of one run, per mode (object ids named
 /// through `ids`).
@@ -72,6 +76,7 @@ struct WeightTrace {
 };
 /// The caption explains the shares for the run's `likelihood` (f_v of eq. (8)).
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
-                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path);
+                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path,
+                       bool captions = true);
 
 }  // namespace dualgrid::tools

@@ -3,9 +3,13 @@
 
 #include <csignal>
 
+#include <filesystem>
 #include <iostream>
+#include <new>
+#include <stdexcept>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "cli_options.hpp"
 #include "dualgrid/scenario/loader.hpp"
@@ -20,7 +24,8 @@ using namespace dualgrid::tools;
 constexpr const char* kExitCodes =
     "Exit codes: 0 done; 1 the run failed (SUMO error, an output not written); 2 bad input "
     "(command line, scenario or network file; nothing simulated); 3 experiment: some seed runs "
-    "failed (the others are aggregated), regress: a case did not run; regress: 1 a check failed; "
+    "failed (the others are aggregated), regress: a case did not run, sweep/collect: runs are "
+    "missing; regress: 1 a check failed; "
     "130/143 stopped by SIGINT/SIGTERM (results of the "
     "simulated part written, marked incomplete). Details: docs/cli.md.";
 
@@ -28,6 +33,18 @@ constexpr const char* kExitCodes =
 std::string VersionText(const dualgrid::sim::NetworkDirLocation& data) {
   return std::string("dualgrid ") + DUALGRID_VERSION + "\nnetworks: " + data.dir.string() + " (" +
          data.source + ")";
+}
+
+// A std::filesystem error as "PATH: WHAT FAILED: WHY" (the library's text reads
+// "filesystem error: cannot get file size: Is a directory [PATH]").
+std::string FilesystemMessage(const std::filesystem::filesystem_error& e) {
+  std::string op = e.what();
+  const std::string prefix = "filesystem error: ";
+  if (op.rfind(prefix, 0) == 0) op.erase(0, prefix.size());
+  op = op.substr(0, op.find(": "));  // "cannot get file size"
+  std::string where = e.path1().string();
+  if (!e.path2().empty()) where += (where.empty() ? "" : " -> ") + e.path2().string();
+  return (where.empty() ? "" : where + ": ") + op + ": " + e.code().message();
 }
 
 std::string SelfPath(const char* argv0) {
@@ -94,6 +111,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A first word that is no subcommand: CLI11 would only say that one is required.
+    if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-') {
+      std::string names;
+      for (const Command& c : commands) names += (names.empty() ? "" : ", ") + c.app->get_name();
+      std::cerr << "dualgrid: error: unknown command '" << OneLine(argv[1]) << "' (expected one of "
+                << names << "; see dualgrid --help)\n";
+      return kExitBadInput;
+    }
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << " (see " << HelpHint(app) << ")\n";
     return kExitBadInput;
   }
@@ -106,6 +131,23 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "dualgrid: error: out of memory (an input asks for more than this machine has; "
+                 "the limits of each input: docs/cli.md)\n";
+    return kExitRunFailed;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::cerr << "dualgrid: error: " << OneLine(FilesystemMessage(e)) << "\n";
+    return kExitRunFailed;
+  } catch (const nlohmann::json::exception& e) {
+    // Every file read back goes through the checked reader: this is a bug, not bad input.
+    std::cerr << "dualgrid: error: internal error: a JSON document did not hold what the program "
+                 "expected (JSON error "
+              << e.id << "; please report it with the command line)\n";
+    return kExitRunFailed;
+  } catch (const std::logic_error& e) {
+    std::cerr << "dualgrid: error: internal error (" << OneLine(e.what())
+              << "; please report it with the command line)\n";
+    return kExitRunFailed;
   } catch (const std::exception& e) {
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
     return kExitRunFailed;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "dualgrid/core/input_file.hpp"
 #include "output.hpp"
 
 namespace dualgrid::tools::replay {
@@ -20,15 +21,12 @@ namespace {
 
 // Centimetre rounding keeps index.json small without losing anything a picture shows.
 double R(double v) { return std::round(v * 100.0) / 100.0; }
+// Detections, most of the index: decimetres and 0.1 m/s (a radar's own accuracy is coarser).
+double D(double v) { return std::round(v * 10.0) / 10.0; }
 
 json BoxJson(const Box& b) {
   return json::array({b.id, R(b.x), R(b.y), std::round(b.yaw * 1e4) / 1e4, R(b.length), R(b.width),
                       R(b.vx), R(b.vy)});
-}
-Box BoxFrom(const json& j) {
-  return {j.at(0).get<int>(),    j.at(1).get<double>(), j.at(2).get<double>(),
-          j.at(3).get<double>(), j.at(4).get<double>(), j.at(5).get<double>(),
-          j.at(6).get<double>(), j.at(7).get<double>()};
 }
 
 template <typename T>
@@ -114,8 +112,9 @@ void Writer::Add(const Frame& f) {
   (void)n;
   uLongf packed_size = compressBound(raw_.size());
   packed_.resize(packed_size);
-  // Level 1: the cell data is mostly runs of equal bytes; higher levels cost time for ~10 %.
-  if (compress2(packed_.data(), &packed_size, raw_.data(), raw_.size(), 1) != Z_OK)
+  // Level 6 (zlib's default): ~10 % smaller than level 1 for ~1 ms more per frame, little at the
+  // default of two frames per simulated second.
+  if (compress2(packed_.data(), &packed_size, raw_.data(), raw_.size(), 6) != Z_OK)
     throw std::runtime_error("replay: compressing frame t = " + FormatFixed(f.time, 2) +
                              " s failed");
   bin_.write(reinterpret_cast<const char*>(packed_.data()),
@@ -130,7 +129,7 @@ void Writer::Add(const Frame& f) {
   for (const Box& b : f.truth) j["truth"].push_back(BoxJson(b));
   j["det"] = json::array();
   for (const Detection& d : f.detections) {
-    json row = {d.sensor, R(d.x), R(d.y), R(d.vx), R(d.vy), d.clutter ? 1 : 0};
+    json row = {d.sensor, D(d.x), D(d.y), D(d.vx), D(d.vy), d.clutter ? 1 : 0};
     if (d.path != 0) row.push_back(d.path);  // ghosts only (docs/replay.md)
     j["det"].push_back(std::move(row));
   }
@@ -174,124 +173,123 @@ void Writer::Finish(const Header& final_header) {
   WriteTextFile(dir_ / "index.json", text + "\n");
 }
 
+namespace {
+
+// Bounds of a recording that the reader accepts: above any recording `run` writes, low enough
+// that a damaged or hostile index cannot make the video or the viewer allocate without end.
+constexpr std::int64_t kMaxCellsPerAxis = 1000000;
+constexpr std::uint64_t kMaxFrameBytes = std::uint64_t{1} << 30;  // one frame, inflated
+constexpr std::int64_t kMaxParticles = 1000000;                   // as --record-particles
+constexpr std::size_t kMaxModes = 3, kMaxSensors = 64, kMaxFrames = 10000000;
+
+Box BoxAt(const JsonAt& j) {
+  const auto v = j.Tuple(8);
+  return {static_cast<int>(v[0].Integer(-1, INT32_MAX)),
+          v[1].Number(),
+          v[2].Number(),
+          v[3].Number(),
+          v[4].Number(0.0, 1e6),
+          v[5].Number(0.0, 1e6),
+          v[6].Number(),
+          v[7].Number()};
+}
+
+}  // namespace
+
 Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   const fs::path index_path = dir_ / "index.json";
-  if (!fs::exists(run_dir)) throw std::invalid_argument(run_dir.string() + ": no such run folder");
+  if (!fs::is_directory(run_dir))
+    throw std::invalid_argument(run_dir.string() + ": no such run folder");
   if (!fs::exists(index_path))
     throw std::invalid_argument(
         index_path.string() +
         ": missing (the run was made with --no-record or --no-figures, or did not finish; "
         "rerun `dualgrid run` without them)");
-  std::ifstream in(index_path);
-  try {
-    index_ = json::parse(in);
-  } catch (const json::exception& e) {
-    throw std::invalid_argument(index_path.string() + ": not JSON (" + e.what() + ")");
-  }
+  index_file_ =
+      std::make_unique<JsonFile>(ReadJsonFile(index_path, "replay index", kMaxStreamedInputBytes));
+  const JsonAt root = index_file_->Root();
   const std::string where = index_path.string();
-  // Every key read through Get names itself in the error (one line, exit code 2).
-  const auto get = [&](const json& j, const std::string& key, auto* out, const std::string& what) {
-    try {
-      *out = j.at(key).get<std::remove_pointer_t<decltype(out)>>();
-    } catch (const json::exception&) {
-      throw std::invalid_argument(where + ": key '" + key + "': expected " + what);
-    }
-  };
+  if (!root.raw().is_object()) root.Fail("an object (a dualgrid replay index)");
+  if (root["format"].raw() != "dualgrid-replay") root["format"].Fail("\"dualgrid-replay\"");
+  if (root["version"].raw() != kFormatVersion)
+    root["version"].Fail(std::to_string(kFormatVersion) + " (recorded by another release)");
   Header& h = header_;
-  std::string format;
-  get(index_, "format", &format, "\"dualgrid-replay\"");
-  if (format != "dualgrid-replay")
-    throw std::invalid_argument(where + ": key 'format': expected \"dualgrid-replay\"");
-  const json version = index_.value("version", json());
-  if (!version.is_number_integer() || version.get<int>() != kFormatVersion)
-    throw std::invalid_argument(where + ": key 'version': expected " +
-                                std::to_string(kFormatVersion) + ", found " + version.dump() +
-                                " (recorded by another release)");
-  get(index_, "scenario", &h.scenario, "a text");
-  get(index_, "seed", &h.seed, "a whole number");
-  get(index_, "modes", &h.modes, "a list of mode names");
-  get(index_, "sensors", &h.sensors, "a list of sensor names");
-  get(index_, "cells_x", &h.cells_x, "a whole number");
-  get(index_, "cells_y", &h.cells_y, "a whole number");
-  get(index_, "resolution", &h.resolution, "a number [m]");
-  get(index_, "frame_yaw_deg", &h.frame_yaw_deg, "a number [deg]");
-  get(index_, "interval", &h.interval, "a number [s]");
-  get(index_, "particle_unit", &h.particle_unit, "a number [m]");
-  get(index_, "max_particles", &h.max_particles, "a whole number");
-  get(index_, "dynamic_threshold", &h.dynamic_threshold, "a number");
-  get(index_, "names", &h.names, "an object");
-  get(index_, "metrics", &h.metrics, "an object");
-  get(index_, "complete", &h.complete, "true or false");
-  get(index_, "status", &h.status, "a text");
-  if (index_.contains("multipath")) get(index_, "multipath", &h.multipath, "true or false");
-  // The filter's own bound on cells (FilterParams) keeps the arrays allocatable.
-  if (h.cells_x <= 0 || h.cells_y <= 0 || static_cast<double>(h.cells_x) * h.cells_y > 2e8)
-    throw std::invalid_argument(where +
-                                ": keys 'cells_x', 'cells_y': expected a grid of 1 to "
-                                "2e8 cells");
-  for (const auto& [key, value] : {std::pair<const char*, double>{"resolution", h.resolution},
-                                   {"interval", h.interval},
-                                   {"particle_unit", h.particle_unit}})
-    if (!(value > 0.0) || !std::isfinite(value))
-      throw std::invalid_argument(where + ": key '" + key + "': expected a positive number");
-  if (h.modes.empty())
-    throw std::invalid_argument(where + ": key 'modes': expected at least one mode");
-  if (h.max_particles < 0)
-    throw std::invalid_argument(where + ": key 'max_particles': expected >= 0");
-  try {
-    for (const json& b : index_.at("parked")) h.parked.push_back(BoxFrom(b));
-    for (const json& r : index_.at("rails")) {
-      h.rails.emplace_back();
-      for (const json& p : r)
-        h.rails.back().push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+  h.scenario = root["scenario"].Text();
+  h.seed = root["seed"].Unsigned();
+  for (const JsonAt& m : root["modes"].Items(kMaxModes)) h.modes.push_back(m.Text());
+  if (h.modes.empty()) root["modes"].Fail("at least one mode");
+  for (const JsonAt& s : root["sensors"].Items(kMaxSensors)) h.sensors.push_back(s.Text());
+  h.cells_x = static_cast<int>(root["cells_x"].Integer(1, kMaxCellsPerAxis));
+  h.cells_y = static_cast<int>(root["cells_y"].Integer(1, kMaxCellsPerAxis));
+  h.resolution = root["resolution"].Number(1e-3, 1e3);
+  h.frame_yaw_deg = root["frame_yaw_deg"].Number();
+  h.interval = root["interval"].Number(1e-4, 1e4);
+  h.particle_unit = root["particle_unit"].Number(1e-4, 1e3);
+  h.max_particles = static_cast<int>(root["max_particles"].Integer(0, kMaxParticles));
+  h.dynamic_threshold = root["dynamic_threshold"].Number(0.0, 1.0);
+  if (!root["names"].raw().is_object()) root["names"].Fail("an object");
+  h.names = root["names"].raw();
+  if (!root["metrics"].raw().is_object()) root["metrics"].Fail("an object");
+  h.metrics = root["metrics"].raw();
+  h.complete = root["complete"].Flag();
+  h.status = root["status"].Text();
+  if (root.Has("multipath")) h.multipath = root["multipath"].Flag();
+  // What one frame inflates to must be allocatable: the video and the viewer hold one.
+  const std::uint64_t cells = static_cast<std::uint64_t>(h.cells_x) * h.cells_y;
+  if ((cells * 7 + 4 * static_cast<std::uint64_t>(h.max_particles)) * h.modes.size() >
+      kMaxFrameBytes)
+    throw std::invalid_argument(
+        where + ": keys 'cells_x', 'cells_y', 'max_particles': a frame of " +
+        std::to_string(h.cells_x) + " x " + std::to_string(h.cells_y) + " cells and " +
+        std::to_string(h.max_particles) + " particles per mode, expected at most 1 GiB per frame");
+  for (const JsonAt& b : root["parked"].Items()) h.parked.push_back(BoxAt(b));
+  for (const JsonAt& r : root["rails"].Items()) {
+    h.rails.emplace_back();
+    for (const JsonAt& p : r.Items()) {
+      const auto xy = p.Tuple(2);
+      h.rails.back().push_back({xy[0].Number(), xy[1].Number()});
     }
-  } catch (const json::exception&) {
-    throw std::invalid_argument(where + ": keys 'parked', 'rails': expected boxes and polylines");
   }
-  const json& frames = index_.value("frames", json());
-  if (!frames.is_array() || frames.empty())
-    throw std::invalid_argument(where +
-                                ": key 'frames': expected a non-empty list (a run "
-                                "records its first frame after --record-interval)");
-  // Each frame's blob must lie in frames.bin and its sizes be the header's, so that a damaged
-  // index fails here with its key named, not later in the middle of a video.
+  const JsonAt frames = root["frames"];
+  const auto list = frames.Items(kMaxFrames);
+  if (list.empty())
+    frames.Fail("a non-empty list (a run records its first frame after --record-interval)");
+  // Each frame's blob must lie in frames.bin and its particle counts within the header's, so that
+  // a damaged index fails here with its key named, not later in the middle of a video.
+  const fs::path bin = dir_ / "frames.bin";
+  std::error_code ec;
+  const fs::file_status bin_status = fs::status(bin, ec);
+  if (fs::exists(bin_status) && !fs::is_regular_file(bin_status))
+    throw std::invalid_argument(
+        bin.string() + ": the recording's frames are not a regular file (" +
+        (fs::is_directory(bin_status) ? "a directory" : "a device or pipe") +
+        "), expected the frames.bin a run writes");
+  std::error_code size_ec;
   const std::uint64_t bin_size =
-      fs::exists(dir_ / "frames.bin") ? fs::file_size(dir_ / "frames.bin") : 0;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
-    const std::string key = "frames[" + std::to_string(i) + "]";
-    const json& f = frames[i];
-    double t = 0.0, yaw = 0.0;
-    get(f, "t", &t, "a time [s] (in " + key + ")");
-    get(f, "yaw", &yaw, "the grid frame's turn [deg] (in " + key + ")");
-    if (!std::isfinite(t) || !std::isfinite(yaw))
-      throw std::invalid_argument(where + ": key '" + key + "': expected a finite 't' and 'yaw'");
-    times_.push_back(t);
-    const json blob = f.value("blob", json());
-    if (!blob.is_array() || blob.size() != 2 || !blob[0].is_number_unsigned() ||
-        !blob[1].is_number_unsigned())
-      throw std::invalid_argument(where + ": key '" + key + ".blob': expected [offset, length]");
-    const auto offset = blob[0].get<std::uint64_t>(), length = blob[1].get<std::uint64_t>();
+      fs::is_regular_file(bin_status) ? fs::file_size(bin, size_ec) : 0;  // 0: missing
+  if (size_ec)
+    throw std::invalid_argument(bin.string() + ": cannot read its size: " + size_ec.message());
+  for (const JsonAt& f : list) {
+    times_.push_back(f["t"].Number());
+    f["yaw"].Number();
+    const auto blob = f["blob"].Tuple(2);
+    const std::uint64_t offset = blob[0].Unsigned(), length = blob[1].Unsigned();
     if (length > bin_size || offset > bin_size - length)
-      throw std::invalid_argument((dir_ / "frames.bin").string() + ": shorter than " + where +
-                                  "'s " + key + ".blob says (truncated copy?)");
-    const json modes = f.value("modes", json());
-    if (!modes.is_array() || modes.size() != h.modes.size())
-      throw std::invalid_argument(where + ": key '" + key + ".modes': expected " +
-                                  std::to_string(h.modes.size()) + " entries");
-    for (const json& m : modes) {
-      const json np = m.value("np", json());
-      if (!np.is_number_unsigned() ||
-          np.get<std::uint64_t>() > static_cast<std::uint64_t>(h.max_particles))
-        throw std::invalid_argument(where + ": key '" + key +
-                                    ".modes[].np': expected 0 to max_particles");
-    }
+      throw std::invalid_argument(bin.string() + ": shorter than " + where + "'s " +
+                                  f["blob"].key() + " says (" +
+                                  (fs::exists(bin_status) ? "truncated copy?" : "missing") + ")");
+    blobs_.push_back({offset, length});
+    const auto modes = f["modes"].Tuple(h.modes.size());
+    for (const JsonAt& m : modes) m["np"].Integer(0, h.max_particles);
   }
 }
 
+Reader::~Reader() = default;
+
+const nlohmann::json& Reader::index() const { return index_file_->doc(); }
+
 std::vector<std::uint8_t> Reader::Compressed(std::size_t i) const {
-  const json& blob = index_["frames"].at(i).at("blob");
-  const auto offset = blob.at(0).get<std::uint64_t>();
-  const auto length = blob.at(1).get<std::uint64_t>();
+  const auto [offset, length] = blobs_.at(i);
   std::ifstream in(dir_ / "frames.bin", std::ios::binary);
   in.seekg(static_cast<std::streamoff>(offset));
   std::vector<std::uint8_t> bytes(length);
@@ -304,59 +302,67 @@ std::vector<std::uint8_t> Reader::Compressed(std::size_t i) const {
 }
 
 Frame Reader::Load(std::size_t i) const {
-  try {
-    return LoadFrame(i);
-  } catch (const json::exception& e) {
-    throw std::invalid_argument((dir_ / "index.json").string() + ": frames[" + std::to_string(i) +
-                                "]: " + e.what());
-  }
-}
-
-Frame Reader::LoadFrame(std::size_t i) const {
-  const std::string where = (dir_ / "index.json").string() + ": frames[" + std::to_string(i) + "]";
-  const json& j = index_["frames"].at(i);
+  const JsonAt j = index_file_->Root()["frames"].Item(i);
   const Header& h = header_;
   const std::size_t n = static_cast<std::size_t>(h.cells_x) * h.cells_y;
+  const std::string where = j.file() + ": " + j.key();
   Frame f;
-  f.time = j.at("t").get<double>();
-  f.yaw_deg = j.at("yaw").get<double>();
-  f.ego = BoxFrom(j.at("ego"));
-  f.origin_x = j.at("origin").at(0).get<double>();
-  f.origin_y = j.at("origin").at(1).get<double>();
-  for (const json& b : j.at("truth")) f.truth.push_back(BoxFrom(b));
-  for (const json& d : j.at("det"))
-    f.detections.push_back({d.at(0).get<int>(), d.at(1).get<double>(), d.at(2).get<double>(),
-                            d.at(3).get<double>(), d.at(4).get<double>(), d.at(5).get<int>() != 0,
-                            d.size() > 6 ? d.at(6).get<int>() : 0});
-  const json& modes = j.at("modes");
-  if (modes.size() != h.modes.size())
-    throw std::invalid_argument(where + ": wrong number of modes");
+  f.time = j["t"].Number();
+  f.yaw_deg = j["yaw"].Number();
+  f.ego = BoxAt(j["ego"]);
+  const auto origin = j["origin"].Tuple(2);
+  f.origin_x = origin[0].Number();
+  f.origin_y = origin[1].Number();
+  for (const JsonAt& b : j["truth"].Items()) f.truth.push_back(BoxAt(b));
+  const auto sensors = static_cast<std::int64_t>(h.sensors.size());
+  for (const JsonAt& d : j["det"].Items()) {
+    if (!d.raw().is_array() || (d.raw().size() != 6 && d.raw().size() != 7))
+      d.Fail("a detection [sensor, x, y, vx, vy, clutter] or [..., path]");
+    const auto v = d.Items();
+    f.detections.push_back(
+        {static_cast<int>(v[0].Integer(0, std::max<std::int64_t>(sensors - 1, 0))), v[1].Number(),
+         v[2].Number(), v[3].Number(), v[4].Number(), v[5].Integer(0, 1) != 0,
+         v.size() > 6 ? static_cast<int>(v[6].Integer(0, 2)) : 0});
+  }
+  const auto modes = j["modes"].Tuple(h.modes.size());
   f.modes.resize(h.modes.size());
   std::size_t raw_size = 0;
+  std::vector<std::size_t> np(modes.size());
   for (std::size_t m = 0; m < modes.size(); ++m) {
     ModeFrame& mf = f.modes[m];
-    for (const json& c : modes[m].at("cl"))
-      mf.clusters.push_back({c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>(),
-                             c.at(3).get<double>(), c.at(4).get<double>(), c.at(5).get<double>(),
-                             c.at(6).get<double>(), c.at(7).get<double>(), c.at(8).get<int>(),
-                             c.at(9).get<int>(), c.at(10).get<int>() != 0});
-    const json& l = modes[m].at("live");
-    mf.live = {l.at(0).get<int>(),  l.at(1).get<int>(),  l.at(2).get<int>(), l.at(3).get<int>(),
-               l.at(4).get<long>(), l.at(5).get<long>(), l.at(6).get<long>()};
-    raw_size += n * 7 + 4 * modes[m].at("np").get<std::size_t>();
+    for (const JsonAt& c : modes[m]["cl"].Items()) {
+      const auto v = c.Tuple(11);
+      mf.clusters.push_back(
+          {v[0].Number(), v[1].Number(), v[2].Number(), v[3].Number(), v[4].Number(), v[5].Number(),
+           v[6].Number(), v[7].Number(), static_cast<int>(v[8].Integer(0, 2)),
+           static_cast<int>(v[9].Integer(-1, INT32_MAX)), v[10].Integer(0, 1) != 0});
+    }
+    const auto l = modes[m]["live"].Tuple(7);
+    mf.live = {static_cast<int>(l[0].Integer(0, INT32_MAX)),
+               static_cast<int>(l[1].Integer(0, INT32_MAX)),
+               static_cast<int>(l[2].Integer(0, INT32_MAX)),
+               static_cast<int>(l[3].Integer(0, INT32_MAX)),
+               l[4].Integer(0, INT64_MAX),
+               l[5].Integer(0, INT64_MAX),
+               l[6].Integer(0, INT64_MAX)};
+    np[m] = static_cast<std::size_t>(modes[m]["np"].Integer(0, h.max_particles));
+    raw_size += n * 7 + 4 * np[m];
   }
   const std::vector<std::uint8_t> packed = Compressed(i);
   std::vector<std::uint8_t> raw(raw_size);
   uLongf size = raw_size;
   if (uncompress(raw.data(), &size, packed.data(), packed.size()) != Z_OK || size != raw_size)
-    throw std::invalid_argument(where + ": frame data damaged (zlib)");
+    throw std::invalid_argument((dir_ / "frames.bin").string() + ": frame " + std::to_string(i) +
+                                " (index.json's " + j.key() +
+                                ".blob) is damaged: expected a zlib stream of " +
+                                std::to_string(raw_size) + " bytes");
   std::size_t at = 0;
   for (ModeFrame& mf : f.modes) {
     Take(raw, at, n, mf.vx_cm, where);
     Take(raw, at, n, mf.vy_cm, where);
   }
   for (std::size_t m = 0; m < f.modes.size(); ++m)
-    Take(raw, at, 2 * modes[m].at("np").get<std::size_t>(), f.modes[m].particles, where);
+    Take(raw, at, 2 * np[m], f.modes[m].particles, where);
   for (ModeFrame& mf : f.modes) {
     Take(raw, at, n, mf.free, where);
     Take(raw, at, n, mf.static_occ, where);

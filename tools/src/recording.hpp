@@ -13,10 +13,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "read_back.hpp"
 
 namespace dualgrid::tools::replay {
 
@@ -126,27 +129,30 @@ class Writer {
   std::vector<std::uint8_t> raw_, packed_;
 };
 
-/// A finished recording, read back. Throws std::invalid_argument naming the file and what is wrong
-/// (missing, not a recording, other version, truncated).
+/// A finished recording, read back through the checked reader (read_back.hpp). The constructor
+/// checks the header and every frame's index entry against the bounds a recording can have;
+/// Load checks the rest of a frame (its detections, clusters and zlib data). Both throw
+/// std::invalid_argument naming the file, the key and what was expected (missing, not a
+/// recording, other version, truncated, damaged, out of bounds).
 class Reader {
  public:
   explicit Reader(const std::filesystem::path& run_dir);
+  ~Reader();
   const Header& header() const { return header_; }
   std::size_t size() const { return times_.size(); }
   double time(std::size_t i) const { return times_[i]; }
   Frame Load(std::size_t i) const;
   /// The index as written (for the viewer) and the raw compressed bytes of frame i.
-  const nlohmann::json& index() const { return index_; }
+  const nlohmann::json& index() const;
   std::vector<std::uint8_t> Compressed(std::size_t i) const;
   const std::filesystem::path& dir() const { return dir_; }
 
  private:
-  Frame LoadFrame(std::size_t i) const;
-
   std::filesystem::path dir_;
-  nlohmann::json index_;
+  std::unique_ptr<JsonFile> index_file_;
   Header header_;
   std::vector<double> times_;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> blobs_;  ///< [offset, length] [bytes]
 };
 
 }  // namespace dualgrid::tools::replay

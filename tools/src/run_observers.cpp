@@ -136,6 +136,7 @@ PictureObserver::PictureObserver(const std::filesystem::path& out, std::vector<d
       figures_(options.figures),
       particles_(options.write_particles),
       formats_(options.figure_formats),
+      captions_(options.figure_captions),
       warnings_(warnings) {}
 
 bool PictureObserver::WantsVelocities(int, double time) {
@@ -157,12 +158,12 @@ void PictureObserver::OnStep(const cosim::StepView& v) {
         out_ / "figures" / ("grid_t" + stamp + ".png"), formats_,
         [&](const auto& p) {
           RenderGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f, f.time,
-                           p);
+                           p, captions_);
         },
         warnings_);
     TryFigures(
         out_ / "figures" / ("scene_t" + stamp + ".png"), formats_,
-        [&](const auto& p) { RenderScene(v.pipeline, p, 60, 140, 22); }, warnings_);
+        [&](const auto& p) { RenderScene(v.pipeline, p, 60, 140, 22, captions_); }, warnings_);
   }
   if (particles_)
     for (std::size_t m = 0; m < v.mode_names.size(); ++m)

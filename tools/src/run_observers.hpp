@@ -104,6 +104,7 @@ class PictureObserver : public cosim::StepObserver {
   bool picture_ = false;  // this step is a picture step (decided in WantsVelocities)
   bool figures_, particles_;
   std::vector<std::string> formats_;
+  bool captions_;
   std::vector<std::string>* warnings_;
 };
 

@@ -59,6 +59,9 @@ fs::path WriteViewer(const replay::Reader& reader, const ReplayOptions& o) {
       CheckOutputFile(o.html_out.empty() ? reader.dir().parent_path() / "replay.html" : o.html_out,
                       "--html-out", ".html");
   const auto [first, last] = FrameRange(reader, o);
+  // Every frame is decoded and checked first, as the video does: a damaged recording is refused
+  // with its file and key named instead of becoming a page that breaks in the browser.
+  for (std::size_t i = first; i < last; ++i) (void)reader.Load(i);
   nlohmann::json index = reader.index();
   nlohmann::json frames = nlohmann::json::array();
   for (std::size_t i = first; i < last; ++i) frames.push_back(index["frames"][i]);

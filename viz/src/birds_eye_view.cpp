@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 
 #include "draw.hpp"
@@ -147,7 +148,8 @@ struct BirdsEyeView::Impl {
     double x0, y0, x1, y1;
     bool Overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
   };
-  std::vector<Box> labels;
+  std::vector<Box> labels;  // and the ego's box
+  int labels_left_out = 0;
   bool InView(const Vector2& p) const {
     return p.x() >= 0.0 && p.y() >= 0.0 && p.x() <= transform.pixel_width() &&
            p.y() <= transform.pixel_height();
@@ -266,28 +268,86 @@ void BirdsEyeView::DrawVehicle(const OrientedBox& box, const VehicleStyle& style
     impl_->AddLegend({buf, colors::kBlack, Marker::kArrow});
   }
   cairo_restore(cr);
+  // The ego's box is kept clear of the labels drawn after it.
+  if (style.ego) impl_->labels.push_back({left, top, right, bottom});
   if (!style.label.empty()) {
     const double sm = impl_->z.sm;
     const double w = detail::TextWidth(cr, style.label, sm, style.ego), h = detail::LineHeight(sm);
     // Centred over the box, but inside the map (a label cut by the edge is unreadable).
-    const double cx = std::clamp(t.ToPixel(box.center).x(), 0.5 * w,
-                                 std::max(0.5 * w, t.pixel_width() - 0.5 * w));
-    const Impl::Box above{cx - 0.5 * w, top - 0.8 * u - h, cx + 0.5 * w, top - 0.8 * u};
-    const Impl::Box below{cx - 0.5 * w, bottom + 0.8 * u, cx + 0.5 * w, bottom + 0.8 * u + h};
-    // Free: inside the map and clear of the labels placed so far.
+    const double cx0 = std::clamp(t.ToPixel(box.center).x(), 0.5 * w,
+                                  std::max(0.5 * w, t.pixel_width() - 0.5 * w));
+    // Free: inside the map and clear of the labels placed so far and of the ego.
     const auto free = [&](const Impl::Box& b) {
-      return b.y0 >= 0.0 && b.y1 <= t.pixel_height() &&
+      return b.y0 >= 0.0 && b.y1 <= t.pixel_height() && b.x0 >= 0.0 &&
+             b.x1 <= t.pixel_width() + 1e-9 &&
              std::none_of(impl_->labels.begin(), impl_->labels.end(),
                           [&](const Impl::Box& o) { return o.Overlaps(b); });
     };
-    const Impl::Box at = free(above) || !free(below) ? above : below;
-    impl_->labels.push_back(at);
-    DrawText(
-        cr, style.label, cx, at.y1 - 0.2 * h,
-        {.size = sm, .bold = style.ego, .h = HAlign::kCenter, .v = VAlign::kBottom, .halo = true});
+    // Candidates, nearest first: above, below, then stepped further out (a leader line joins a
+    // label to its box), then beside. A label with no free place is left out rather than drawn
+    // over another.
+    std::optional<Impl::Box> at;
+    for (int k = 0; k < 8 && !at; ++k) {
+      for (const double shift : {0.0, -0.6 * w - u, 0.6 * w + u}) {
+        if (k < 2 && shift != 0.0) continue;
+        const double cx = cx0 + shift;
+        const double gap = 0.8 * u + k * (h + 0.3 * u);
+        const Impl::Box above{cx - 0.5 * w, top - gap - h, cx + 0.5 * w, top - gap};
+        const Impl::Box below{cx - 0.5 * w, bottom + gap, cx + 0.5 * w, bottom + gap + h};
+        if (free(above))
+          at = above;
+        else if (free(below))
+          at = below;
+        if (at) break;
+      }
+    }
+    if (at) {
+      impl_->labels.push_back(*at);
+      const double cx = 0.5 * (at->x0 + at->x1);
+      const bool is_above = at->y1 <= top;
+      const double edge = is_above ? top : bottom;
+      const double near = is_above ? at->y1 : at->y0;
+      if (std::abs(near - edge) > 1.5 * u || std::abs(cx - t.ToPixel(box.center).x()) > 0.5 * w) {
+        cairo_save(cr);
+        SetColor(cr, WithAlpha(colors::kBlack, 0.6));
+        cairo_set_line_width(cr, 0.35 * u);
+        cairo_move_to(cr, cx, near);
+        cairo_line_to(cr, std::clamp(cx, left, right), edge);
+        cairo_stroke(cr);
+        cairo_restore(cr);
+      }
+      DrawText(cr, style.label, cx, at->y1 - 0.2 * h,
+               {.size = sm,
+                .bold = style.ego,
+                .h = HAlign::kCenter,
+                .v = VAlign::kBottom,
+                .halo = true});
+    } else {
+      ++impl_->labels_left_out;
+    }
   }
   const std::string legend = !style.legend.empty() ? style.legend : style.ego ? "ego" : "vehicle";
   impl_->AddLegend({legend, fill, Marker::kSwatch, Mix(fill, colors::kBlack, 0.55)});
+}
+
+std::vector<std::array<double, 4>> BirdsEyeView::label_boxes() const {
+  std::vector<std::array<double, 4>> out;
+  for (const auto& b : impl_->labels) out.push_back({b.x0, b.y0, b.x1, b.y1});
+  return out;
+}
+
+int BirdsEyeView::labels_left_out() const { return impl_->labels_left_out; }
+
+void BirdsEyeView::KeepLabelsOff(const OrientedBox& box) {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const Position& c : box.Corners()) {
+    const Vector2 p = impl_->transform.ToPixel(c);
+    x0 = std::min(x0, p.x());
+    y0 = std::min(y0, p.y());
+    x1 = std::max(x1, p.x());
+    y1 = std::max(y1, p.y());
+  }
+  impl_->labels.push_back({x0, y0, x1, y1});
 }
 
 void BirdsEyeView::DrawSensorFov(const SensorFov& fov) {

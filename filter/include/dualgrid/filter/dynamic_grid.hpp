@@ -125,6 +125,10 @@ class DynamicGrid {
   }
   const FilterParams& params() const { return params_; }
 
+  /// The new-born mass of the last Update summed over the cells (step 7's rho_b, the mass its
+  /// birth particles are drawn for); 0 before the first Update and after one without detections.
+  double NewbornMass() const;
+
   /// Checks the invariants that hold after every Update (the soak test runs it each cycle):
   /// every cell's masses are finite, in [0, 1] and free + static + dynamic <= 1 (unknown >= 0);
   /// the particle count is num_particles; every particle's position, velocity and weights are

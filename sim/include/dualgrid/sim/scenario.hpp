@@ -10,6 +10,12 @@
 
 namespace dualgrid::sim {
 
+/// Radar cross-sections a scenario may give [dBsm]: from a small animal to a ship's side. The
+/// radar equation takes 10^(rcs / 10): far beyond these (1e300) it overflows to inf and the
+/// filter's weights to NaN.
+inline constexpr double kMinRcsDbsm = -60.0;
+inline constexpr double kMaxRcsDbsm = 80.0;
+
 /// A vehicle class: SUMO vType attributes plus the radar cross-section the radar model uses.
 struct VehicleTypeSpec {
   double length = 4.5;               ///< [m]

@@ -2,6 +2,7 @@
 // laid out in points at a column width (dualgrid/viz/figure.hpp), with axes in metres.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -121,7 +122,17 @@ class BirdsEyeView {
   void DrawLane(const std::vector<Position>& centre_line, double width);
   /// A guard rail (or any barrier) polyline, dark, `width` [m] (at least 2 px).
   void DrawGuardRail(const std::vector<Position>& polyline, double width = 0.3);
+  /// A vehicle's box, heading mark, velocity arrow and label. Labels never overlap each other
+  /// or the ego's box (KeepLabelsOff): each goes above or below its box, stepped further out
+  /// with a leader line when that is taken; a label with no free place is left out (counted).
+  /// The ego's box, when drawn, is kept clear of later labels.
   void DrawVehicle(const OrientedBox& box, const VehicleStyle& style = {});
+  /// Keeps the labels drawn from now on off `box` (e.g. the ego's, drawn last on top).
+  void KeepLabelsOff(const OrientedBox& box);
+  /// The pixel boxes [x0, y0, x1, y1] of the labels placed so far (and the boxes kept clear),
+  /// and how many labels found no free place.
+  std::vector<std::array<double, 4>> label_boxes() const;
+  int labels_left_out() const;
   void DrawSensorFov(const SensorFov& fov);
   void DrawDetections(const std::vector<DetectionMark>& detections,
                       const DetectionStyle& style = {});
