@@ -13,7 +13,8 @@ import dualgrid
 FILTER_FIELDS = [
     "length_x", "width_y", "resolution", "num_particles", "num_birth", "process_noise_position",
     "process_noise_velocity", "persistence", "birth_probability", "birth_max_tangential_speed",
-    "max_speed", "birth_sigma_radial", "sigma_f", "sigma_static_distance",
+    "max_speed", "birth_sigma_radial", "doppler_fit_radius", "doppler_fit_sigma",
+    "birth_fit_uniform_share", "sigma_f", "sigma_static_distance",
     "sigma_static_velocity", "sigma_v", "cutoff_sigmas", "occupied_mass", "free_mass",
     "free_mass_no_return", "free_angle_bin", "free_bin_dilation", "free_decay",
     "static_persistence", "static_gain", "static_speed", "decay_eps", "cycle", "mode",
@@ -66,9 +67,9 @@ class FilterParamsTest(unittest.TestCase):
         p = dualgrid.FilterParams()
         accepted = {
             "mode": ["position", "velocity", "dual"],
-            "birth_velocity": ["doppler", "uniform"],
+            "birth_velocity": ["doppler", "uniform", "doppler_fit"],
             "zero_likelihood": ["keep_prediction", "literal"],
-            "velocity_likelihood": ["vector", "radial"],
+            "velocity_likelihood": ["vector", "radial", "radial_fit"],
             "normalisation": ["per_cell", "literal"],
         }
         for name, values in accepted.items():
