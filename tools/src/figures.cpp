@@ -257,9 +257,16 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
       " m/s of its true velocity. w_position scores positions only; w_velocity also scores the "
       "Doppler. ";
   // The explanation depends on the run's f_v (eq. (8)): say which one this run used.
-  if (likelihood == filter::VelocityLikelihood::kRadial)
+  if (likelihood == filter::VelocityLikelihood::kRadialFit)
     chart.caption +=
-        "This run uses the radial likelihood (the dualgrid preset, the default): a particle "
+        "This run uses the radial likelihood with the Doppler fit's tangential term (the "
+        "dualgrid preset, the default): a particle with the true velocity matches the radial "
+        "speed and, where neighbouring Dopplers fix it, the tangential part, so w_velocity's "
+        "share sits at or above w_position's. The paper's Fig. 4 (w_velocity drops while the "
+        "Doppler is below the speed) is eq. (8) in its vector form (filter.preset=paper).";
+  else if (likelihood == filter::VelocityLikelihood::kRadial)
+    chart.caption +=
+        "This run uses the radial likelihood (velocity_likelihood=radial): a particle "
         "with the true velocity always matches the radial speed, even across the line of "
         "sight, so w_velocity's share sits at or above w_position's. The paper's Fig. 4 "
         "(w_velocity drops while the Doppler is below the speed) is eq. (8) in its vector form "

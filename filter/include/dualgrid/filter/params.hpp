@@ -128,9 +128,11 @@ struct FilterParams {
 
   // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset,
   // the best setting of the ablation in docs/results.md; Preset("paper") gives the literal ones.
-  BirthVelocity birth_velocity = BirthVelocity::kDoppler;
+  // birth_velocity and velocity_likelihood: the Doppler fit since issue 28 (docs/results.md,
+  // section 9: crossing traffic dual D_v 31.8 -> 63.6 %, the paper's scenarios unchanged).
+  BirthVelocity birth_velocity = BirthVelocity::kDopplerFit;
   ZeroLikelihood zero_likelihood = ZeroLikelihood::kKeepPrediction;
-  VelocityLikelihood velocity_likelihood = VelocityLikelihood::kRadial;
+  VelocityLikelihood velocity_likelihood = VelocityLikelihood::kRadialFit;
   Normalisation normalisation = Normalisation::kPerCell;
 
   /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
