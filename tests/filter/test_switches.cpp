@@ -115,6 +115,7 @@ TEST_CASE("the radial likelihood lets velocity weights track a tangential target
   const std::uint64_t seed = GENERATE(1, 2, 3, 4);
   FilterParams fp;
   fp.mode = WeightMode::kVelocity;
+  fp.birth_velocity = BirthVelocity::kDoppler;  // not the default fit: eq. (8) alone decides
   fp.velocity_likelihood = VelocityLikelihood::kRadial;
   const Trace radial = Run(Case::kTangential, fp, seed);
   fp.velocity_likelihood = VelocityLikelihood::kVector;
@@ -124,6 +125,26 @@ TEST_CASE("the radial likelihood lets velocity weights track a tangential target
   INFO("seed " << seed << " velocity-mode error: radial " << e_radial << ", vector " << e_vector);
   CHECK(e_radial < 4.0);
   CHECK(e_vector > 6.0);
+}
+
+TEST_CASE("doppler_fit births let even eq. (8)'s vector form track a tangential target",
+          "[filter][switches]") {
+  // The tangential case above, vector likelihood, but the default births: the detections on the
+  // car's near face see it along spread lines of sight, so their Doppler fit gives the tangential
+  // velocity and births carry it; eq. (8) then rewards particles near that whole vector. The
+  // same 4 m/s bound as position and dual weights, where Doppler births give > 6 m/s.
+  const std::uint64_t seed = GENERATE(1, 2, 3, 4);
+  FilterParams fp;
+  fp.mode = WeightMode::kVelocity;
+  fp.velocity_likelihood = VelocityLikelihood::kVector;
+  REQUIRE(fp.birth_velocity == BirthVelocity::kDopplerFit);
+  const double e_fit = MeanVelocityError(Run(Case::kTangential, fp, seed), 20, 60);
+  fp.birth_velocity = BirthVelocity::kDoppler;
+  const double e_doppler = MeanVelocityError(Run(Case::kTangential, fp, seed), 20, 60);
+  INFO("seed " << seed << " velocity-mode error: doppler_fit births " << e_fit
+               << ", doppler births " << e_doppler);
+  CHECK(e_fit < 4.0);
+  CHECK(e_doppler > 6.0);
 }
 
 TEST_CASE("the paper preset separates static from moving targets", "[filter][switches]") {
@@ -227,6 +248,7 @@ TEST_CASE("the radial_fit likelihood concentrates the weight on the right tangen
   for (int fit = 0; fit < 2; ++fit) {
     FilterParams fp;
     fp.mode = WeightMode::kVelocity;
+    fp.birth_velocity = BirthVelocity::kDoppler;
     fp.velocity_likelihood = fit ? VelocityLikelihood::kRadialFit : VelocityLikelihood::kRadial;
     DynamicGrid g(fp, seed);
     const Pose2 ego;

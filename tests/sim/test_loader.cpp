@@ -103,8 +103,10 @@ TEST_CASE("Malformed scenarios are rejected naming the key and the expectation",
       {"set_speed: 30", "set_speed: [30]", "'actions[0].set_speed'", "expected a number"},
       {"[[0, 0], [100, 0]]", "[[0, 0], [100]]", "'obstacles.guard_rails[0].points[1]'",
        "expected a point"},
-      {"car: {length: 4.5", "car: {length: 0", "'vehicle_types.car.length'", "expected in (0, 30] m, got 0"},
-      {"vehicle: a", "vehicle: nobody", "'actions[0].vehicle'", "expected a vehicle of the scenario, got 'nobody'"},
+      {"car: {length: 4.5", "car: {length: 0", "'vehicle_types.car.length'",
+       "expected in (0, 30] m, got 0"},
+      {"vehicle: a", "vehicle: nobody", "'actions[0].vehicle'",
+       "expected a vehicle of the scenario, got 'nobody'"},
       {"ego: {", "ego: [", "", "not valid YAML"},
   }));
   const std::string msg = ErrorOf(Replace(kValid, c.from, c.to));
@@ -189,11 +191,12 @@ TEST_CASE("filter presets set the switches and single keys override them", "[loa
         filter::BirthVelocity::kUniform);
   CHECK(per_mode.FilterFor(WeightMode::kVelocity).birth_velocity ==
         filter::BirthVelocity::kDoppler);
-  CHECK(per_mode.FilterFor(WeightMode::kDual).birth_velocity == filter::BirthVelocity::kDoppler);
+  // dual is not listed: the section's value, the default doppler_fit.
+  CHECK(per_mode.FilterFor(WeightMode::kDual).birth_velocity == filter::BirthVelocity::kDopplerFit);
   CHECK(per_mode.FilterFor(WeightMode::kPosition).mode == WeightMode::kPosition);
   const nlohmann::json j = ConfigToJson(per_mode);
   CHECK(j.at("filter").at("birth_velocity").at("position") == "uniform");
-  CHECK(j.at("filter").at("birth_velocity").at("dual") == "doppler");
+  CHECK(j.at("filter").at("birth_velocity").at("dual") == "doppler_fit");
 }
 
 TEST_CASE("--set overrides are applied to the document before it is read", "[loader][set]") {
@@ -255,7 +258,7 @@ TEST_CASE("grid frame and placement keys", "[loader][frame]") {
   const auto d = LoadScenario(Write("frame0.yaml", kValid));
   CHECK(d.grid.frame == scenario::GridPlacement::Frame::kFollow);  // the default
   CHECK(d.grid.realign_deg == 5.0);
-  CHECK(d.grid.CentreOffset(200.0, 25.0) == Vector2::Zero());       // the ego centred, exactly
+  CHECK(d.grid.CentreOffset(200.0, 25.0) == Vector2::Zero());  // the ego centred, exactly
   const auto w = LoadScenario(
       Write("frame1.yaml", std::string(kValid) + "filter: {frame: world, ahead: 150, left: 10}\n"));
   CHECK(w.grid.frame == scenario::GridPlacement::Frame::kWorld);
@@ -265,7 +268,8 @@ TEST_CASE("grid frame and placement keys", "[loader][frame]") {
   CHECK(ErrorOf(std::string(kValid) + "filter: {frame: diagonal}\n")
             .find("'filter.frame' expected 'follow', 'heading' or 'world', got 'diagonal'") !=
         std::string::npos);
-  const auto f = LoadScenario(Write("frame4.yaml", std::string(kValid) + "filter: {realign_deg: 2}\n"));
+  const auto f =
+      LoadScenario(Write("frame4.yaml", std::string(kValid) + "filter: {realign_deg: 2}\n"));
   CHECK(f.grid.realign_deg == 2.0);
   CHECK(ErrorOf(std::string(kValid) + "filter: {realign_deg: 0}\n")
             .find("'filter.realign_deg' expected an angle in (0, 90] deg, got 0") !=
