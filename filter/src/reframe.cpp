@@ -2,6 +2,7 @@
 // that a grid following the ego's heading stays along the road. Particles are turned exactly;
 // cell masses, which live on the lattice, are resampled from the old lattice by nearest cell.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -40,7 +41,10 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   const double* const old_static = old_free + cells;
   const double* const old_dynamic = old_static + cells;
   const std::int64_t ogx = origin_gx_, ogy = origin_gy_;
-  const auto [gx, gy] = OriginFor(ego);
+  // Plain variables, not a structured binding: clang 14 (the fuzz and TSan builds) cannot
+  // capture a binding into the OpenMP region.
+  const std::array<std::int64_t, 2> origin = OriginFor(ego);
+  const std::int64_t gx = origin[0], gy = origin[1];
   const double r = params_.resolution;
 #pragma omp parallel for schedule(static)
   for (std::int64_t iy = 0; iy < ny_; ++iy) {
