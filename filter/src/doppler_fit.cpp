@@ -86,18 +86,7 @@ void DynamicGrid::FitDetectionVelocities(std::span<const Measurement> z) {
   const int reach = static_cast<int>(
       std::ceil(params_.doppler_fit_radius / (bucket_cells_ * params_.resolution)));
   const double floor = params_.doppler_fit_sigma;
-  // Per detection the unit line of sight and the signed radial speed (UpdateCells keeps its own
-  // copy; this step runs before it).
-  if (static_cast<int>(det_fit_los_.size()) < 3 * nz) det_fit_los_.resize(3 * nz);  // grow only
-  double* const los = det_fit_los_.data();
-  for (int j = 0; j < nz; ++j) {
-    Vector2 u = z[j].position - z[j].sensor_position;
-    const double len = u.norm();
-    u = len > 0.0 ? Vector2(u / len) : Vector2(1.0, 0.0);
-    los[3 * j] = u.x();
-    los[3 * j + 1] = u.y();
-    los[3 * j + 2] = z[j].radial_velocity.dot(u);
-  }
+  const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
 #pragma omp parallel for schedule(dynamic, 32)
   for (int j = 0; j < nz; ++j) {
     det_fit_t_[j] = 0.0;

@@ -90,6 +90,7 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   cycle_params_ = ForCycle(params_, dt);         // per-cycle factors for this dt
   PredictAndSort(dt);                            // 2. prediction, 3. assignment
   BuildMeasurementGrid(measurements, coverage);  // 4. measurement grid
+  ComputeLinesOfSight(measurements);             // read by 4a and 5.-6.
   if (params_.birth_velocity == BirthVelocity::kDopplerFit ||
       params_.velocity_likelihood == VelocityLikelihood::kRadialFit)
     FitDetectionVelocities(measurements);  // 4a. velocity fit to neighbouring Dopplers

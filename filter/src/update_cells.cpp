@@ -11,6 +11,19 @@ namespace dualgrid::filter {
 
 using namespace detail;
 
+void DynamicGrid::ComputeLinesOfSight(std::span<const Measurement> z) {
+  const int nz = static_cast<int>(z.size());
+  if (det_los_.size() < 3 * z.size()) det_los_.resize(3 * z.size());  // grow only
+  for (int j = 0; j < nz; ++j) {
+    Vector2 u = z[j].position - z[j].sensor_position;
+    const double n = u.norm();
+    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
+    det_los_[3 * j] = u.x();
+    det_los_[3 * j + 1] = u.y();
+    det_los_[3 * j + 2] = z[j].radial_velocity.dot(u);
+  }
+}
+
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
@@ -27,19 +40,9 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // likelihood forms, since a zero velocity has no line-of-sight component either), and for the
   // radial likelihood the unit line of sight u and the signed compensated radial speed v_r . u.
   const int nz = static_cast<int>(z.size());
-  if (static_cast<int>(det_fv0_.size()) < nz) {  // grow only
-    det_fv0_.resize(nz);
-    det_los_.resize(3 * static_cast<std::size_t>(nz));
-  }
-  for (int j = 0; j < nz; ++j) {
+  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grow only
+  for (int j = 0; j < nz; ++j)
     det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
-    Vector2 u = z[j].position - z[j].sensor_position;
-    const double n = u.norm();
-    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
-    det_los_[3 * j] = u.x();
-    det_los_[3 * j + 1] = u.y();
-    det_los_[3 * j + 2] = z[j].radial_velocity.dot(u);
-  }
   // radial_fit: per detection 1 / (2 (sigma_v^2 + s_t^2)) of the tangential term, 0 where no fit.
   const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
   if (radial_fit) {

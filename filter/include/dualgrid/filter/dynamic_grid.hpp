@@ -152,6 +152,9 @@ class DynamicGrid {
   void BuildMeasurementGrid(std::span<const Measurement> z, std::span<const SensorCoverage> cov);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
+  // Per detection the unit line of sight and the signed radial speed into det_los_ (once per
+  // cycle, before the Doppler fit and UpdateCells, which both read it).
+  void ComputeLinesOfSight(std::span<const Measurement> z);
   void Birth(std::span<const Measurement> z);
   // doppler_fit / radial_fit: per detection, the tangential velocity that a robust fit to the
   // Doppler of its neighbours gives, and its standard deviation (inf: no fit).
@@ -209,8 +212,7 @@ class DynamicGrid {
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
   std::vector<double> reframe_layers_;          // Reframe: the old free, static and dynamic layers
   std::vector<double> det_fit_t_, det_fit_sd_;  // FitDetectionVelocities: per detection [m/s]
-  std::vector<double> det_fit_los_,
-      det_fit_k_;  // FitDetectionVelocities: u_x, u_y, v_r per detection
+  std::vector<double> det_fit_k_;  // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
