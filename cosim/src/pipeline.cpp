@@ -72,6 +72,11 @@ void Pipeline::MakeFilters(bool cycle_is_step) {
     // their particle sets differ, so the comparison isolates the weights.
     filters_.push_back(std::make_unique<filter::DynamicGrid>(p, config_.sim.seed));
   }
+  // Step 4 depends on the detections and the grid's geometry only: built once per step for every
+  // mode (MeasurementGrid, docs/performance.md).
+  measurement_.reset();
+  if (!filters_.empty())
+    measurement_ = std::make_unique<filter::MeasurementGrid>(filters_[0]->params());
 }
 
 void Pipeline::Start(const std::filesystem::path& network_dir,
@@ -92,9 +97,13 @@ void Pipeline::UpdateFilter(std::size_t i) {
   // position of EgoInput's pose, to place the grid.
   const Pose2 pose = grid_frame_.ToGrid(ego_.pose);
   const Position centre = pose.position + centre_offset_;
-  if (realign_angle_ != 0.0) filters_[i]->Reframe(realign_angle_, centre);
-  filters_[i]->Update({{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)}, measurements_,
-                      coverage_, dt_);
+  filter::DynamicGrid& grid = *filters_[i];
+  if (realign_angle_ != 0.0) grid.Reframe(realign_angle_, centre);
+  const filter::EgoInput ego{{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)};
+  if (measurement_->SharesGeometry(grid.params()))
+    grid.Update(ego, *measurement_, dt_);  // built in Advance
+  else
+    grid.Update(ego, measurements_, coverage_, dt_);
 }
 
 void Pipeline::FixFrame(const sim::Frame& f) {
@@ -152,6 +161,8 @@ bool Pipeline::Advance() {
     coverage_.push_back(
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
+  // Every filter's centre (UpdateFilter); the grid frame has already turned (above).
+  measurement_->Build(g.ToGrid(ego_.pose).position + centre_offset_, measurements_, coverage_);
   return true;
 }
 

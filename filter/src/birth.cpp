@@ -100,7 +100,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
 
 void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                                  std::int64_t k_hi, double mass, double r, double vmax) {
-  const int j = near_det_[s];
+  const int j = mg_->near_det_[s];
   // Global cell of storage index s: the unique one inside the current window.
   const std::int64_t sx = s % nx_, sy = s / nx_;
   const std::int64_t gx = origin_gx_ + Mod(sx - origin_gx_, nx_);
@@ -129,8 +129,9 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   // standard deviation is vt_max / sqrt(3)), births draw it from the fit, but for a share kept
   // uniform (FitDetectionVelocities).
   const bool fitted = params_.birth_velocity == BirthVelocity::kDopplerFit &&
-                      det_fit_sd_[j] < vt_max / std::sqrt(3.0);
-  const double fit_t = fitted ? det_fit_t_[j] : 0.0, fit_sd = fitted ? det_fit_sd_[j] : 0.0;
+                      mg_->det_fit_sd_[j] < vt_max / std::sqrt(3.0);
+  const double fit_t = fitted ? mg_->det_fit_t_[j] : 0.0,
+               fit_sd = fitted ? mg_->det_fit_sd_[j] : 0.0;
   constexpr std::int64_t kBatch = 64;
   alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
   for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-#include "dualgrid/filter/dynamic_grid.hpp"
+#include "dualgrid/filter/measurement_grid.hpp"
 #include "grid_internal.hpp"
 
 namespace dualgrid::filter {
@@ -76,7 +76,8 @@ bool RobustFit(const double* ux, const double* uy, const double* y, int n, doubl
 
 }  // namespace
 
-void DynamicGrid::FitDetectionVelocities(std::span<const Measurement> z) {
+void MeasurementGrid::FitDetectionVelocities() {
+  const std::span<const Measurement> z = z_;
   const int nz = static_cast<int>(z.size());
   if (static_cast<int>(det_fit_t_.size()) < nz) {  // grow only
     det_fit_t_.resize(nz);

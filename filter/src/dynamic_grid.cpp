@@ -29,9 +29,6 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   const auto c = static_cast<std::size_t>(num_cells_);
   for (auto* v : {&free_, &static_, &dynamic_, &born_}) v->assign(c, 0.0);
   view_.assign(c, 0);
-  near_det_.assign(c, -1);
-  near_d2_.assign(c, kInf);
-  touched_.reserve(4096);
   const auto n = static_cast<std::size_t>(params_.num_particles);
   const auto b = static_cast<std::size_t>(params_.num_birth);
   particles_.resize(n);
@@ -45,14 +42,6 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 10) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
   scan_out_.assign(n + b + 1, 0.0);
-  const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
-  // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
-  // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
-  bucket_cells_ = static_cast<int>(std::ceil(cutoff / params_.resolution)) + 1;
-  nbx_ = (nx_ + bucket_cells_ - 1) / bucket_cells_;
-  nby_ = (ny_ + bucket_cells_ - 1) / bucket_cells_;
-  bucket_count_.assign(static_cast<std::size_t>(nbx_) * nby_, 0);
-  bucket_start_.assign(static_cast<std::size_t>(nbx_) * nby_ + 1, 0);
 }
 
 std::int64_t DynamicGrid::Storage(std::int64_t gx, std::int64_t gy) const {
@@ -67,6 +56,15 @@ Position DynamicGrid::CellCenter(CellIndex c) const {
 
 void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measurements,
                          std::span<const SensorCoverage> coverage, double dt) {
+  if (!own_measurement_) own_measurement_.emplace(params_);
+  if (!ego.pose.position.allFinite()) {
+    throw std::invalid_argument("DynamicGrid::Update: ego position is not finite");
+  }
+  own_measurement_->Build(ego.pose.position, measurements, coverage);  // 4. measurement grid
+  Update(ego, *own_measurement_, dt);
+}
+
+void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) {
     throw std::invalid_argument("DynamicGrid::Update: dt must be finite and >= 0, got " +
                                 std::to_string(dt));
@@ -74,29 +72,27 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   if (!ego.pose.position.allFinite()) {
     throw std::invalid_argument("DynamicGrid::Update: ego position is not finite");
   }
-  for (const SensorCoverage& c : coverage) {
-    if (!c.origin.allFinite() || !std::isfinite(c.boresight) || !(c.half_fov >= 0.0) ||
-        !(c.min_range >= 0.0) || !(c.max_range >= c.min_range) || !std::isfinite(c.max_range)) {
-      throw std::invalid_argument(
-          "DynamicGrid::Update: SensorCoverage needs a finite origin/boresight, half_fov >= 0 "
-          "and 0 <= min_range <= max_range < inf");
-    }
+  if (!measurement.SharesGeometry(params_) || measurement.builds() == 0 ||
+      measurement.origin_index() != OriginFor(ego.pose.position)) {
+    throw std::invalid_argument(
+        "DynamicGrid::Update: the MeasurementGrid was not built for this grid (another geometry, "
+        "never built, or built for another ego position)");
   }
   if (!initialized_) {
     Initialize(ego);
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
-  cycle_params_ = ForCycle(params_, dt);         // per-cycle factors for this dt
-  PredictAndSort(dt);                            // 2. prediction, 3. assignment
-  BuildMeasurementGrid(measurements, coverage);  // 4. measurement grid
-  ComputeLinesOfSight(measurements);             // read by 4a and 5.-6.
-  if (params_.birth_velocity == BirthVelocity::kDopplerFit ||
-      params_.velocity_likelihood == VelocityLikelihood::kRadialFit)
-    FitDetectionVelocities(measurements);  // 4a. velocity fit to neighbouring Dopplers
-  UpdateCells(measurements);               // 5.-6. occupancy update, weights, 9. statistics
-  Birth(measurements);                     // 7. birth
-  Resample();                              // 8. resampling
+  mg_ = &measurement;
+  const std::span<const Measurement> z = measurement.measurements();
+  cycle_params_ = ForCycle(params_, dt);  // per-cycle factors for this dt
+  PredictAndSort(dt);                     // 2. prediction, 3. assignment
+  // 4. measurement grid and 4a. Doppler fit: in `measurement` (MeasurementGrid::Build).
+  UpdateCells(z);             // 5.-6. occupancy update, weights, 9. statistics
+  Birth(z);                   // 7. birth
+  Resample();                 // 8. resampling
+  view_ = measurement.view_;  // same size: a copy, no allocation (Cell, ExportMasses)
+  mg_ = nullptr;
   ++step_;
 }
 

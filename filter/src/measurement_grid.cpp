@@ -1,10 +1,14 @@
 // Step 4 of the cycle (docs/algorithm.md, paper eqs. 2-4): nearest detection per cell, detection
-// buckets, and the per-sensor ray free space.
-#include "dualgrid/filter/dynamic_grid.hpp"
+// buckets, the per-sensor ray free space and the detections' lines of sight (MeasurementGrid).
+#include "dualgrid/filter/measurement_grid.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <utility>
+
+#include "dualgrid/filter/particles.hpp"
 #include "grid_internal.hpp"
 
 namespace dualgrid::filter {
@@ -30,8 +34,71 @@ constexpr double kAtanError = 5e-4;
 
 }  // namespace
 
-void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
-                                       std::span<const SensorCoverage> cov) {
+MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
+  std::string error;
+  if (!params_.IsValid(&error)) {
+    throw std::invalid_argument("dualgrid::filter::MeasurementGrid: invalid FilterParams: " +
+                                error);
+  }
+  with_fit_ = params_.birth_velocity == BirthVelocity::kDopplerFit ||
+              params_.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  nx_ = params_.CellsX();
+  ny_ = params_.CellsY();
+  num_cells_ = static_cast<std::int64_t>(nx_) * ny_;
+  const auto c = static_cast<std::size_t>(num_cells_);
+  view_.assign(c, 0);
+  near_det_.assign(c, -1);
+  near_d2_.assign(c, kInf);
+  touched_.reserve(4096);
+  const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
+  // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
+  // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
+  bucket_cells_ = static_cast<int>(std::ceil(cutoff / params_.resolution)) + 1;
+  nbx_ = (nx_ + bucket_cells_ - 1) / bucket_cells_;
+  nby_ = (ny_ + bucket_cells_ - 1) / bucket_cells_;
+  bucket_count_.assign(static_cast<std::size_t>(nbx_) * nby_, 0);
+  bucket_start_.assign(static_cast<std::size_t>(nbx_) * nby_ + 1, 0);
+}
+
+bool MeasurementGrid::SharesGeometry(const FilterParams& p) const {
+  const FilterParams& q = params_;
+  const bool fit = p.birth_velocity == BirthVelocity::kDopplerFit ||
+                   p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  return p.resolution == q.resolution && p.CellsX() == nx_ && p.CellsY() == ny_ &&
+         p.cutoff_sigmas == q.cutoff_sigmas && p.sigma_f == q.sigma_f &&
+         p.free_angle_bin == q.free_angle_bin && p.free_bin_dilation == q.free_bin_dilation &&
+         fit == with_fit_ &&
+         (!fit || (p.doppler_fit_radius == q.doppler_fit_radius &&
+                   p.doppler_fit_sigma == q.doppler_fit_sigma));
+}
+
+void MeasurementGrid::Build(const Position& centre, std::span<const Measurement> z,
+                            std::span<const SensorCoverage> coverage) {
+  if (!centre.allFinite())
+    throw std::invalid_argument("MeasurementGrid::Build: the grid centre is not finite");
+  for (const SensorCoverage& c : coverage) {
+    if (!c.origin.allFinite() || !std::isfinite(c.boresight) || !(c.half_fov >= 0.0) ||
+        !(c.min_range >= 0.0) || !(c.max_range >= c.min_range) || !std::isfinite(c.max_range)) {
+      throw std::invalid_argument(
+          "MeasurementGrid::Build: SensorCoverage needs a finite origin/boresight, half_fov >= 0 "
+          "and 0 <= min_range <= max_range < inf");
+    }
+  }
+  // DynamicGrid's origin for this centre (OriginFor): the same cells, the same storage.
+  const double r = params_.resolution;
+  origin_gx_ = static_cast<std::int64_t>(std::floor(centre.x() / r)) - nx_ / 2;
+  origin_gy_ = static_cast<std::int64_t>(std::floor(centre.y() / r)) - ny_ / 2;
+  z_.assign(z.begin(), z.end());  // capacity reused across builds
+  Stamp();
+  Bins(coverage);
+  FieldOfView(coverage);
+  ComputeLinesOfSight();
+  if (with_fit_) FitDetectionVelocities();
+  ++builds_;
+}
+
+void MeasurementGrid::Stamp() {
+  const std::span<const Measurement> z = z_;
   const double r = params_.resolution;
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
   const int rc = static_cast<int>(std::ceil(cutoff / r));
@@ -92,6 +159,11 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
     det_x_[k] = z[j].position.x();
     det_y_[k] = z[j].position.y();
   }
+}
+
+void MeasurementGrid::Bins(std::span<const SensorCoverage> cov) {
+  const std::span<const Measurement> z = z_;
+  const int nz = static_cast<int>(z.size());
 
   // Bearing bins per sensor: range of the closest detection shadowing each bin.
   const int ns = static_cast<int>(cov.size());
@@ -121,7 +193,11 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
       }
     }
   }
+}
 
+void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
+  const int ns = static_cast<int>(cov.size());
+  const double r = params_.resolution;
   // Field of view and ray free space per cell (rows in parallel: each cell has one writer).
   const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
   const std::int64_t sx0 = Mod(origin_gx_, nx_);
@@ -308,7 +384,20 @@ void DynamicGrid::BuildMeasurementGrid(std::span<const Measurement> z,
   }
 }
 
-std::pair<int, int> DynamicGrid::BucketOf(double px, double py) const {
+void MeasurementGrid::ComputeLinesOfSight() {
+  const int nz = static_cast<int>(z_.size());
+  if (det_los_.size() < 3 * z_.size()) det_los_.resize(3 * z_.size());  // grow only
+  for (int j = 0; j < nz; ++j) {
+    Vector2 u = z_[j].position - z_[j].sensor_position;
+    const double n = u.norm();
+    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
+    det_los_[3 * j] = u.x();
+    det_los_[3 * j + 1] = u.y();
+    det_los_[3 * j + 2] = z_[j].radial_velocity.dot(u);
+  }
+}
+
+std::pair<int, int> MeasurementGrid::BucketOf(double px, double py) const {
   // Same formula for detections and queries.
   const double inv = 1.0 / (bucket_cells_ * params_.resolution);
   const double x0 = static_cast<double>(origin_gx_) * params_.resolution;

@@ -11,22 +11,10 @@ namespace dualgrid::filter {
 
 using namespace detail;
 
-void DynamicGrid::ComputeLinesOfSight(std::span<const Measurement> z) {
-  const int nz = static_cast<int>(z.size());
-  if (det_los_.size() < 3 * z.size()) det_los_.resize(3 * z.size());  // grow only
-  for (int j = 0; j < nz; ++j) {
-    Vector2 u = z[j].position - z[j].sensor_position;
-    const double n = u.norm();
-    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
-    det_los_[3 * j] = u.x();
-    det_los_[3 * j + 1] = u.y();
-    det_los_[3 * j + 2] = z[j].radial_velocity.dot(u);
-  }
-}
-
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
+  const MeasurementGrid& mg = *mg_;
   const double inv_2sf2 = 0.5 / (p.sigma_f * p.sigma_f);
   const double inv_sd2 = 1.0 / (p.sigma_static_distance * p.sigma_static_distance);
   const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);
@@ -48,27 +36,33 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   if (radial_fit) {
     if (static_cast<int>(det_fit_k_.size()) < nz) det_fit_k_.resize(nz);  // grow only
     for (int j = 0; j < nz; ++j) {
-      const double s2 = p.sigma_v * p.sigma_v + det_fit_sd_[j] * det_fit_sd_[j];
+      const double s2 = p.sigma_v * p.sigma_v + mg.det_fit_sd_[j] * mg.det_fit_sd_[j];
       det_fit_k_[j] = std::isfinite(s2) ? 0.5 / s2 : 0.0;
     }
   }
   const double* const fit_k = det_fit_k_.data();
-  const double* const fit_t = det_fit_t_.data();
+  const double* const fit_t = mg.det_fit_t_.data();
   // The static hypothesis (v = 0) is scored by the same f_v: under radial_fit its tangential
   // part 0 against the fit's v_t as well, so a fitted crossing car is not taken for static.
   if (radial_fit)
     for (int j = 0; j < nz; ++j)
       if (fit_k[j] > 0.0) det_fv0_[j] *= ExpUnder(-fit_t[j] * fit_t[j] * fit_k[j]);
   const double* const fv0_of = det_fv0_.data();
-  const double* const los_of = det_los_.data();
+  const double* const los_of = mg.det_los_.data();
   const bool radial = p.velocity_likelihood != VelocityLikelihood::kVector;
   const bool literal_norm = p.normalisation == Normalisation::kLiteral;
   const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
   const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
   const double static_persistence = p.static_persistence, free_decay = p.free_decay;
   const std::int64_t* const start = cell_start_.data();
-  const int* const near = near_det_.data();
-  const std::uint8_t* const view_bits = view_.data();
+  const int* const near = mg.near_det_.data();
+  const double* const near_d2 = mg.near_d2_.data();
+  const std::int64_t* const bucket_start = mg.bucket_start_.data();
+  const int* const bucket_items = mg.bucket_items_.data();
+  const double* const det_x = mg.det_x_.data();
+  const double* const det_y = mg.det_y_.data();
+  const int nbx = mg.nbx_, nby = mg.nby_;
+  const std::uint8_t* const view_bits = mg.view_.data();
   double* const free_l = free_.data();
   double* const static_l = static_.data();
   double* const dynamic_l = dynamic_.data();
@@ -111,7 +105,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     for (std::int64_t s = c_lo; s < c_hi; ++s) {
       const std::int64_t lo = start[s], hi = start[s + 1];
       if (lo == hi && near[s] < 0) continue;  // done above
-      const std::uint8_t view = view_[s];
+      const std::uint8_t view = view_bits[s];
       const bool observed = (view & kObserved) != 0;
 
       // --- Prediction: predicted masses (dynamic = sum of persistent particle weights). ---
@@ -126,9 +120,9 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
 
       // --- Measurement grid: occupied (f_d, eq. 2), static (eq. 4), free (eq. 3 on rays). ---
       double occ_k = 0.0, static_k = 0.0;
-      const int j = near_det_[s];
+      const int j = near[s];
       if (j >= 0) {
-        const double d2 = near_d2_[s];
+        const double d2 = near_d2[s];
         occ_k = std::exp(-d2 * inv_2sf2);
         static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
       }
@@ -168,12 +162,12 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
       bool any_candidate = false;
       if (hi > lo) {
-        const auto [bx, by] = BucketOf(q.x[lo], q.y[lo]);
-        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx_ - 1, bx + 1);
-        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++r) {
-          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx_;
-          cand[r][0] = bucket_start_[row + x_lo];
-          cand[r][1] = bucket_start_[row + x_hi + 1];
+        const auto [bx, by] = mg.BucketOf(q.x[lo], q.y[lo]);
+        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx - 1, bx + 1);
+        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby - 1, by + 1); ++yy, ++r) {
+          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx;
+          cand[r][0] = bucket_start[row + x_lo];
+          cand[r][1] = bucket_start[row + x_hi + 1];
           any_candidate = any_candidate || cand[r][1] > cand[r][0];
         }
       }
@@ -194,11 +188,11 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
           const double px = q.x[i], py = q.y[i];
           for (const auto& range : cand) {
             for (std::int64_t k = range[0]; k < range[1]; ++k) {
-              const double ex = det_x_[k] - px, ey = det_y_[k] - py;
+              const double ex = det_x[k] - px, ey = det_y[k] - py;
               const double e2 = ex * ex + ey * ey;
-              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items_[k] < jn)) {
+              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items[k] < jn)) {
                 d2 = e2;
-                jn = bucket_items_[k];
+                jn = bucket_items[k];
               }
             }
           }

@@ -70,8 +70,9 @@ class Pipeline {
   /// last step stays readable, Advance() must not be called again. No-op before Start().
   void Finish();
 
-  /// Advances SUMO one step, scans the due radars and prepares the filters' inputs. False at the
-  /// end (the duration reached, or the ego left the network). Needs Start().
+  /// Advances SUMO one step, scans the due radars and prepares the filters' inputs, with their
+  /// shared measurement grid (step 4, built once for every mode). False at the end (the duration
+  /// reached, or the ego left the network). Needs Start().
   bool Advance();
   /// Updates filter `i` with the inputs of the last Advance(). Independent per filter, so callers
   /// may run the filters concurrently (each with a one-thread team inside;
@@ -134,6 +135,8 @@ class Pipeline {
   std::unique_ptr<DetectionSource> source_;
   std::vector<filter::WeightMode> modes_;
   std::vector<std::unique_ptr<filter::DynamicGrid>> filters_;
+  // This step's measurement grid, shared by the filters that share its geometry (all of ours).
+  std::unique_ptr<filter::MeasurementGrid> measurement_;
   radar::EgoMotion ego_;
   std::vector<radar::Detection> detections_;
   std::vector<int> scanned_;

@@ -17,27 +17,11 @@
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/measurement_grid.hpp"
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/filter/particles.hpp"
 
 namespace dualgrid::filter {
-
-/// One radar detection, the paper's eq. (1) [x, y, v_rx, v_ry], in the caller's frame (above).
-struct Measurement {
-  Position position;
-  /// Ego-motion-compensated radial speed over ground times the line-of-sight unit vector.
-  Velocity radial_velocity;
-  Position sensor_position;
-};
-
-/// Field of view of one sensor that scanned this cycle, in the caller's frame.
-struct SensorCoverage {
-  Position origin;
-  double boresight = 0.0;  ///< [rad]
-  double half_fov = 0.0;   ///< [rad]
-  double min_range = 0.0;  ///< [m]
-  double max_range = 0.0;  ///< [m]
-};
 
 /// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
 /// elsewhere in the grid offsets it, as dualgrid's filter.ahead / filter.left do).
@@ -72,8 +56,17 @@ class DynamicGrid {
   DynamicGrid(const FilterParams& params, std::uint64_t seed);
 
   /// One filter cycle. The first call initialises the grid around the ego. `dt` >= 0 [s].
+  /// Builds this cycle's measurement grid (MeasurementGrid::Build on ego.pose.position) and runs
+  /// the cycle on it. The grid's own MeasurementGrid is allocated at the first call.
   void Update(const EgoInput& ego, std::span<const Measurement> measurements,
               std::span<const SensorCoverage> coverage, double dt);
+  /// One filter cycle on a measurement grid built for it: `measurement.Build(ego.pose.position,
+  /// ...)` with this cycle's detections, after any Reframe. Filters whose params share the
+  /// geometry (MeasurementGrid::SharesGeometry) can share one: the co-simulation builds it once per
+  /// step for its three modes. Same results, bit for bit, as the Update above with the same
+  /// inputs. Only the call's duration reads `measurement`. Throws std::invalid_argument when it
+  /// does not share this grid's geometry, was never built, or was built for another position.
+  void Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt);
 
   /// Turns the caller's frame by `angle` [rad] (counter-clockwise) about its origin, between two
   /// cycles: the caller's next inputs come in the turned frame (the grid that follows the ego's
@@ -149,22 +142,13 @@ class DynamicGrid {
   void ResetRow(std::int64_t gy);
   // Prediction (PredictParticles) fused with the counting sort's first pass.
   void PredictAndSort(double dt);
-  void BuildMeasurementGrid(std::span<const Measurement> z, std::span<const SensorCoverage> cov);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
-  // Per detection the unit line of sight and the signed radial speed into det_los_ (once per
-  // cycle, before the Doppler fit and UpdateCells, which both read it).
-  void ComputeLinesOfSight(std::span<const Measurement> z);
   void Birth(std::span<const Measurement> z);
-  // doppler_fit / radial_fit: per detection, the tangential velocity that a robust fit to the
-  // Doppler of its neighbours gives, and its standard deviation (inf: no fit).
-  void FitDetectionVelocities(std::span<const Measurement> z);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                       std::int64_t k_hi, double mass, double r, double vmax);
   void Resample();
-  // Detection bucket (clamped to the bucket grid) of a point.
-  std::pair<int, int> BucketOf(double px, double py) const;
 
   FilterParams params_;
   // params_ with the per-cycle factors of this cycle's dt (ForCycle): what steps 2-7 read.
@@ -178,10 +162,7 @@ class DynamicGrid {
 
   // Cell layers (storage order).
   std::vector<double> free_, static_, dynamic_, born_;
-  std::vector<std::uint8_t> view_;     // field-of-view / ray free-space bits (see .cpp)
-  std::vector<int> near_det_;          // nearest detection index or -1
-  std::vector<double> near_d2_;        // its squared distance to the cell centre
-  std::vector<std::int64_t> touched_;  // cells with near_det_ set (reset next cycle)
+  std::vector<std::uint8_t> view_;  // the last cycle's MeasurementGrid bits (Cell, ExportMasses)
 
   // Particles: persistent set (public), sorted working copy, new-born.
   ParticleSet particles_, sorted_, births_;
@@ -195,24 +176,13 @@ class DynamicGrid {
   std::vector<std::int64_t> born_cells_;
   std::vector<std::int32_t> born_count_;
   std::vector<double> det_fv0_;         // per detection: f_v of a particle at v = 0
-  std::vector<double> det_los_;         // per detection: unit line of sight (x, y), v_r . u
   std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
-
-  // Detection bucket index (logical coordinates, bucket edge >= cutoff).
-  int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
-  std::vector<std::int64_t> bucket_count_, bucket_start_;
-  std::vector<int> bucket_items_;
-  std::vector<double> det_x_, det_y_;  // detection positions in bucket order (compact queries)
-
-  // Per-sensor bearing bins for the ray free space.
-  std::vector<double> bin_range_;
-  std::vector<std::int64_t> bin_offset_;
-  std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1
-  std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
-  std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
-  std::vector<double> reframe_layers_;          // Reframe: the old free, static and dynamic layers
-  std::vector<double> det_fit_t_, det_fit_sd_;  // FitDetectionVelocities: per detection [m/s]
-  std::vector<double> det_fit_k_;  // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
+  // The measurement grid of the running Update (the caller's or own_measurement_); null between
+  // cycles.
+  const MeasurementGrid* mg_ = nullptr;
+  std::optional<MeasurementGrid> own_measurement_;  // the first standalone Update makes it
+  std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
+  std::vector<double> det_fit_k_;       // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
