@@ -1,19 +1,23 @@
 #!/usr/bin/env bash
-# The performance table of docs/performance.md (issue 14), measured side by side on this machine.
+# The performance table of docs/performance.md (issues 14 and 25), measured side by side on this
+# machine.
 #
 #   bench/perf_table.sh [BUILD_DIR [OLD_BUILD_DIR]]      (defaults: build, none)
 #
 # BUILD_DIR (and OLD_BUILD_DIR, e.g. a build of an earlier commit, for a before/after column) must
-# hold Release builds of `dualgrid` and `bench_filter`. Runs, alternating the builds within each
-# repetition so that drifting machine load hits both alike, REPS times (default 3; medians shown):
+# hold Release builds of `dualgrid`, `bench_filter` and `bench_recorded`. Runs, alternating the
+# builds within each repetition so that drifting machine load hits both alike, REPS times (default
+# 3; medians shown):
 #   - the highway run (60 s simulated, 3 modes, 2 threads) without figures, quiet and with one
-#     competing CPU-bound process (a shell busy loop), and with figures, quiet;
+#     competing CPU-bound process (a shell busy loop); the default run (recording and figures),
+#     quiet; the replay video of that run (`dualgrid replay`);
 #   - bench_filter at paper size (50 and 700 detections per cycle), quiet and under the same
-#     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet.
-# bench_filter runs with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for itself.
-# Prints a Markdown table: values, targets and the loaded / quiet slowdown. Takes ~5 min (new
-# build only) to ~12 min (both). Nothing else should run meanwhile: timings of a busy machine are
-# noise (check `uptime` before).
+#     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet;
+#   - bench_recorded: a 20 s recorded sequence, three modes, the default 1 ms batch window.
+# The benchmarks run with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for
+# itself. Prints a Markdown table: values, targets (issue 25's; issue 23's for the recorded row)
+# and the loaded / quiet slowdown. Takes ~8 min (new build only) to ~16 min (both). Nothing else
+# should run meanwhile: timings of a busy machine are noise (check `uptime` before).
 set -euo pipefail
 
 NEW=${1:-build}
@@ -22,7 +26,7 @@ REPS=${REPS:-3}
 SCENARIO=${SCENARIO:-scenarios/highway.yaml}
 SIMULATED=60
 for b in "$NEW" $OLD; do
-  for exe in tools/dualgrid bench/bench_filter; do
+  for exe in tools/dualgrid bench/bench_filter bench/bench_recorded; do
     [[ -x "$b/$exe" ]] || { echo "perf_table.sh: $b/$exe missing: build it first (Release)" >&2; exit 2; }
   done
 done
@@ -47,21 +51,38 @@ busy_stop() {
   BUSY=""
 }
 
-# Wall seconds of one highway run: e2e BUILD [extra args].
-e2e() {
-  local build=$1
-  shift
-  rm -rf "$WORK/run"
+# Wall seconds of one dualgrid command: timed BUILD WHAT ARGS... (WHAT names it in an error).
+timed() {
+  local build=$1 what=$2
+  shift 2
   local t0 t1
   t0=$(date +%s.%N)
-  if ! "$build/tools/dualgrid" run "$SCENARIO" --out "$WORK/run" -q --threads 2 "$@" \
-    >/dev/null 2>"$WORK/err"; then
-    echo "perf_table.sh: $build/tools/dualgrid run failed:" >&2
+  if ! "$build/tools/dualgrid" "$@" >/dev/null 2>"$WORK/err"; then
+    echo "perf_table.sh: $build/tools/dualgrid $what failed:" >&2
     cat "$WORK/err" >&2
     exit 1
   fi
   t1=$(date +%s.%N)
   awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f\n", b - a }'
+}
+
+# Wall seconds of one highway run: e2e BUILD [extra args].
+e2e() {
+  local build=$1
+  shift
+  rm -rf "$WORK/run"
+  timed "$build" run run "$SCENARIO" --out "$WORK/run" -q --threads 2 "$@"
+}
+
+# Wall seconds of the replay video of the last e2e run (its recording): video BUILD.
+video() { timed "$1" replay replay "$WORK/run" -q; }
+
+# x real time of the recorded-data loop, three modes, the default batch window, 2 threads
+# (bench_recorded; issue 23's target): recorded BUILD.
+recorded() {
+  OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 OMP_NUM_THREADS=2 "$1/bench/bench_recorded" \
+    --benchmark_filter='^BM_Recorded/3/1/' 2>/dev/null | grep -o 'x_real_time=[0-9.]*' |
+    cut -d= -f2
 }
 
 # Median real time [ms] per cycle of one bench_filter case: bench BUILD NAME_PREFIX.
@@ -88,6 +109,7 @@ for ((r = 1; r <= REPS; ++r)); do
     add "e2e_loaded|$b" "$(e2e "$b" --no-figures)"
     busy_stop
     add "e2e_figures|$b" "$(e2e "$b")"
+    add "video|$b" "$(video "$b")"
   done
 done
 for b in "${BUILDS[@]}"; do
@@ -95,6 +117,7 @@ for b in "${BUILDS[@]}"; do
   add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
   add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/)"
+  for ((r = 1; r <= REPS; ++r)); do add "recorded_quiet|$b" "$(recorded "$b")"; done
   busy_start
   add "paper50_loaded|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_loaded|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
@@ -128,12 +151,18 @@ row() {  # key kind label target
   echo "$line"
 }
 row e2e xrt "highway run, 3 modes, no figures: x real time" ">= 50x; loaded <= 2x slower"
-line="| highway run with figures: x real time | >= 30x |"
+line="| the default run (recording + figures, no video): x real time | >= 25x |"
 for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med e2e_figures "$b")" xrt) | - | - |"; done
 echo "$line"
-row paper50 cps "filter, paper size, 50 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
-row paper700 cps "filter, paper size, 700 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
-line="| filter, Nuss scale (1.44e6 cells, 2e6 + 2e5 particles): ms/cycle | <= 50 ms |"
+row paper50 cps "filter, paper size, 2 threads, 50 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
+row paper700 cps "filter, paper size, 2 threads, 700 detections: cycles/s" ">= 3,000/s; loaded <= 2x"
+line="| filter, Nuss scale (1.44e6 cells, 2e6 + 2e5 particles), 2 threads: ms/cycle | <= 50 ms |"
 for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med nuss_quiet "$b")" ms) | - | - |"; done
 echo "$line"
-echo "(medians of $REPS runs for the highway rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"
+line="| replay video of the 60 s highway (\`dualgrid replay\`): s | <= 16 s |"
+for b in "${BUILDS[@]}"; do line+=" $(med video "$b") s | - | - |"; done
+echo "$line"
+line="| recorded sequence, 3 modes, 1 ms window, 2 threads (bench_recorded): x real time | >= 10x (issue 23) |"
+for b in "${BUILDS[@]}"; do line+=" $(med recorded_quiet "$b")x | - | - |"; done
+echo "$line"
+echo "(medians of $REPS runs for the highway, video and recorded rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"

@@ -152,7 +152,8 @@ Enum-like fields are strings.)doc");
   cls.def_property_readonly("cells_y", &FilterParams::CellsY,
                             "Cells along y (width_y / resolution rounded, >= 1).");
   cls.def("memory_bytes", &FilterParams::MemoryBytes,
-          "Heap memory of one DynamicGrid with these parameters [bytes] (within a few percent).");
+          "Heap memory of one DynamicGrid with these parameters after its first update() [bytes] "
+          "(within a few percent).");
   cls.def(
       "is_valid", [](const FilterParams& p) { return p.IsValid(nullptr); },
       "True when every field is usable.");

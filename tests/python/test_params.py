@@ -131,7 +131,8 @@ class FilterParamsTest(unittest.TestCase):
 
     def test_memory_bytes(self):
         p = dualgrid.FilterParams()
-        self.assertAlmostEqual(p.memory_bytes(), 93.0 * 400 * 50 + 88.0 * 10000 + 44.0 * 1000)
+        # 94 B per cell: the grid (81) and its own MeasurementGrid (13), FilterParams::MemoryBytes.
+        self.assertAlmostEqual(p.memory_bytes(), 94.0 * 400 * 50 + 88.0 * 10000 + 44.0 * 1000)
 
 
 class SensorParamsTest(unittest.TestCase):
