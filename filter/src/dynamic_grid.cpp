@@ -57,9 +57,7 @@ Position DynamicGrid::CellCenter(CellIndex c) const {
 void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measurements,
                          std::span<const SensorCoverage> coverage, double dt) {
   if (!own_measurement_) own_measurement_.emplace(params_);
-  if (!ego.pose.position.allFinite()) {
-    throw std::invalid_argument("DynamicGrid::Update: ego position is not finite");
-  }
+  // Build refuses a non-finite centre or coverage before anything changes.
   own_measurement_->Build(ego.pose.position, measurements, coverage);  // 4. measurement grid
   Update(ego, *own_measurement_, dt);
 }

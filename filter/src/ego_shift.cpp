@@ -51,9 +51,7 @@ void DynamicGrid::ResetRow(std::int64_t gy) {
 }
 
 std::array<std::int64_t, 2> DynamicGrid::OriginFor(const Position& ego) const {
-  const double r = params_.resolution;
-  return {static_cast<std::int64_t>(std::floor(ego.x() / r)) - nx_ / 2,
-          static_cast<std::int64_t>(std::floor(ego.y() / r)) - ny_ / 2};
+  return detail::OriginFor(ego, params_.resolution, nx_, ny_);
 }
 
 void DynamicGrid::ShiftTo(const Position& ego) {

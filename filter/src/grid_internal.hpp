@@ -2,6 +2,7 @@
 // measurement_grid.cpp, update_cells.cpp, birth.cpp, resample.cpp). Not installed.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -34,6 +35,13 @@ constexpr std::int64_t kScanBlock = 1 << 14;
 // Cells per UpdateCells work item; divides kScanBlock (Birth walks the per-chunk birth lists).
 constexpr std::int64_t kCellChunk = 512;
 static_assert(kScanBlock % kCellChunk == 0);
+
+// Global index of logical cell (0, 0) of an nx x ny grid of resolution r centred on `centre`
+// (DynamicGrid::OriginFor and MeasurementGrid::Build must agree to the cell).
+inline std::array<std::int64_t, 2> OriginFor(const Position& centre, double r, int nx, int ny) {
+  return {static_cast<std::int64_t>(std::floor(centre.x() / r)) - nx / 2,
+          static_cast<std::int64_t>(std::floor(centre.y() / r)) - ny / 2};
+}
 
 // static_cast<int64>(std::ceil(x)) for finite |x| < 2^62 (no libm call without SSE4.1).
 inline std::int64_t CeilToInt(double x) {

@@ -84,10 +84,10 @@ void MeasurementGrid::Build(const Position& centre, std::span<const Measurement>
           "and 0 <= min_range <= max_range < inf");
     }
   }
-  // DynamicGrid's origin for this centre (OriginFor): the same cells, the same storage.
-  const double r = params_.resolution;
-  origin_gx_ = static_cast<std::int64_t>(std::floor(centre.x() / r)) - nx_ / 2;
-  origin_gy_ = static_cast<std::int64_t>(std::floor(centre.y() / r)) - ny_ / 2;
+  // DynamicGrid's origin for this centre: the same cells, the same storage.
+  const auto origin = OriginFor(centre, params_.resolution, nx_, ny_);
+  origin_gx_ = origin[0];
+  origin_gy_ = origin[1];
   z_.assign(z.begin(), z.end());  // capacity reused across builds
   Stamp();
   Bins(coverage);
