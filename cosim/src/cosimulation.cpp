@@ -1,8 +1,11 @@
 #include "dualgrid/cosim/cosimulation.hpp"
 
+#include "dualgrid/cosim/mode_schedule.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 
 namespace dualgrid::cosim {
@@ -49,18 +52,23 @@ bool CoSimulation::Step() {
   return true;
 }
 
-// The modes run concurrently as tasks, one thread each, in one parallel region per step instead
-// of ~40 (the filters' regions and barriers, three times): robust when another process shares
-// the cores (docs/performance.md). With one mode (or one thread) the filter's own loops are
-// parallel instead.
+// The modes run concurrently, one thread each, in one parallel region per step instead of ~40 (the
+// filters' regions and barriers, three times): robust when another process shares the cores
+// (docs/performance.md). With one mode (or one thread) the filter's own loops are parallel
+// instead. Which thread runs what is fixed (ModeSchedule), not left to a task queue: a filter's
+// state (~2-3 MB) then stays in the cache of the core that updated it last step, and its snapshot
+// is taken there at once. With tasks, a mode moved between cores from step to step and every pass
+// over its cells paid for the move (+28 % CPU time on the recorded loop, docs/performance.md).
+// Results do not depend on the schedule: every value is computed by one thread from the same
+// inputs.
 void CoSimulation::FilterAndScore(bool with_velocities) {
-  const std::size_t modes = mode_names_.size();
+  const int modes = static_cast<int>(mode_names_.size());
   objects_.clear();
   truth_classes_.clear();
   if (modes == 0) return;
   if (threads_ > 0) omp_set_num_threads(threads_);
   const int threads = omp_get_max_threads();
-  const int team = std::min(static_cast<int>(modes), threads);
+  const int team = std::min(modes, threads);
   // Threads beyond one per mode go to each filter's own loops (e.g. 8 threads, 3 modes: 3 x 2);
   // on 2 cores that is 1, and nested regions stay off.
   const int per_filter = std::max(1, threads / team);
@@ -73,9 +81,13 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   if (score_points)
     for (const radar::Detection& d : pipeline_.detections())
       point_positions_.push_back(pipeline_.grid_frame().ToGrid(d.position_world));
-  // Exceptions must not leave a parallel region: kept per mode, rethrown after it.
+  const ModeSchedule schedule(modes, team);
+  // Exceptions must not leave a parallel region: kept per mode, rethrown after it. Every flag is
+  // raised whatever happened, so that no thread waits for work that failed.
   std::vector<std::exception_ptr> errors(modes);
   std::exception_ptr truth_error;
+  std::vector<std::atomic<int>> filtered(modes);
+  std::atomic<int> truth_done{0};
   auto guarded = [](std::exception_ptr& slot, auto&& work) {
     try {
       work();
@@ -83,44 +95,49 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       slot = std::current_exception();
     }
   };
-  // Tasks: filter m, then (after filter 0) the shared truth, then scoring m once both are done.
+  auto raise = [](std::atomic<int>& flag) {
+    flag.store(1, std::memory_order_release);
+    flag.notify_all();
+  };
+  auto await = [](const std::atomic<int>& flag) {
+    while (flag.load(std::memory_order_acquire) == 0) flag.wait(0, std::memory_order_acquire);
+  };
   // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
-  // and per object is computed once for the first and holds for every mode. A thread that
-  // finished a filter scores while another still filters (3 modes on 2 cores).
-  std::vector<char> filtered(modes), truth_done(1);
-  char* const f_dep = filtered.data();
-  char* const t_dep = truth_done.data();
-  (void)f_dep;  // used only in depend clauses, which GCC 12's -Wunused-variable misses
-  (void)t_dep;
+  // and per object is computed once, from the first filter its thread finished, for every mode.
+  auto truth = [&](int m) {
+    guarded(truth_error, [&] {
+      if (errors[m]) return;
+      objects_ = pipeline_.TruthObjects(pipeline_.grid(m));
+      truth_classes_ =
+          TruthClasses(snapshots_[m], pipeline_.grid_frame(), f, pipeline_.config().sim);
+    });
+    raise(truth_done);
+  };
+  auto score = [&](int m) {
+    await(filtered[m]);
+    await(truth_done);
+    guarded(errors[m], [&] {
+      if (truth_error || errors[m]) return;
+      scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
+                           ego_box);
+      if (score_points)
+        scorers_[m].AddPoints(pipeline_.grid(m), snapshots_[m], point_positions_,
+                              pipeline_.labels(), ego_box);
+    });
+  };
 #pragma omp parallel num_threads(team) if (team > 1)
-#pragma omp single
   {
-    for (std::size_t m = 0; m < modes; ++m) {
-#pragma omp task depend(out : f_dep[m]) shared(errors)
+    const int t = omp_get_thread_num();
+    if (team > 1) omp_set_num_threads(per_filter);  // this thread's nested regions only
+    for (int m : schedule.filters(t)) {
       guarded(errors[m], [&] {
-        if (team > 1) omp_set_num_threads(per_filter);  // this task's nested regions only
         pipeline_.UpdateFilter(m);
+        TakeSnapshot(pipeline_.grid(m), with_velocities, snapshots_[m]);
       });
-      if (m == 0) {
-#pragma omp task depend(in : f_dep[0]) depend(out : t_dep[0]) shared(truth_error, f)
-        guarded(truth_error, [&] {
-          objects_ = pipeline_.TruthObjects(pipeline_.grid(0));
-          TakeSnapshot(pipeline_.grid(0), with_velocities, snapshots_[0]);
-          truth_classes_ =
-              TruthClasses(snapshots_[0], pipeline_.grid_frame(), f, pipeline_.config().sim);
-        });
-      }
-#pragma omp task depend(in : f_dep[m], t_dep[0]) shared(errors, truth_error, f, ego_box)
-      guarded(errors[m], [&] {
-        if (truth_error || errors[m]) return;
-        if (m > 0) TakeSnapshot(pipeline_.grid(m), with_velocities, snapshots_[m]);
-        scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
-                             ego_box);
-        if (score_points)
-          scorers_[m].AddPoints(pipeline_.grid(m), snapshots_[m], point_positions_,
-                                pipeline_.labels(), ego_box);
-      });
+      raise(filtered[m]);
+      if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
     }
+    for (int m : schedule.scores(t)) score(m);
   }
   if (truth_error) std::rethrow_exception(truth_error);
   for (auto& e : errors)

@@ -67,10 +67,13 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   double* const static_l = static_.data();
   double* const dynamic_l = dynamic_.data();
   double* const born_l = born_.data();
-  // Blocks of cells in parallel; dynamic scheduling only balances load, every value is computed by
-  // one thread from the same inputs, so results do not depend on the thread count.
+  // Blocks of cells in parallel, dealt round robin: the same block goes to the same thread every
+  // cycle (its cells stay in that core's cache; dynamic scheduling moved them between cores, which
+  // cost more than it balanced: docs/performance.md, round 3), and neighbouring blocks, where the
+  // particles cluster, go to different threads. Every value is computed by one thread from the
+  // same inputs, so results do not depend on the thread count.
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(static, 1)
   for (std::int64_t ch = 0; ch < chunks; ++ch) {
     const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
     // Fast path (most cells): no particle, no detection. The general equations below reduce to a
