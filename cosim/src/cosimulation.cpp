@@ -82,6 +82,9 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     for (const radar::Detection& d : pipeline_.detections())
       point_positions_.push_back(pipeline_.grid_frame().ToGrid(d.position_world));
   const ModeSchedule schedule(modes, team);
+  // The prediction normals are the same for every mode: drawn once (here only at the first step;
+  // afterwards ahead, by the thread with the fewest filters, while the others still filter).
+  pipeline_.DrawNoise(false);
   // Exceptions must not leave a parallel region: kept per mode, rethrown after it. Every flag is
   // raised whatever happened, so that no thread waits for work that failed.
   std::vector<std::exception_ptr> errors(modes);
@@ -138,6 +141,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
     }
     for (int m : schedule.scores(t)) score(m);
+    if (t == schedule.truth_thread()) pipeline_.DrawNoise(true);  // the other slot: no race
   }
   if (truth_error) std::rethrow_exception(truth_error);
   for (auto& e : errors)

@@ -100,10 +100,27 @@ void Pipeline::UpdateFilter(std::size_t i) {
   filter::DynamicGrid& grid = *filters_[i];
   if (realign_angle_ != 0.0) grid.Reframe(realign_angle_, centre);
   const filter::EgoInput ego{{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)};
-  if (measurement_->SharesGeometry(grid.params()))
-    grid.Update(ego, *measurement_, dt_);  // built in Advance
-  else
+  if (measurement_->SharesGeometry(grid.params())) {
+    // Only this cycle's slot: a filter behind the others (after an error) draws its own, never
+    // reading the slot that DrawNoise(true) may be writing.
+    const filter::PredictionNoise& noise = noise_[grid.step() % 2];
+    const bool shared = grid.step() == noise_cycle_ &&
+                        noise.Holds(config_.sim.seed, grid.step(), grid.params().num_particles);
+    grid.Update(ego, *measurement_, dt_, shared ? &noise : nullptr);  // built in Advance
+  } else {
     grid.Update(ego, measurements_, coverage_, dt_);
+  }
+}
+
+void Pipeline::DrawNoise(bool ahead) {
+  if (filters_.empty()) return;
+  // Every filter has the seed config_.sim.seed (MakeFilters) and they advance in lockstep. Ahead
+  // reads no filter (they may be updating): the cycle after the one set without `ahead`.
+  if (!ahead) noise_cycle_ = filters_[0]->step();
+  const std::uint64_t cycle = noise_cycle_ + (ahead ? 1 : 0);
+  const std::int64_t n = filters_[0]->params().num_particles;
+  filter::PredictionNoise& slot = noise_[cycle % 2];
+  if (!slot.Holds(config_.sim.seed, cycle, n)) slot.Draw(config_.sim.seed, cycle, n);
 }
 
 void Pipeline::FixFrame(const sim::Frame& f) {

@@ -62,7 +62,8 @@ void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measu
   Update(ego, *own_measurement_, dt);
 }
 
-void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt) {
+void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+                         const PredictionNoise* noise) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) {
     throw std::invalid_argument("DynamicGrid::Update: dt must be finite and >= 0, got " +
                                 std::to_string(dt));
@@ -76,6 +77,13 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
         "DynamicGrid::Update: the MeasurementGrid was not built for this grid (another geometry, "
         "never built, or built for another ego position)");
   }
+  if (noise != nullptr && !noise->Holds(seed_, step_, params_.num_particles)) {
+    throw std::invalid_argument(
+        "DynamicGrid::Update: the PredictionNoise holds another seed, step or fewer particles "
+        "than this grid's next cycle (seed " +
+        std::to_string(seed_) + ", step " + std::to_string(step_) + ", " +
+        std::to_string(params_.num_particles) + " particles)");
+  }
   if (!initialized_) {
     Initialize(ego);
   } else {
@@ -84,7 +92,7 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
   mg_ = &measurement;
   const std::span<const Measurement> z = measurement.measurements();
   cycle_params_ = ForCycle(params_, dt);  // per-cycle factors for this dt
-  PredictAndSort(dt);                     // 2. prediction, 3. assignment
+  PredictAndSort(dt, noise);              // 2. prediction, 3. assignment
   // 4. measurement grid and 4a. Doppler fit: in `measurement` (MeasurementGrid::Build).
   UpdateCells(z);             // 5.-6. occupancy update, weights, 9. statistics
   Birth(z);                   // 7. birth

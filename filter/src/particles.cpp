@@ -4,7 +4,10 @@
 #include <cassert>
 #include <cmath>
 
+#include <omp.h>
+
 #include "dualgrid/core/random.hpp"
+#include "dualgrid/filter/prediction_noise.hpp"
 #include "fast_normal.hpp"
 #include "predict.hpp"
 
@@ -18,28 +21,42 @@ void ParticleSet::resize(std::size_t n) {
 
 namespace detail {
 
+void PredictionNormals(std::uint64_t seed, std::uint64_t step, std::int64_t b0, std::int64_t m,
+                       float* g0, float* g1, float* g2, float* g3) {
+  assert(m <= kPredictBlock);
+  alignas(64) std::uint32_t raw[4][kPredictBlock];
+  alignas(64) float u[4][kPredictBlock];
+  PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(b0), m, 0, raw[0],
+               raw[1], raw[2], raw[3]);
+  for (int c = 0; c < 4; ++c) {
+    for (std::int64_t k = 0; k < m; ++k) u[c][k] = ToUnit24(raw[c][k]);
+  }
+  BoxMuller(u[0], u[1], g0, g1, m);
+  BoxMuller(u[2], u[3], g2, g3, m);
+}
+
 void PredictRange(ParticleSet& p, std::int64_t lo, std::int64_t hi, double dt, float sp, float sv,
-                  double persistence, std::uint64_t seed, std::uint64_t step) {
+                  double persistence, std::uint64_t seed, std::uint64_t step,
+                  const PredictionNoise* shared) {
   const bool noisy = sp > 0.0f || sv > 0.0f;
   // Blocks of particles: raw Philox draws first, then the Box-Muller transform as straight-line
   // array code the compiler vectorises (the scalar transform cost ~4x more per particle). Every
-  // particle's noise depends on its index only, so any blocking gives the same result.
+  // particle's noise depends on its index only, so any blocking gives the same result, and so
+  // do the shared draws (PredictionNoise: the same function over other blocks).
   constexpr std::int64_t kBlock = kPredictBlock;
   for (std::int64_t b0 = lo; b0 < hi; b0 += kBlock) {
     const std::int64_t m = std::min(kBlock, hi - b0);
-    alignas(64) float u[4][kBlock], g[4][kBlock];
-    if (noisy) {
-      alignas(64) std::uint32_t raw[4][kBlock];
-      PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(b0), m, 0,
-                   raw[0], raw[1], raw[2], raw[3]);
-      for (int c = 0; c < 4; ++c) {
-        for (std::int64_t k = 0; k < m; ++k) u[c][k] = ToUnit24(raw[c][k]);
-      }
-      for (int pair = 0; pair < 2; ++pair) {
-        BoxMuller(u[2 * pair], u[2 * pair + 1], g[2 * pair], g[2 * pair + 1], m);
-      }
+    alignas(64) float own[4][kBlock];
+    const float* g[4];
+    if (noisy && shared != nullptr) {
+      for (int c = 0; c < 4; ++c) g[c] = shared->channel(c) + b0;
     } else {
-      for (int c = 0; c < 4; ++c) std::fill_n(g[c], m, 0.0f);
+      if (noisy) {
+        PredictionNormals(seed, step, b0, m, own[0], own[1], own[2], own[3]);
+      } else {
+        for (int c = 0; c < 4; ++c) std::fill_n(own[c], m, 0.0f);
+      }
+      for (int c = 0; c < 4; ++c) g[c] = own[c];
     }
     for (std::int64_t k = 0; k < m; ++k) {
       const std::int64_t i = b0 + k;
@@ -66,8 +83,26 @@ void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_
 #pragma omp parallel for schedule(static)
   for (std::int64_t b = 0; b < blocks; ++b) {
     detail::PredictRange(p, b * kBlock, std::min(n, (b + 1) * kBlock), dt, sp, sv, persistence,
-                         seed, step);
+                         seed, step, nullptr);
   }
+}
+
+void PredictionNoise::Draw(std::uint64_t seed, std::uint64_t step, std::int64_t n) {
+  assert(n >= 0);
+  drawn_ = false;  // a failed allocation leaves no stale match
+  for (auto& c : g_) c.resize(static_cast<std::size_t>(n));
+  constexpr std::int64_t kBlock = detail::kPredictBlock;
+  const std::int64_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static) if (!omp_in_parallel())
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    const std::int64_t b0 = b * kBlock, m = std::min(kBlock, n - b0);
+    detail::PredictionNormals(seed, step, b0, m, g_[0].data() + b0, g_[1].data() + b0,
+                              g_[2].data() + b0, g_[3].data() + b0);
+  }
+  seed_ = seed;
+  step_ = step;
+  n_ = n;
+  drawn_ = true;
 }
 
 namespace {

@@ -14,7 +14,7 @@ namespace dualgrid::filter {
 
 using namespace detail;
 
-void DynamicGrid::PredictAndSort(double dt) {
+void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
   const float sp = static_cast<float>(params_.process_noise_position * std::sqrt(dt));
   const float sv = static_cast<float>(params_.process_noise_velocity * std::sqrt(dt));
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
@@ -41,7 +41,7 @@ void DynamicGrid::PredictAndSort(double dt) {
       for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
         const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
         detail::PredictRange(particles_, b0, b1, dt, sp, sv, cycle_params_.persistence, seed_,
-                             step_);
+                             step_, noise);
         for (std::int64_t i = b0; i < b1; ++i) {
           const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
           const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);

@@ -248,11 +248,12 @@ TEST_CASE("new-born mass belongs to the last update only, in every path and afte
   nothing();
 }
 
-TEST_CASE("a shared MeasurementGrid gives every filter the same cycle as its own",
+TEST_CASE("a shared MeasurementGrid and PredictionNoise give every filter the same cycle",
           "[filter][measurement]") {
-  // Three modes with their own Update against three fed one MeasurementGrid per cycle (the
-  // co-simulation's way): particles, masses and observed bits equal bit for bit, with the Doppler
-  // fit on (the default) and off, while the ego moves by fractions of a cell.
+  // Three modes with their own Update against three fed one MeasurementGrid and one
+  // PredictionNoise per cycle (the co-simulation's way): particles, masses and observed bits equal
+  // bit for bit, with the Doppler fit on (the default) and off, while the ego moves by fractions
+  // of a cell. The noise is drawn for more particles than the filters have (allowed).
   const bool fit = GENERATE(true, false);
   std::vector<DynamicGrid> own, shared;
   FilterParams base;
@@ -269,6 +270,7 @@ TEST_CASE("a shared MeasurementGrid gives every filter the same cycle as its own
     shared.emplace_back(fp, 11);
   }
   MeasurementGrid mg(base);
+  PredictionNoise noise;
   Pose2 ego;
   std::size_t mismatches = 0;
   for (int step = 0; step < 8; ++step) {
@@ -276,9 +278,11 @@ TEST_CASE("a shared MeasurementGrid gives every filter the same cycle as its own
     const auto cov = Sensors(ego);
     const auto z = RandomDetections(ego, 13, step, cov);
     mg.Build(ego.position, z, cov);
+    noise.Draw(11, static_cast<std::uint64_t>(step), base.num_particles + 77);
     for (std::size_t m = 0; m < own.size(); ++m) {
       own[m].Update({ego, {14.6, 2.2}}, z, cov, 0.05);
-      shared[m].Update({ego, {14.6, 2.2}}, mg, 0.05);
+      // Every other cycle without the noise: the filter draws its own, the same.
+      shared[m].Update({ego, {14.6, 2.2}}, mg, 0.05, step % 3 == 1 ? nullptr : &noise);
       const ParticleSet &a = own[m].particles(), &b = shared[m].particles();
       for (std::size_t i = 0; i < a.size(); ++i)
         mismatches += a.x[i] != b.x[i] || a.y[i] != b.y[i] || a.vx[i] != b.vx[i] ||
@@ -323,6 +327,17 @@ TEST_CASE("a MeasurementGrid for another geometry or position is refused",
   CHECK_THROWS_AS(g.Update({ego, {0, 0}}, elsewhere, 0.05), std::invalid_argument);
   CHECK(g.step() == 0);  // nothing ran
   MeasurementGrid right(fp);
+  {
+    right.Build(ego.position, z, cov);
+    PredictionNoise wrong;
+    wrong.Draw(3, 1, fp.num_particles);  // the next cycle is step 0
+    CHECK_THROWS_AS(g.Update({ego, {0, 0}}, right, 0.05, &wrong), std::invalid_argument);
+    wrong.Draw(4, 0, fp.num_particles);  // another seed
+    CHECK_THROWS_AS(g.Update({ego, {0, 0}}, right, 0.05, &wrong), std::invalid_argument);
+    wrong.Draw(3, 0, fp.num_particles - 1);  // too few particles
+    CHECK_THROWS_AS(g.Update({ego, {0, 0}}, right, 0.05, &wrong), std::invalid_argument);
+    CHECK(g.step() == 0);
+  }
   right.Build(ego.position, z, cov);
   FilterParams velocity = fp;
   velocity.mode = WeightMode::kVelocity;  // the weight mode is not geometry

@@ -4,6 +4,7 @@
 // the filters and the scoring on top of it.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -78,6 +79,12 @@ class Pipeline {
   /// may run the filters concurrently (each with a one-thread team inside;
   /// docs/performance.md).
   void UpdateFilter(std::size_t i);
+  /// Draws the filters' prediction normals (filter::PredictionNoise) once for every mode (they
+  /// share seed and step): `ahead` = false for the cycle UpdateFilter runs next (call it before
+  /// the filters of a step), true for the one after (may run while those filters run: another
+  /// slot, and it reads no filter). UpdateFilter reads them when they match its cycle and draws
+  /// its own otherwise, so calling this only saves work. No-op without filters or when drawn.
+  void DrawNoise(bool ahead);
 
   /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
   const scenario::ScenarioConfig& config() const { return config_; }
@@ -137,6 +144,9 @@ class Pipeline {
   std::vector<std::unique_ptr<filter::DynamicGrid>> filters_;
   // This step's measurement grid, shared by the filters that share its geometry (all of ours).
   std::unique_ptr<filter::MeasurementGrid> measurement_;
+  // Prediction normals shared by the modes, by cycle parity (DrawNoise).
+  std::array<filter::PredictionNoise, 2> noise_;
+  std::uint64_t noise_cycle_ = 0;  // the filters' cycle at the last DrawNoise(false)
   radar::EgoMotion ego_;
   std::vector<radar::Detection> detections_;
   std::vector<int> scanned_;

@@ -20,6 +20,7 @@
 #include "dualgrid/filter/measurement_grid.hpp"
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/filter/particles.hpp"
+#include "dualgrid/filter/prediction_noise.hpp"
 
 namespace dualgrid::filter {
 
@@ -66,7 +67,11 @@ class DynamicGrid {
   /// step for its three modes. Same results, bit for bit, as the Update above with the same
   /// inputs. Only the call's duration reads `measurement`. Throws std::invalid_argument when it
   /// does not share this grid's geometry, was never built, or was built for another position.
-  void Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt);
+  /// `noise`, if not null, holds this cycle's prediction normals, drawn once for filters with the
+  /// same seed and step (PredictionNoise::Draw(seed, step(), params().num_particles)): read
+  /// instead of drawing them, same results bit for bit; std::invalid_argument if it holds others.
+  void Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+              const PredictionNoise* noise = nullptr);
 
   /// Turns the caller's frame by `angle` [rad] (counter-clockwise) about its origin, between two
   /// cycles: the caller's next inputs come in the turned frame (the grid that follows the ego's
@@ -140,8 +145,8 @@ class DynamicGrid {
   std::array<std::int64_t, 2> OriginFor(const Position& ego) const;
   void ResetColumn(std::int64_t gx);
   void ResetRow(std::int64_t gy);
-  // Prediction (PredictParticles) fused with the counting sort's first pass.
-  void PredictAndSort(double dt);
+  // Prediction (PredictParticles) fused with the counting sort's first pass; `noise` may be null.
+  void PredictAndSort(double dt, const PredictionNoise* noise);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
   void Birth(std::span<const Measurement> z);
