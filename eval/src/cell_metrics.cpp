@@ -12,13 +12,6 @@ namespace dualgrid::eval {
 using detail::OptFromJson;
 using detail::OptToJson;
 
-CellClass ClassifyCell(double p_free, double p_static, double p_dynamic, double threshold) {
-  if (p_dynamic > threshold) return CellClass::kDynamic;
-  if (p_static > threshold) return CellClass::kStatic;
-  if (p_free > threshold) return CellClass::kFree;
-  return CellClass::kUnknown;
-}
-
 void RasterizeTruth(std::span<const Position> cell_centers, std::span<const OrientedBox> moving,
                     std::span<const OrientedBox> stationary, std::span<std::uint8_t> out) {
   if (out.size() != cell_centers.size())

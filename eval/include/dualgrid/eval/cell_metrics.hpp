@@ -21,7 +21,14 @@ inline constexpr int kNumPredictedClasses = 4;  // ... and unknown
 /// Predicted class of a cell from its masses: dynamic when p_dynamic > threshold (the paper's
 /// rule with 0.6), else static when p_static > threshold, else free when p_free > threshold,
 /// else unknown. With threshold >= 0.5 and masses summing to <= 1 at most one class qualifies.
-CellClass ClassifyCell(double p_free, double p_static, double p_dynamic, double threshold = 0.6);
+/// Inline: it runs once per cell and mode in every step.
+inline CellClass ClassifyCell(double p_free, double p_static, double p_dynamic,
+                              double threshold = 0.6) {
+  if (p_dynamic > threshold) return CellClass::kDynamic;
+  if (p_static > threshold) return CellClass::kStatic;
+  if (p_free > threshold) return CellClass::kFree;
+  return CellClass::kUnknown;
+}
 
 /// Ground-truth class per cell: kDynamic when the cell centre lies in a moving box, else kStatic
 /// when it lies in a stationary box (parked vehicle, guard-rail segment given as a thin box), else
