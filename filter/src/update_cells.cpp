@@ -80,8 +80,14 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     // free/static Dempster update with the whole occupied mass static and no dynamic mass (same
     // operations with d_pred = 0, occ_k = 0). Branch-free over the block so that it vectorises;
     // the other cells keep their values here and are updated in the loop below.
+    // The other cells' offsets in the block, appended branch-free (the general loop visits only
+    // them instead of testing every cell again).
+    std::int32_t slow[kCellChunk];
+    std::int32_t n_slow = 0;
     for (std::int64_t s = c_lo; s < c_hi; ++s) {
       const bool fast = (start[s] == start[s + 1]) & (near[s] < 0);
+      slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
+      n_slow += fast ? 0 : 1;
       const std::uint8_t view = view_bits[s];
       // z_free of the general path, as 0/1 selectors (fm * 1 + fm_nr * 0 = fm exactly).
       const int obs = view & kObserved, ray = (view >> 1) & 1, none = (view >> 2) & 1;
@@ -105,9 +111,9 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     // Cells with birth mass, in cell order (Birth reads only these).
     std::int64_t* const born_list = born_cells_.data() + c_lo;
     std::int32_t n_born = 0;
-    for (std::int64_t s = c_lo; s < c_hi; ++s) {
+    for (std::int32_t t = 0; t < n_slow; ++t) {
+      const std::int64_t s = c_lo + slow[t];
       const std::int64_t lo = start[s], hi = start[s + 1];
-      if (lo == hi && near[s] < 0) continue;  // done above
       const std::uint8_t view = view_bits[s];
       const bool observed = (view & kObserved) != 0;
 
