@@ -13,7 +13,9 @@
 #     quiet; the replay video of that run (`dualgrid replay`);
 #   - bench_filter at paper size (50 and 700 detections per cycle), quiet and under the same
 #     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet;
-#   - bench_recorded: a 20 s recorded sequence, three modes, the default 1 ms batch window.
+#   - the highway run with the dual mode only, 2 threads and 1 thread, no figures;
+#   - bench_recorded: a 20 s recorded sequence, three modes and the dual mode alone, the default
+#     1 ms batch window.
 # The benchmarks run with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for
 # itself. Prints a Markdown table: values, targets (issue 25's; issue 23's for the recorded row)
 # and the loaded / quiet slowdown. Takes ~8 min (new build only) to ~16 min (both). Nothing else
@@ -74,14 +76,20 @@ e2e() {
   timed "$build" run run "$SCENARIO" --out "$WORK/run" -q --threads 2 "$@"
 }
 
+# Wall seconds of the highway run with the dual mode only, no figures: single BUILD THREADS.
+single() {
+  rm -rf "$WORK/single"
+  timed "$1" run run "$SCENARIO" --out "$WORK/single" -q --no-figures --modes dual --threads "$2"
+}
+
 # Wall seconds of the replay video of the last e2e run (its recording): video BUILD.
 video() { timed "$1" replay replay "$WORK/run" -q; }
 
-# x real time of the recorded-data loop, three modes, the default batch window, 2 threads
-# (bench_recorded; issue 23's target): recorded BUILD.
+# x real time of the recorded-data loop, MODES modes (3, or 1: dual only), the default batch
+# window, 2 threads (bench_recorded; issue 23's target): recorded BUILD MODES.
 recorded() {
   OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 OMP_NUM_THREADS=2 "$1/bench/bench_recorded" \
-    --benchmark_filter='^BM_Recorded/3/1/' 2>/dev/null | grep -o 'x_real_time=[0-9.]*' |
+    --benchmark_filter="^BM_Recorded/$2/1/" 2>/dev/null | grep -o 'x_real_time=[0-9.]*' |
     cut -d= -f2
 }
 
@@ -110,6 +118,8 @@ for ((r = 1; r <= REPS; ++r)); do
     busy_stop
     add "e2e_figures|$b" "$(e2e "$b")"
     add "video|$b" "$(video "$b")"
+    add "single2|$b" "$(single "$b" 2)"
+    add "single1|$b" "$(single "$b" 1)"
   done
 done
 for b in "${BUILDS[@]}"; do
@@ -117,7 +127,10 @@ for b in "${BUILDS[@]}"; do
   add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
   add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/)"
-  for ((r = 1; r <= REPS; ++r)); do add "recorded_quiet|$b" "$(recorded "$b")"; done
+  for ((r = 1; r <= REPS; ++r)); do
+    add "recorded_quiet|$b" "$(recorded "$b" 3)"
+    add "recorded1|$b" "$(recorded "$b" 1)"
+  done
   busy_start
   add "paper50_loaded|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_loaded|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
@@ -164,5 +177,13 @@ for b in "${BUILDS[@]}"; do line+=" $(med video "$b") s | - | - |"; done
 echo "$line"
 line="| recorded sequence, 3 modes, 1 ms window, 2 threads (bench_recorded): x real time | >= 10x (issue 23) |"
 for b in "${BUILDS[@]}"; do line+=" $(med recorded_quiet "$b")x | - | - |"; done
+echo "$line"
+line="| recorded sequence, dual only, 1 ms window, 2 threads (bench_recorded): x real time | >= 10x (issue 23) |"
+for b in "${BUILDS[@]}"; do line+=" $(med recorded1 "$b")x | - | - |"; done
+echo "$line"
+line="| highway run, dual only, no figures, 2 threads / 1 thread: x real time | 2 threads not slower |"
+for b in "${BUILDS[@]}"; do
+  line+=" $(fmt "$(med single2 "$b")" xrt) / $(fmt "$(med single1 "$b")" xrt) | - | - |"
+done
 echo "$line"
 echo "(medians of $REPS runs for the highway, video and recorded rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"

@@ -120,7 +120,11 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     await(filtered[m]);
     await(truth_done);
     guarded(errors[m], [&] {
-      if (truth_error || errors[m]) return;
+      if (errors[m]) return;
+      // The velocity moments (observers' pictures and files only) on the scoring thread: with
+      // the filters of two modes on one thread, this spreads them over both.
+      if (with_velocities) TakeVelocities(pipeline_.grid(m), snapshots_[m]);
+      if (truth_error) return;
       scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
                            ego_box);
       if (score_points)
@@ -132,7 +136,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     for (int m : schedule.filters(t)) {
       guarded(errors[m], [&] {
         pipeline_.UpdateFilter(m);
-        TakeSnapshot(pipeline_.grid(m), with_velocities, snapshots_[m]);
+        TakeSnapshot(pipeline_.grid(m), false, snapshots_[m]);
       });
       raise(filtered[m]);
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);

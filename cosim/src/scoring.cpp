@@ -21,7 +21,11 @@ void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnaps
   grid.ExportMasses(s.free, s.static_occ, s.dynamic, s.observed);
   s.mean_vx.clear();
   s.mean_vy.clear();
-  if (!with_velocity) return;
+  if (with_velocity) TakeVelocities(grid, s);
+}
+
+void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s) {
+  const std::size_t n = static_cast<std::size_t>(s.cells_x) * s.cells_y;
   s.mean_vx.resize(n);
   s.mean_vy.resize(n);
   for (int y = 0; y < s.cells_y; ++y) {

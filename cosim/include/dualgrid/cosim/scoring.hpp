@@ -29,6 +29,9 @@ struct GridSnapshot {
 /// Fills `s` (reusing its storage). The velocity moments cost a pass over every particle and are
 /// needed only for figures and particle files, so scoring takes it without them.
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s);
+/// Adds the velocity moments to a snapshot taken without them from the same grid state:
+/// TakeSnapshot(grid, false, s) then TakeVelocities(grid, s) equals TakeSnapshot(grid, true, s).
+void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s);
 
 /// Ground-truth class per cell: moving vehicles dynamic; parked boxes and guard rails (as boxes
 /// one cell wide) static; the rest free. The world's boxes are mapped into the grid frame and
