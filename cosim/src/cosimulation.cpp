@@ -107,12 +107,15 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   };
   // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
   // and per object is computed once, from the first filter its thread finished, for every mode.
+  // truth_ok: computed (not skipped after its filter failed); published by truth_done.
+  bool truth_ok = false;
   auto truth = [&](int m) {
     guarded(truth_error, [&] {
-      if (errors[m]) return;
+      if (errors[m]) return;  // that error is the step's; the others are not scored
       objects_ = pipeline_.TruthObjects(pipeline_.grid(m));
       truth_classes_ =
           TruthClasses(snapshots_[m], pipeline_.grid_frame(), f, pipeline_.config().sim);
+      truth_ok = true;
     });
     raise(truth_done);
   };
@@ -124,7 +127,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       // The velocity moments (observers' pictures and files only) on the scoring thread: with
       // the filters of two modes on one thread, this spreads them over both.
       if (with_velocities) TakeVelocities(pipeline_.grid(m), snapshots_[m]);
-      if (truth_error) return;
+      if (!truth_ok) return;
       scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
                            ego_box);
       if (score_points)

@@ -24,8 +24,9 @@ struct CoSimOptions {
   /// Weight modes run side by side on the same detections; empty: SUMO and the radar only.
   std::vector<filter::WeightMode> modes = {
       filter::WeightMode::kPosition, filter::WeightMode::kVelocity, filter::WeightMode::kDual};
-  /// OpenMP threads; 0: the OpenMP default. The modes run as concurrent tasks (one thread each);
-  /// threads beyond one per mode go to each filter's own loops. Results do not depend on it.
+  /// OpenMP threads; 0: the OpenMP default. The modes run concurrently, each on a fixed thread
+  /// (ModeSchedule); threads beyond one per mode go to each filter's own loops. Results do not
+  /// depend on it.
   int threads = 0;
 };
 
