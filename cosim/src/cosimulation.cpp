@@ -88,7 +88,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   // Exceptions must not leave a parallel region: kept per mode, rethrown after it. Every flag is
   // raised whatever happened, so that no thread waits for work that failed.
   std::vector<std::exception_ptr> errors(modes);
-  std::exception_ptr truth_error;
+  std::exception_ptr truth_error, noise_error;
   std::vector<std::atomic<int>> filtered(modes);
   std::atomic<int> truth_done{0};
   auto guarded = [](std::exception_ptr& slot, auto&& work) {
@@ -145,7 +145,8 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
     }
     for (int m : schedule.scores(t)) score(m);
-    if (t == schedule.truth_thread()) pipeline_.DrawNoise(true);  // the other slot: no race
+    if (t == schedule.truth_thread())  // the other slot: no race
+      guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and
@@ -160,6 +161,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     }
   }
   if (truth_error) std::rethrow_exception(truth_error);
+  if (noise_error) std::rethrow_exception(noise_error);
   for (auto& e : errors)
     if (e) std::rethrow_exception(e);
 }
