@@ -84,9 +84,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   const ModeSchedule schedule(modes, team);
   // The prediction normals are the same for every mode: drawn once (here only at the first step;
   // afterwards ahead, by the thread with the fewest filters, while the others still filter).
-  // One mode draws its own: stored draws would only add a pass over memory.
-  const bool share_noise = modes > 1;
-  if (share_noise) pipeline_.DrawNoise(false);
+  pipeline_.DrawNoise(false);
   // Exceptions must not leave a parallel region: kept per mode, rethrown after it. Every flag is
   // raised whatever happened, so that no thread waits for work that failed.
   std::vector<std::exception_ptr> errors(modes);
@@ -147,7 +145,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
     }
     for (int m : schedule.scores(t)) score(m);
-    if (share_noise && t == schedule.truth_thread())  // the other slot: no race
+    if (t == schedule.truth_thread())  // the other slot: no race
       guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
   };
   if (team == 1) {
