@@ -11,6 +11,91 @@ namespace dualgrid::filter {
 
 using namespace detail;
 
+namespace {
+
+// Two cells per operation (GCC / Clang vector extensions). Each lane is the scalar expression's
+// IEEE operation, so every cell's result is bit-identical to the scalar code; written by hand
+// because GCC 12 does not vectorise std::min feeding std::max ("control flow in loop").
+using V2 = double __attribute__((vector_size(16)));
+using M2 = std::int64_t __attribute__((vector_size(16)));  // lane masks: -1 true, 0 false
+inline V2 Min(V2 a, V2 b) { return b < a ? b : a; }        // std::min(a, b) per lane
+inline V2 Max(V2 a, V2 b) { return a < b ? b : a; }        // std::max(a, b) per lane
+
+struct FastCellInputs {
+  const std::int64_t* start;  // particle ranges per cell (cell_start_)
+  const int* near;            // nearest detection per cell, -1 if none
+  const std::uint8_t* view;   // observed / free-ray / no-return bits
+  double free_mass, free_mass_no_return, static_persistence, free_decay;
+};
+
+// The update of a cell with no particle and no detection nearby: the general equations of
+// UpdateCells with d_pred = 0 and occ_k = 0 (a free/static Dempster update, the whole occupied mass
+// static, no dynamic or new-born mass), for cells [c_lo, c_hi). Writes the masses of those cells
+// and leaves the others untouched; lists the others' offsets from c_lo in `slow` (in cell order)
+// and returns their count.
+std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t c_hi,
+                       double* free_l, double* static_l, double* dynamic_l, double* born_l,
+                       std::int32_t* slow) {
+  std::int32_t n_slow = 0;
+  // Lane values of z_free (eq. 3 with occ_k = 0): observed on a free ray -> free_mass, observed
+  // without a return -> free_mass_no_return, else 0.
+  const auto z_free = [&](std::int64_t s) {
+    const std::uint8_t v = in.view[s];
+    if (!(v & kObserved)) return 0.0;
+    return (v & kFreeRay) ? in.free_mass : (v & kNoReturn) ? in.free_mass_no_return : 0.0;
+  };
+  const auto fast = [&](std::int64_t s) {
+    return in.start[s] == in.start[s + 1] && in.near[s] < 0;
+  };
+  std::int64_t s = c_lo;
+  for (; s + 1 < c_hi; s += 2) {
+    const bool f0 = fast(s), f1 = fast(s + 1);
+    slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
+    n_slow += f0 ? 0 : 1;
+    slow[n_slow] = static_cast<std::int32_t>(s + 1 - c_lo);
+    n_slow += f1 ? 0 : 1;
+    const V2 zf = {z_free(s), z_free(s + 1)};
+    const V2 st = {static_l[s], static_l[s + 1]}, fr = {free_l[s], free_l[s + 1]};
+    const V2 s_pred = Min(in.static_persistence * st, V2{1.0, 1.0});
+    const V2 f_pred = Max(V2{0.0, 0.0}, Min(in.free_decay * fr, 1.0 - s_pred));
+    const V2 u_pred = Max(V2{0.0, 0.0}, 1.0 - (0.0 + s_pred) - f_pred);
+    const V2 norm0 = 1.0 / (1.0 - s_pred * zf);
+    const V2 nf = (f_pred + u_pred * zf) * norm0;
+    const V2 ns = s_pred * (1.0 - zf) * norm0;
+    // Selects, not branches: fast and other cells interleave wherever particles are.
+    const M2 keep = {f0 ? 0 : -1, f1 ? 0 : -1};
+    const V2 dyn = {dynamic_l[s], dynamic_l[s + 1]}, born = {born_l[s], born_l[s + 1]};
+    const V2 free_new = keep ? fr : nf, static_new = keep ? st : ns;
+    const V2 dyn_new = keep ? dyn : V2{0.0, 0.0}, born_new = keep ? born : V2{0.0, 0.0};
+    free_l[s] = free_new[0];
+    free_l[s + 1] = free_new[1];
+    static_l[s] = static_new[0];
+    static_l[s + 1] = static_new[1];
+    dynamic_l[s] = dyn_new[0];
+    dynamic_l[s + 1] = dyn_new[1];
+    born_l[s] = born_new[0];
+    born_l[s + 1] = born_new[1];
+  }
+  for (; s < c_hi; ++s) {  // an odd last cell: the same expressions in scalar
+    slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
+    if (!fast(s)) {
+      ++n_slow;
+      continue;
+    }
+    const double zf = z_free(s);
+    const double s_pred = std::min(in.static_persistence * static_l[s], 1.0);
+    const double f_pred = std::max(0.0, std::min(in.free_decay * free_l[s], 1.0 - s_pred));
+    const double u_pred = std::max(0.0, 1.0 - (0.0 + s_pred) - f_pred);
+    const double norm0 = 1.0 / (1.0 - s_pred * zf);
+    free_l[s] = (f_pred + u_pred * zf) * norm0;
+    static_l[s] = s_pred * (1.0 - zf) * norm0;
+    dynamic_l[s] = born_l[s] = 0.0;
+  }
+  return n_slow;
+}
+
+}  // namespace
+
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
@@ -72,42 +157,16 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // cost more than it balanced: docs/performance.md, round 3), and neighbouring blocks, where the
   // particles cluster, go to different threads. Every value is computed by one thread from the
   // same inputs, so results do not depend on the thread count.
+  const FastCellInputs fast_in{start, near, view_bits, fm, fm_nr, static_persistence, free_decay};
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
 #pragma omp parallel for schedule(static, 1)
   for (std::int64_t ch = 0; ch < chunks; ++ch) {
     const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
-    // Fast path (most cells): no particle, no detection. The general equations below reduce to a
-    // free/static Dempster update with the whole occupied mass static and no dynamic mass (same
-    // operations with d_pred = 0, occ_k = 0). Branch-free over the block so that it vectorises;
-    // the other cells keep their values here and are updated in the loop below.
-    // The other cells' offsets in the block, appended branch-free (the general loop visits only
-    // them instead of testing every cell again).
+    // Fast path (most cells): no particle, no detection (FastCells). The other cells keep their
+    // values there and are updated in the loop below, which visits only them.
     std::int32_t slow[kCellChunk];
-    std::int32_t n_slow = 0;
-    for (std::int64_t s = c_lo; s < c_hi; ++s) {
-      const bool fast = (start[s] == start[s + 1]) & (near[s] < 0);
-      slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
-      n_slow += fast ? 0 : 1;
-      const std::uint8_t view = view_bits[s];
-      // z_free of the general path, as 0/1 selectors (fm * 1 + fm_nr * 0 = fm exactly).
-      const int obs = view & kObserved, ray = (view >> 1) & 1, none = (view >> 2) & 1;
-      const double z_free =
-          static_cast<double>(obs & ray) * fm + static_cast<double>(obs & (ray ^ 1) & none) * fm_nr;
-      const double st = static_l[s], fr = free_l[s];
-      const double s_pred = std::min(static_persistence * st, 1.0 - 0.0);
-      const double f_pred = std::max(0.0, std::min(free_decay * fr, 1.0 - 0.0 - s_pred));
-      const double o_pred = 0.0 + s_pred;
-      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
-      const double norm0 = 1.0 / (1.0 - s_pred * z_free);
-      const double nf = (f_pred + u_pred * z_free) * norm0;
-      const double ns = s_pred * (1.0 - z_free) * norm0;
-      free_l[s] = fast ? nf : fr;
-      static_l[s] = fast ? ns : st;
-      dynamic_l[s] = fast ? 0.0 : dynamic_l[s];
-      // No detection near a fast cell: no birth (a_birth is 0 without one). Cleared here as the
-      // general path below sets it, so that no cell keeps an earlier cycle's new-born mass.
-      born_l[s] = fast ? 0.0 : born_l[s];
-    }
+    const std::int32_t n_slow =
+        FastCells(fast_in, c_lo, c_hi, free_l, static_l, dynamic_l, born_l, slow);
     // Cells with birth mass, in cell order (Birth reads only these).
     std::int64_t* const born_list = born_cells_.data() + c_lo;
     std::int32_t n_born = 0;
