@@ -18,6 +18,7 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   if (!std::isfinite(angle) || !ego.allFinite())
     throw std::invalid_argument("DynamicGrid::Reframe: angle and ego position must be finite");
   if (!initialized_ || angle == 0.0) return;
+  sorted_current_ = false;  // the weighted particles stay binned on the old cells
   // New coordinates of a point with old coordinates p: R(-angle) p.
   const double c = std::cos(angle), s = std::sin(angle);
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());

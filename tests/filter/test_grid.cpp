@@ -345,3 +345,56 @@ TEST_CASE("a MeasurementGrid for another geometry or position is refused",
   g.Update({ego, {0, 0}}, right, 0.05);
   CHECK(g.step() == 1);
 }
+
+TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, in its CellOf cell",
+          "[filter][grid][property]") {
+  // 0.3 m: 1 / r is inexact, so CellOf must share the sort's arithmetic (x * (1 / r)) for the
+  // ranges to agree with it on cell borders; the ego moves by fractions of a cell.
+  const std::uint64_t seed = GENERATE(range(1, 7));
+  FilterParams fp;
+  fp.resolution = 0.3;
+  fp.length_x = 60.0;
+  fp.width_y = 30.0;
+  fp.num_particles = 3000;
+  fp.num_birth = 300;
+  DynamicGrid g(fp, seed);
+  Pose2 ego;
+  CounterRng rng(seed, RngPurpose::kTest, 2000, 0);
+  ego.position = {rng.Uniform(-500.0, 500.0), rng.Uniform(-500.0, 500.0)};
+  for (int step = 0; step < 6; ++step) {
+    ego.position += Vector2(rng.Uniform(0.0, 1.7), rng.Uniform(-0.4, 0.4));
+    const auto cov = Sensors(ego);
+    g.Update({ego, {20, 0}}, RandomDetections(ego, seed, step, cov), cov, 0.05);
+    const ParticleSet& p = g.weighted_particles();
+    const std::size_t n = g.num_weighted_particles();
+    std::vector<int> visits(n, 0);
+    std::int64_t previous_last = 0;
+    int wrong_cell = 0, out_of_order = 0;
+    g.ForEachWeightedCell([&](std::size_t k, std::int64_t first, std::int64_t last) {
+      out_of_order += first < previous_last || last <= first;
+      previous_last = last;
+      for (std::int64_t i = first; i < last; ++i) {
+        ++visits[static_cast<std::size_t>(i)];
+        const auto c = g.CellOf({p.x[i], p.y[i]});
+        wrong_cell += !c || static_cast<std::size_t>(c->y) * g.cells_x() + c->x != k;
+      }
+    });
+    // Every particle CellOf places on the grid was visited once; the others never.
+    int missed = 0, visited_off_grid = 0, on_grid = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const bool inside = g.CellOf({p.x[i], p.y[i]}).has_value();
+      on_grid += inside;
+      missed += inside && visits[i] != 1;
+      visited_off_grid += !inside && visits[i] != 0;
+    }
+    INFO("seed " << seed << " step " << step);
+    CHECK(on_grid > 0);
+    CHECK(wrong_cell == 0);
+    CHECK(out_of_order == 0);
+    CHECK(missed == 0);
+    CHECK(visited_off_grid == 0);
+  }
+  g.Reframe(0.1, ego.position);
+  CHECK_THROWS_AS(g.ForEachWeightedCell([](std::size_t, std::int64_t, std::int64_t) {}),
+                  std::logic_error);
+}

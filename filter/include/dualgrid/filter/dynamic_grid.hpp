@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -121,6 +122,15 @@ class DynamicGrid {
   std::size_t num_weighted_particles() const {
     return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
   }
+  /// Calls f(k, first, last) for every cell holding weighted particles, in the order of
+  /// weighted_particles(): k = y * cells_x() + x is the logical cell (ExportMasses' index) and
+  /// [first, last) its particles in weighted_particles(). Every particle of that range has
+  /// CellOf() == (x, y) (the sort and CellOf share their arithmetic); particles off the grid are
+  /// in no range. O(cells), no allocation: the scorer's way to the particles of dynamic cells
+  /// without locating each particle. Valid between an Update and the next Reframe (throws
+  /// std::logic_error after a Reframe, whose new cells the particles are not sorted into).
+  template <typename F>
+  void ForEachWeightedCell(F&& f) const;
   const FilterParams& params() const { return params_; }
 
   /// The new-born mass of the last Update summed over the cells (step 7's rho_b, the mass its
@@ -164,6 +174,7 @@ class DynamicGrid {
   int nx_, ny_;
   std::int64_t num_cells_;
   std::int64_t origin_gx_ = 0, origin_gy_ = 0;  // global index of logical cell (0, 0)
+  bool sorted_current_ = false;  // sorted_ is binned on the current cells (no Reframe since)
 
   // Cell layers (storage order).
   std::vector<double> free_, static_, dynamic_, born_;
@@ -192,11 +203,32 @@ class DynamicGrid {
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
   if (!initialized_ || !p.allFinite()) return std::nullopt;
-  const double r = params_.resolution;
-  const double fx = std::floor(p.x() / r) - static_cast<double>(origin_gx_);
-  const double fy = std::floor(p.y() / r) - static_cast<double>(origin_gy_);
+  // The arithmetic of the particles' sort (PredictAndSort): a particle's cell is the one it was
+  // weighed in, whatever the resolution.
+  const double inv_r = 1.0 / params_.resolution;
+  const double fx = std::floor(p.x() * inv_r) - static_cast<double>(origin_gx_);
+  const double fy = std::floor(p.y() * inv_r) - static_cast<double>(origin_gy_);
   if (fx < 0.0 || fy < 0.0 || fx >= nx_ || fy >= ny_) return std::nullopt;
   return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
+}
+
+template <typename F>
+void DynamicGrid::ForEachWeightedCell(F&& f) const {
+  if (cell_start_.empty()) return;
+  if (!sorted_current_)
+    throw std::logic_error("DynamicGrid::ForEachWeightedCell: called after Reframe, before Update");
+  // Storage (sx, sy) holds logical ((sx - sx0) mod nx, (sy - sy0) mod ny): storage order is the
+  // particles' order.
+  const std::int64_t sx0 = ((origin_gx_ % nx_) + nx_) % nx_, sy0 = ((origin_gy_ % ny_) + ny_) % ny_;
+  for (std::int64_t sy = 0; sy < ny_; ++sy) {
+    const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
+    const std::int64_t* const start = cell_start_.data() + sy * nx_;
+    for (std::int64_t sx = 0; sx < nx_; ++sx) {
+      if (start[sx] == start[sx + 1]) continue;
+      const std::int64_t x = sx >= sx0 ? sx - sx0 : sx - sx0 + nx_;
+      f(static_cast<std::size_t>(y * nx_ + x), start[sx], start[sx + 1]);
+    }
+  }
 }
 
 }  // namespace dualgrid::filter
