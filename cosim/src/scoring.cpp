@@ -121,10 +121,8 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   association_ = tracking_.AddFrame(time, clusters_, objects);
 
   predicted_.resize(snapshot.dynamic.size());
-  for (std::size_t k = 0; k < predicted_.size(); ++k) {
-    predicted_[k] = static_cast<std::uint8_t>(eval::ClassifyCell(
-        snapshot.free[k], snapshot.static_occ[k], snapshot.dynamic[k], config_.dynamic_threshold));
-  }
+  eval::ClassifyCells(snapshot.free, snapshot.static_occ, snapshot.dynamic,
+                      config_.dynamic_threshold, predicted_);
   cells_.AddFrame(predicted_, truth_classes, snapshot.observed);
 }
 

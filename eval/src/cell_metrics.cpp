@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -89,6 +90,31 @@ void RasterizeTruth(const RegularGrid& grid, std::span<const OrientedBox> moving
     StampBox(grid, b, static_cast<std::uint8_t>(CellClass::kDynamic), out);
 }
 
+void ClassifyCells(std::span<const float> free, std::span<const float> static_occ,
+                   std::span<const float> dynamic, double threshold, std::span<std::uint8_t> out) {
+  const std::size_t n = out.size();
+  if (free.size() != n || static_occ.size() != n || dynamic.size() != n)
+    throw std::invalid_argument("ClassifyCells: sizes differ (" + std::to_string(free.size()) +
+                                " free, " + std::to_string(static_occ.size()) + " static, " +
+                                std::to_string(dynamic.size()) + " dynamic, " + std::to_string(n) +
+                                " out)");
+  static_assert(
+      static_cast<int>(CellClass::kFree) == 0 && static_cast<int>(CellClass::kStatic) == 1 &&
+      static_cast<int>(CellClass::kDynamic) == 2 && static_cast<int>(CellClass::kUnknown) == 3);
+  // ClassifyCell's cascade as arithmetic on its three tests (each false for NaN, as there): not
+  // dynamic, not static, not free -> 3; the first test that holds wins.
+  // The threshold as the float t with (x > t) == (x > threshold) for every float x (the largest
+  // float not above it), so that the comparisons stay in float and vectorise.
+  float t = static_cast<float>(threshold);
+  if (static_cast<double>(t) > threshold)
+    t = std::nextafter(t, -std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < n; ++i) {
+    const int d = dynamic[i] > t, s = static_occ[i] > t, f = free[i] > t;
+    const int rest = s + (1 - s) * 3 * (1 - f);  // static 1, else free 0, else unknown 3
+    out[i] = static_cast<std::uint8_t>(2 * d + (1 - d) * rest);
+  }
+}
+
 void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predicted,
                                              std::span<const std::uint8_t> truth,
                                              std::span<const std::uint8_t> observed) {
@@ -97,13 +123,35 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(predicted.size()) + " predicted, " +
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    if (!observed.empty() && observed[i] == 0) continue;
-    if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
-      throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
-                                  std::to_string(i) + " has class out of range");
-    ++m_.confusion[truth[i]][predicted[i]];
-    ++m_.cells;
+  // Counted into four interleaved tables, summed at the end: consecutive cells mostly share one
+  // (truth, predicted) pair, and a single table would chain every increment on the one before.
+  std::array<std::array<std::int64_t, kNumTruthClasses * kNumPredictedClasses>, 4> counts{};
+  std::uint8_t out_of_range = 0;
+  const std::size_t n = truth.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t t = truth[i], p = predicted[i];
+    const std::uint8_t seen = observed.empty() || observed[i] != 0;
+    out_of_range |= seen & ((t >= kNumTruthClasses) | (p >= kNumPredictedClasses));
+    // After an out-of-range pair everything lands in slot 0: the frame is refused below, before
+    // any of its counts is kept (unobserved cells are not checked, as they are not counted).
+    const int slot = out_of_range ? 0 : t * kNumPredictedClasses + p;
+    counts[i & 3][slot] += seen;
+  }
+  if (out_of_range) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!observed.empty() && observed[i] == 0) continue;
+      if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
+        throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
+                                    std::to_string(i) + " has class out of range");
+    }
+  }
+  for (const auto& c : counts) {
+    for (int t = 0; t < kNumTruthClasses; ++t) {
+      for (int p = 0; p < kNumPredictedClasses; ++p) {
+        m_.confusion[t][p] += c[t * kNumPredictedClasses + p];
+        m_.cells += c[t * kNumPredictedClasses + p];
+      }
+    }
   }
   ++m_.frames;
 }

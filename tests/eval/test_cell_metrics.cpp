@@ -1,4 +1,7 @@
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -56,6 +59,71 @@ TEST_CASE("Confusion matrix and scores counted by hand", "[cells]") {
   CHECK(*m.static_precision == Approx(1.0));
   CHECK(*m.static_recall == Approx(0.5));
   CHECK(*m.accuracy == Approx((6.0 + 1.0 + 2.0) / 13.0));
+}
+
+TEST_CASE("ClassifyCells equals ClassifyCell cell by cell", "[cells][property]") {
+  // Masses from a small set that includes the thresholds themselves, float neighbours of them,
+  // 0, 1 and NaN, in every combination, for two thresholds (0.6 and 0.5, where two classes tie).
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (const double threshold : {0.6, 0.5}) {
+    const float t = static_cast<float>(threshold);
+    const std::vector<float> values = {
+        0.0f, 0.2f, std::nextafter(t, 0.0f), t, std::nextafter(t, 1.0f), 0.61f, 1.0f, nan};
+    std::vector<float> fr, st, dy;
+    for (float a : values)
+      for (float b : values)
+        for (float c : values) {
+          fr.push_back(a);
+          st.push_back(b);
+          dy.push_back(c);
+        }
+    std::vector<std::uint8_t> out(fr.size(), 255);
+    dualgrid::eval::ClassifyCells(fr, st, dy, threshold, out);
+    int differ = 0;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      differ += out[i] != static_cast<std::uint8_t>(ClassifyCell(fr[i], st[i], dy[i], threshold));
+    INFO("threshold " << threshold);
+    CHECK(differ == 0);
+  }
+  std::vector<std::uint8_t> short_out(3);
+  const std::vector<float> four(4, 0.0f);
+  CHECK_THROWS_AS(dualgrid::eval::ClassifyCells(four, four, four, 0.6, short_out),
+                  std::invalid_argument);
+}
+
+TEST_CASE("The confusion matrix equals a plain count over random frames", "[cells][property]") {
+  const std::uint64_t seed = GENERATE(range(1, 6));
+  dualgrid::CounterRng rng(seed, dualgrid::RngPurpose::kTest, 0, 0);
+  CellClassificationAccumulator acc;
+  std::array<std::array<std::int64_t, 4>, 3> expected{};
+  std::int64_t cells = 0;
+  for (int frame = 0; frame < 4; ++frame) {
+    const std::size_t n = 1 + static_cast<std::size_t>(rng.Uniform() * 997);
+    std::vector<std::uint8_t> truth(n), pred(n), observed(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      truth[i] = static_cast<std::uint8_t>(rng.Uniform() * 3);
+      pred[i] = static_cast<std::uint8_t>(rng.Uniform() * 4);
+      observed[i] = static_cast<std::uint8_t>(rng.Uniform() < 0.7 ? 1 + rng.Uniform() * 3 : 0);
+      if (observed[i] != 0) {
+        ++expected[truth[i]][pred[i]];
+        ++cells;
+      }
+    }
+    acc.AddFrame(pred, truth, observed);
+  }
+  const CellMetrics m = acc.Result();
+  CHECK(m.confusion == expected);
+  CHECK(m.cells == cells);
+  // A class out of range in an unobserved cell is ignored; in an observed one the frame is
+  // refused and none of its cells counted.
+  std::vector<std::uint8_t> truth(9, 0), pred(9, 0), observed(9, 1);
+  truth[4] = 3;
+  observed[4] = 0;
+  acc.AddFrame(pred, truth, observed);
+  CHECK(acc.Result().cells == cells + 8);
+  observed[4] = 1;
+  CHECK_THROWS_AS(acc.AddFrame(pred, truth, observed), std::invalid_argument);
+  CHECK(acc.Result().cells == cells + 8);
 }
 
 TEST_CASE("Cell scores are empty without the class", "[cells]") {

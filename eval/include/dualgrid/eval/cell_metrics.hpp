@@ -30,6 +30,12 @@ inline CellClass ClassifyCell(double p_free, double p_static, double p_dynamic,
   return CellClass::kUnknown;
 }
 
+/// ClassifyCell for every cell: out[i] = ClassifyCell(free[i], static_occ[i], dynamic[i],
+/// threshold) (as a byte), without branches so that it vectorises (the scorer classifies every
+/// cell of every mode in each step). Throws std::invalid_argument when the sizes differ.
+void ClassifyCells(std::span<const float> free, std::span<const float> static_occ,
+                   std::span<const float> dynamic, double threshold, std::span<std::uint8_t> out);
+
 /// Ground-truth class per cell: kDynamic when the cell centre lies in a moving box, else kStatic
 /// when it lies in a stationary box (parked vehicle, guard-rail segment given as a thin box), else
 /// kFree. `cell_centers` and the boxes share a frame. Writes out[i] for every cell.
