@@ -358,6 +358,9 @@ TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, 
   fp.num_particles = 3000;
   fp.num_birth = 300;
   DynamicGrid g(fp, seed);
+  int calls_before_update = 0;  // no particles yet: nothing to visit, nothing to refuse
+  g.ForEachWeightedCell([&](std::size_t, std::int64_t, std::int64_t) { ++calls_before_update; });
+  CHECK(calls_before_update == 0);
   Pose2 ego;
   CounterRng rng(seed, RngPurpose::kTest, 2000, 0);
   ego.position = {rng.Uniform(-500.0, 500.0), rng.Uniform(-500.0, 500.0)};

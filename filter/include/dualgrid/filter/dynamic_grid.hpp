@@ -214,7 +214,7 @@ inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
 
 template <typename F>
 void DynamicGrid::ForEachWeightedCell(F&& f) const {
-  if (cell_start_.empty()) return;
+  if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
   if (!sorted_current_)
     throw std::logic_error("DynamicGrid::ForEachWeightedCell: called after Reframe, before Update");
   // Storage (sx, sy) holds logical ((sx - sx0) mod nx, (sy - sy0) mod ny): storage order is the
