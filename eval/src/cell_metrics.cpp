@@ -123,36 +123,20 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(predicted.size()) + " predicted, " +
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
-  // Counted into four interleaved tables, summed at the end: consecutive cells mostly share one
-  // (truth, predicted) pair, and a single table would chain every increment on the one before.
-  std::array<std::array<std::int64_t, kNumTruthClasses * kNumPredictedClasses>, 4> counts{};
-  std::uint8_t out_of_range = 0;
-  const std::size_t n = truth.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t t = truth[i], p = predicted[i];
-    const std::uint8_t seen = observed.empty() || observed[i] != 0;
-    out_of_range |= seen & ((t >= kNumTruthClasses) | (p >= kNumPredictedClasses));
-    // After an out-of-range pair everything lands in slot 0: the frame is refused below, before
-    // any of its counts is kept (unobserved cells are not checked, as they are not counted).
-    const int slot = out_of_range ? 0 : t * kNumPredictedClasses + p;
-    counts[i & 3][slot] += seen;
+  // Counted into a table of this frame first, so that a refused frame leaves nothing counted.
+  std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses> frame{};
+  std::int64_t cells = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (!observed.empty() && observed[i] == 0) continue;
+    if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
+      throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
+                                  std::to_string(i) + " has class out of range");
+    ++frame[truth[i]][predicted[i]];
+    ++cells;
   }
-  if (out_of_range) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!observed.empty() && observed[i] == 0) continue;
-      if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
-        throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
-                                    std::to_string(i) + " has class out of range");
-    }
-  }
-  for (const auto& c : counts) {
-    for (int t = 0; t < kNumTruthClasses; ++t) {
-      for (int p = 0; p < kNumPredictedClasses; ++p) {
-        m_.confusion[t][p] += c[t * kNumPredictedClasses + p];
-        m_.cells += c[t * kNumPredictedClasses + p];
-      }
-    }
-  }
+  for (int t = 0; t < kNumTruthClasses; ++t)
+    for (int p = 0; p < kNumPredictedClasses; ++p) m_.confusion[t][p] += frame[t][p];
+  m_.cells += cells;
   ++m_.frames;
 }
 
