@@ -108,15 +108,16 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   const BoxTest ego(ego_box);
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
   // visited, in the particles' order.
-  grid.ForEachWeightedCell([&](std::size_t k, std::int64_t first, std::int64_t last) {
-    if (!(snapshot.dynamic[k] > config_.dynamic_threshold)) return;
-    for (std::int64_t i = first; i < last; ++i) {
-      if (!(p.weight[i] > 0.0f)) continue;
-      const Position pos(p.x[i], p.y[i]);
-      if (ego.Contains(pos)) continue;
-      dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
-    }
-  });
+  grid.ForEachWeightedCellAbove(
+      snapshot.dynamic, config_.dynamic_threshold,
+      [&](std::size_t, std::int64_t first, std::int64_t last) {
+        for (std::int64_t i = first; i < last; ++i) {
+          if (!(p.weight[i] > 0.0f)) continue;
+          const Position pos(p.x[i], p.y[i]);
+          if (ego.Contains(pos)) continue;
+          dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+        }
+      });
   clusters_ = clusterer_.Run(dynamic_particles_);
   association_ = tracking_.AddFrame(time, clusters_, objects);
 

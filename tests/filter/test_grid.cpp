@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -390,7 +391,30 @@ TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, 
       missed += inside && visits[i] != 1;
       visited_off_grid += !inside && visits[i] != 0;
     }
+    // ForEachWeightedCellAbove: the same calls, in order, filtered by the layer's test.
+    const std::size_t cells = static_cast<std::size_t>(g.cells_x()) * g.cells_y();
+    std::vector<float> fr(cells), st(cells), dyn(cells);
+    std::vector<std::uint8_t> seen(cells);
+    g.ExportMasses(fr, st, dyn, seen);
+    int above_differ = 0, above_calls = 0;
+    for (const double threshold : {0.0, 0.3, 0.6}) {
+      std::vector<std::array<std::int64_t, 3>> want, got;
+      g.ForEachWeightedCell([&](std::size_t k, std::int64_t first, std::int64_t last) {
+        if (dyn[k] > threshold) want.push_back({static_cast<std::int64_t>(k), first, last});
+      });
+      g.ForEachWeightedCellAbove(dyn, threshold,
+                                 [&](std::size_t k, std::int64_t first, std::int64_t last) {
+                                   got.push_back({static_cast<std::int64_t>(k), first, last});
+                                 });
+      above_differ += want != got;
+      above_calls += static_cast<int>(got.size());
+    }
     INFO("seed " << seed << " step " << step);
+    CHECK(above_differ == 0);
+    if (step > 0) CHECK(above_calls > 0);  // not vacuous: threshold 0 keeps every dynamic cell
+    CHECK_THROWS_AS(g.ForEachWeightedCellAbove(std::span(dyn).first(cells - 1), 0.5,
+                                               [](std::size_t, std::int64_t, std::int64_t) {}),
+                    std::invalid_argument);
     CHECK(on_grid > 0);
     CHECK(wrong_cell == 0);
     CHECK(out_of_order == 0);
@@ -400,4 +424,8 @@ TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, 
   g.Reframe(0.1, ego.position);
   CHECK_THROWS_AS(g.ForEachWeightedCell([](std::size_t, std::int64_t, std::int64_t) {}),
                   std::logic_error);
+  const std::vector<float> layer(static_cast<std::size_t>(g.cells_x()) * g.cells_y(), 1.0f);
+  CHECK_THROWS_AS(
+      g.ForEachWeightedCellAbove(layer, 0.5, [](std::size_t, std::int64_t, std::int64_t) {}),
+      std::logic_error);
 }

@@ -131,6 +131,13 @@ class DynamicGrid {
   /// std::logic_error after a Reframe, whose new cells the particles are not sorted into).
   template <typename F>
   void ForEachWeightedCell(F&& f) const;
+  /// The calls of ForEachWeightedCell, in the same order, for the cells whose value in `layer`
+  /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer) is above
+  /// `threshold` only. Finds them by scanning the layer, whose cells above a threshold are few and
+  /// clustered, instead of every cell's particle range (a branch per cell on where the particles
+  /// are). Throws as ForEachWeightedCell, and std::invalid_argument for a layer of another size.
+  template <typename F>
+  void ForEachWeightedCellAbove(std::span<const float> layer, double threshold, F&& f) const;
   const FilterParams& params() const { return params_; }
 
   /// The new-born mass of the last Update summed over the cells (step 7's rho_b, the mass its
@@ -228,6 +235,35 @@ void DynamicGrid::ForEachWeightedCell(F&& f) const {
       const std::int64_t x = sx >= sx0 ? sx - sx0 : sx - sx0 + nx_;
       f(static_cast<std::size_t>(y * nx_ + x), start[sx], start[sx + 1]);
     }
+  }
+}
+
+template <typename F>
+void DynamicGrid::ForEachWeightedCellAbove(std::span<const float> layer, double threshold,
+                                           F&& f) const {
+  if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
+  if (!sorted_current_)
+    throw std::logic_error(
+        "DynamicGrid::ForEachWeightedCellAbove: called after Reframe, before Update");
+  if (layer.size() != static_cast<std::size_t>(num_cells_))
+    throw std::invalid_argument("DynamicGrid::ForEachWeightedCellAbove: layer of " +
+                                std::to_string(layer.size()) + " cells for " +
+                                std::to_string(num_cells_));
+  const std::int64_t sx0 = ((origin_gx_ % nx_) + nx_) % nx_, sy0 = ((origin_gy_ % ny_) + ny_) % ny_;
+  for (std::int64_t sy = 0; sy < ny_; ++sy) {
+    const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
+    const float* const row = layer.data() + y * nx_;
+    const std::int64_t* const start = cell_start_.data() + sy * nx_;
+    // Storage columns [0, sx0) hold logical x = sx + nx - sx0, columns [sx0, nx) x = sx - sx0:
+    // two contiguous runs of the logical row, visited in storage (= particle) order.
+    const auto run = [&](std::int64_t sx_lo, std::int64_t sx_hi, std::int64_t x_off) {
+      for (std::int64_t sx = sx_lo; sx < sx_hi; ++sx) {
+        if (!(row[sx + x_off] > threshold) || start[sx] == start[sx + 1]) continue;
+        f(static_cast<std::size_t>(y * nx_ + sx + x_off), start[sx], start[sx + 1]);
+      }
+    };
+    run(0, sx0, nx_ - sx0);
+    run(sx0, nx_, -sx0);
   }
 }
 
