@@ -54,6 +54,7 @@ MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
   // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
   // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
   bucket_cells_ = static_cast<int>(std::ceil(cutoff / params_.resolution)) + 1;
+  bucket_inv_ = 1.0 / (bucket_cells_ * params_.resolution);
   nbx_ = (nx_ + bucket_cells_ - 1) / bucket_cells_;
   nby_ = (ny_ + bucket_cells_ - 1) / bucket_cells_;
   bucket_count_.assign(static_cast<std::size_t>(nbx_) * nby_, 0);
@@ -88,6 +89,8 @@ void MeasurementGrid::Build(const Position& centre, std::span<const Measurement>
   const auto origin = OriginFor(centre, params_.resolution, nx_, ny_);
   origin_gx_ = origin[0];
   origin_gy_ = origin[1];
+  bucket_x0_ = static_cast<double>(origin_gx_) * params_.resolution;
+  bucket_y0_ = static_cast<double>(origin_gy_) * params_.resolution;
   z_.assign(z.begin(), z.end());  // capacity reused across builds
   Stamp();
   Bins(coverage);
@@ -395,16 +398,6 @@ void MeasurementGrid::ComputeLinesOfSight() {
     det_los_[3 * j + 1] = u.y();
     det_los_[3 * j + 2] = z_[j].radial_velocity.dot(u);
   }
-}
-
-std::pair<int, int> MeasurementGrid::BucketOf(double px, double py) const {
-  // Same formula for detections and queries.
-  const double inv = 1.0 / (bucket_cells_ * params_.resolution);
-  const double x0 = static_cast<double>(origin_gx_) * params_.resolution;
-  const double y0 = static_cast<double>(origin_gy_) * params_.resolution;
-  const double fx = std::clamp(std::floor((px - x0) * inv), 0.0, nbx_ - 1.0);
-  const double fy = std::clamp(std::floor((py - y0) * inv), 0.0, nby_ - 1.0);
-  return {static_cast<int>(fx), static_cast<int>(fy)};
 }
 
 }  // namespace dualgrid::filter

@@ -3,7 +3,9 @@
 // of any filter's particles or weight mode. docs/algorithm.md, "One cycle".
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -84,7 +86,8 @@ class MeasurementGrid {
   // Per detection the tangential velocity a robust fit to its neighbours' Doppler gives, and its
   // standard deviation (inf: no fit).
   void FitDetectionVelocities();
-  // Detection bucket (clamped to the bucket grid) of a point.
+  // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
+  // every cell holding particles.
   std::pair<int, int> BucketOf(double px, double py) const;
 
   FilterParams params_;
@@ -103,6 +106,8 @@ class MeasurementGrid {
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff + one cell).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
+  // BucketOf's 1 / bucket edge [1/m] (with the geometry) and the grid's corner [m] (each Build).
+  double bucket_inv_ = 1.0, bucket_x0_ = 0.0, bucket_y0_ = 0.0;
   std::vector<std::int64_t> bucket_count_, bucket_start_;
   std::vector<int> bucket_items_;
   std::vector<double> det_x_, det_y_;     // detection positions in bucket order [m]
@@ -117,5 +122,12 @@ class MeasurementGrid {
   std::vector<double> det_los_;                 // per detection: unit line of sight, v_r . u
   std::vector<double> det_fit_t_, det_fit_sd_;  // per detection: the fit [m/s] (4a)
 };
+
+inline std::pair<int, int> MeasurementGrid::BucketOf(double px, double py) const {
+  // Same formula for detections and queries.
+  const double fx = std::clamp(std::floor((px - bucket_x0_) * bucket_inv_), 0.0, nbx_ - 1.0);
+  const double fy = std::clamp(std::floor((py - bucket_y0_) * bucket_inv_), 0.0, nby_ - 1.0);
+  return {static_cast<int>(fx), static_cast<int>(fy)};
+}
 
 }  // namespace dualgrid::filter
