@@ -48,6 +48,10 @@ std::int64_t DynamicGrid::Storage(std::int64_t gx, std::int64_t gy) const {
   return Mod(gy, ny_) * nx_ + Mod(gx, nx_);
 }
 
+std::array<std::int64_t, 2> DynamicGrid::StorageOrigin() const {
+  return {Mod(origin_gx_, nx_), Mod(origin_gy_, ny_)};
+}
+
 Position DynamicGrid::CellCenter(CellIndex c) const {
   const double r = params_.resolution;
   return {(static_cast<double>(origin_gx_ + c.x) + 0.5) * r,

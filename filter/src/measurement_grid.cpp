@@ -89,8 +89,6 @@ void MeasurementGrid::Build(const Position& centre, std::span<const Measurement>
   const auto origin = OriginFor(centre, params_.resolution, nx_, ny_);
   origin_gx_ = origin[0];
   origin_gy_ = origin[1];
-  bucket_x0_ = static_cast<double>(origin_gx_) * params_.resolution;
-  bucket_y0_ = static_cast<double>(origin_gy_) * params_.resolution;
   z_.assign(z.begin(), z.end());  // capacity reused across builds
   Stamp();
   Bins(coverage);

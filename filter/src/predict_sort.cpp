@@ -27,7 +27,6 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
   const std::int64_t nblocks = (c1 + kCellBlock - 1) / kCellBlock;
   if (static_cast<std::int64_t>(hist_total_.size()) < nblocks + 1) hist_total_.resize(nblocks + 1);
   std::int64_t* block_base = hist_total_.data();
-  sorted_current_ = true;
   // All passes in one parallel region (the implicit barriers of the worksharing loops order them).
 #pragma omp parallel
   {
@@ -100,6 +99,7 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
       }
     }
   }
+  sorted_current_ = true;  // sorted_ and cell_start_ bin the particles on the current cells
 }
 
 }  // namespace dualgrid::filter

@@ -47,15 +47,16 @@ std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t
   const auto fast = [&](std::int64_t s) {
     return in.start[s] == in.start[s + 1] && in.near[s] < 0;
   };
-  std::int64_t s = c_lo;
-  for (; s + 1 < c_hi; s += 2) {
-    const bool f0 = fast(s), f1 = fast(s + 1);
+  for (std::int64_t s = c_lo; s < c_hi; s += 2) {
+    // An odd last cell fills both lanes (the same inputs, the same result written twice).
+    const std::int64_t s1 = s + 1 < c_hi ? s + 1 : s;
+    const bool f0 = fast(s), f1 = fast(s1);
     slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
     n_slow += f0 ? 0 : 1;
-    slow[n_slow] = static_cast<std::int32_t>(s + 1 - c_lo);
-    n_slow += f1 ? 0 : 1;
-    const V2 zf = {z_free(s), z_free(s + 1)};
-    const V2 st = {static_l[s], static_l[s + 1]}, fr = {free_l[s], free_l[s + 1]};
+    slow[n_slow] = static_cast<std::int32_t>(s1 - c_lo);
+    n_slow += f1 || s1 == s ? 0 : 1;
+    const V2 zf = {z_free(s), z_free(s1)};
+    const V2 st = {static_l[s], static_l[s1]}, fr = {free_l[s], free_l[s1]};
     const V2 s_pred = Min(in.static_persistence * st, V2{1.0, 1.0});
     const V2 f_pred = Max(V2{0.0, 0.0}, Min(in.free_decay * fr, 1.0 - s_pred));
     const V2 u_pred = Max(V2{0.0, 0.0}, 1.0 - (0.0 + s_pred) - f_pred);
@@ -64,32 +65,17 @@ std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t
     const V2 ns = s_pred * (1.0 - zf) * norm0;
     // Selects, not branches: fast and other cells interleave wherever particles are.
     const M2 keep = {f0 ? 0 : -1, f1 ? 0 : -1};
-    const V2 dyn = {dynamic_l[s], dynamic_l[s + 1]}, born = {born_l[s], born_l[s + 1]};
+    const V2 dyn = {dynamic_l[s], dynamic_l[s1]}, born = {born_l[s], born_l[s1]};
     const V2 free_new = keep ? fr : nf, static_new = keep ? st : ns;
     const V2 dyn_new = keep ? dyn : V2{0.0, 0.0}, born_new = keep ? born : V2{0.0, 0.0};
     free_l[s] = free_new[0];
-    free_l[s + 1] = free_new[1];
+    free_l[s1] = free_new[1];
     static_l[s] = static_new[0];
-    static_l[s + 1] = static_new[1];
+    static_l[s1] = static_new[1];
     dynamic_l[s] = dyn_new[0];
-    dynamic_l[s + 1] = dyn_new[1];
+    dynamic_l[s1] = dyn_new[1];
     born_l[s] = born_new[0];
-    born_l[s + 1] = born_new[1];
-  }
-  for (; s < c_hi; ++s) {  // an odd last cell: the same expressions in scalar
-    slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
-    if (!fast(s)) {
-      ++n_slow;
-      continue;
-    }
-    const double zf = z_free(s);
-    const double s_pred = std::min(in.static_persistence * static_l[s], 1.0);
-    const double f_pred = std::max(0.0, std::min(in.free_decay * free_l[s], 1.0 - s_pred));
-    const double u_pred = std::max(0.0, 1.0 - (0.0 + s_pred) - f_pred);
-    const double norm0 = 1.0 / (1.0 - s_pred * zf);
-    free_l[s] = (f_pred + u_pred * zf) * norm0;
-    static_l[s] = s_pred * (1.0 - zf) * norm0;
-    dynamic_l[s] = born_l[s] = 0.0;
+    born_l[s1] = born_new[1];
   }
   return n_slow;
 }

@@ -347,10 +347,11 @@ TEST_CASE("a MeasurementGrid for another geometry or position is refused",
   CHECK(g.step() == 1);
 }
 
-TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, in its CellOf cell",
+TEST_CASE("ForEachWeightedCellAbove gives the particles of the cells above a threshold, by CellOf",
           "[filter][grid][property]") {
-  // 0.3 m: 1 / r is inexact, so CellOf must share the sort's arithmetic (x * (1 / r)) for the
-  // ranges to agree with it on cell borders; the ego moves by fractions of a cell.
+  // The reference: each weighted particle located with CellOf; consecutive particles in one cell
+  // above the threshold form one call. 0.3 m: 1 / r is inexact, so CellOf must share the sort's
+  // arithmetic (x * (1 / r)) to agree on cell borders; the ego moves by fractions of a cell.
   const std::uint64_t seed = GENERATE(range(1, 7));
   FilterParams fp;
   fp.resolution = 0.3;
@@ -359,9 +360,16 @@ TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, 
   fp.num_particles = 3000;
   fp.num_birth = 300;
   DynamicGrid g(fp, seed);
-  int calls_before_update = 0;  // no particles yet: nothing to visit, nothing to refuse
-  g.ForEachWeightedCell([&](std::size_t, std::int64_t, std::int64_t) { ++calls_before_update; });
-  CHECK(calls_before_update == 0);
+  const std::size_t cells = static_cast<std::size_t>(g.cells_x()) * g.cells_y();
+  std::vector<float> fr(cells), st(cells), dyn(cells, 1.0f);
+  std::vector<std::uint8_t> seen(cells);
+  using Call = std::array<std::int64_t, 3>;  // k, first, last
+  std::vector<Call> got;
+  const auto record = [&](std::size_t k, std::int64_t first, std::int64_t last) {
+    got.push_back({static_cast<std::int64_t>(k), first, last});
+  };
+  g.ForEachWeightedCellAbove(dyn, 0.5, record);  // no particles yet: nothing to visit
+  CHECK(got.empty());
   Pose2 ego;
   CounterRng rng(seed, RngPurpose::kTest, 2000, 0);
   ego.position = {rng.Uniform(-500.0, 500.0), rng.Uniform(-500.0, 500.0)};
@@ -369,63 +377,34 @@ TEST_CASE("ForEachWeightedCell visits every weighted particle on the grid once, 
     ego.position += Vector2(rng.Uniform(0.0, 1.7), rng.Uniform(-0.4, 0.4));
     const auto cov = Sensors(ego);
     g.Update({ego, {20, 0}}, RandomDetections(ego, seed, step, cov), cov, 0.05);
-    const ParticleSet& p = g.weighted_particles();
-    const std::size_t n = g.num_weighted_particles();
-    std::vector<int> visits(n, 0);
-    std::int64_t previous_last = 0;
-    int wrong_cell = 0, out_of_order = 0;
-    g.ForEachWeightedCell([&](std::size_t k, std::int64_t first, std::int64_t last) {
-      out_of_order += first < previous_last || last <= first;
-      previous_last = last;
-      for (std::int64_t i = first; i < last; ++i) {
-        ++visits[static_cast<std::size_t>(i)];
-        const auto c = g.CellOf({p.x[i], p.y[i]});
-        wrong_cell += !c || static_cast<std::size_t>(c->y) * g.cells_x() + c->x != k;
-      }
-    });
-    // Every particle CellOf places on the grid was visited once; the others never.
-    int missed = 0, visited_off_grid = 0, on_grid = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const bool inside = g.CellOf({p.x[i], p.y[i]}).has_value();
-      on_grid += inside;
-      missed += inside && visits[i] != 1;
-      visited_off_grid += !inside && visits[i] != 0;
-    }
-    // ForEachWeightedCellAbove: the same calls, in order, filtered by the layer's test.
-    const std::size_t cells = static_cast<std::size_t>(g.cells_x()) * g.cells_y();
-    std::vector<float> fr(cells), st(cells), dyn(cells);
-    std::vector<std::uint8_t> seen(cells);
     g.ExportMasses(fr, st, dyn, seen);
-    int above_differ = 0, above_calls = 0;
-    for (const double threshold : {0.0, 0.3, 0.6}) {
-      std::vector<std::array<std::int64_t, 3>> want, got;
-      g.ForEachWeightedCell([&](std::size_t k, std::int64_t first, std::int64_t last) {
-        if (dyn[k] > threshold) want.push_back({static_cast<std::int64_t>(k), first, last});
-      });
-      g.ForEachWeightedCellAbove(dyn, threshold,
-                                 [&](std::size_t k, std::int64_t first, std::int64_t last) {
-                                   got.push_back({static_cast<std::int64_t>(k), first, last});
-                                 });
-      above_differ += want != got;
-      above_calls += static_cast<int>(got.size());
+    const ParticleSet& p = g.weighted_particles();
+    int differ = 0;
+    std::size_t calls = 0;
+    // -1: every cell holding particles, so every particle on the grid is in exactly one call.
+    for (const double threshold : {-1.0, 0.3, 0.6}) {
+      std::vector<Call> want;
+      for (std::int64_t i = 0; i < static_cast<std::int64_t>(g.num_weighted_particles()); ++i) {
+        const auto c = g.CellOf({p.x[i], p.y[i]});
+        if (!c) continue;
+        const std::int64_t k = static_cast<std::int64_t>(c->y) * g.cells_x() + c->x;
+        if (!(dyn[static_cast<std::size_t>(k)] > threshold)) continue;
+        if (!want.empty() && want.back()[0] == k && want.back()[2] == i)
+          ++want.back()[2];
+        else
+          want.push_back({k, i, i + 1});
+      }
+      got.clear();
+      g.ForEachWeightedCellAbove(dyn, threshold, record);
+      differ += want != got;
+      calls += got.size();
     }
     INFO("seed " << seed << " step " << step);
-    CHECK(above_differ == 0);
-    if (step > 0) CHECK(above_calls > 0);  // not vacuous: threshold 0 keeps every dynamic cell
-    CHECK_THROWS_AS(g.ForEachWeightedCellAbove(std::span(dyn).first(cells - 1), 0.5,
-                                               [](std::size_t, std::int64_t, std::int64_t) {}),
+    CHECK(differ == 0);
+    CHECK(calls > 0);
+    CHECK_THROWS_AS(g.ForEachWeightedCellAbove(std::span(dyn).first(cells - 1), 0.5, record),
                     std::invalid_argument);
-    CHECK(on_grid > 0);
-    CHECK(wrong_cell == 0);
-    CHECK(out_of_order == 0);
-    CHECK(missed == 0);
-    CHECK(visited_off_grid == 0);
   }
   g.Reframe(0.1, ego.position);
-  CHECK_THROWS_AS(g.ForEachWeightedCell([](std::size_t, std::int64_t, std::int64_t) {}),
-                  std::logic_error);
-  const std::vector<float> layer(static_cast<std::size_t>(g.cells_x()) * g.cells_y(), 1.0f);
-  CHECK_THROWS_AS(
-      g.ForEachWeightedCellAbove(layer, 0.5, [](std::size_t, std::int64_t, std::int64_t) {}),
-      std::logic_error);
+  CHECK_THROWS_AS(g.ForEachWeightedCellAbove(dyn, 0.5, record), std::logic_error);
 }

@@ -122,20 +122,16 @@ class DynamicGrid {
   std::size_t num_weighted_particles() const {
     return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
   }
-  /// Calls f(k, first, last) for every cell holding weighted particles, in the order of
-  /// weighted_particles(): k = y * cells_x() + x is the logical cell (ExportMasses' index) and
-  /// [first, last) its particles in weighted_particles(). Every particle of that range has
-  /// CellOf() == (x, y) (the sort and CellOf share their arithmetic); particles off the grid are
-  /// in no range. O(cells), no allocation: the scorer's way to the particles of dynamic cells
-  /// without locating each particle. Valid between an Update and the next Reframe (throws
-  /// std::logic_error after a Reframe, whose new cells the particles are not sorted into).
-  template <typename F>
-  void ForEachWeightedCell(F&& f) const;
-  /// The calls of ForEachWeightedCell, in the same order, for the cells whose value in `layer`
+  /// Calls f(k, first, last) for every cell holding weighted particles whose value in `layer`
   /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer) is above
-  /// `threshold` only. Finds them by scanning the layer, whose cells above a threshold are few and
-  /// clustered, instead of every cell's particle range (a branch per cell on where the particles
-  /// are). Throws as ForEachWeightedCell, and std::invalid_argument for a layer of another size.
+  /// `threshold`, in the order of weighted_particles(): k = y * cells_x() + x is the logical cell
+  /// and [first, last) its particles in weighted_particles(). Every particle of that range has
+  /// CellOf() == (x, y) (the sort and CellOf share their arithmetic); particles off the grid are
+  /// in no range. Scans the layer (cells above a threshold are few and clustered) rather than
+  /// every cell's range: the scorer's way to the particles of dynamic cells without locating each
+  /// particle. O(cells), no allocation; nothing before the first Update. Valid between an Update
+  /// and the next Reframe: throws std::logic_error after a Reframe (the particles are not sorted
+  /// into its new cells), std::invalid_argument for a layer of another size.
   template <typename F>
   void ForEachWeightedCellAbove(std::span<const float> layer, double threshold, F&& f) const;
   const FilterParams& params() const { return params_; }
@@ -156,6 +152,8 @@ class DynamicGrid {
  private:
   // Storage index of global cell (gx, gy): circular in both axes so that shifting moves no data.
   std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
+  // Storage column and row of logical cell (0, 0).
+  std::array<std::int64_t, 2> StorageOrigin() const;
   void Initialize(const EgoInput& ego);
   void ShiftTo(const Position& ego);
   // Global index of logical cell (0, 0) for a grid centred on `ego`.
@@ -220,25 +218,6 @@ inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
 }
 
 template <typename F>
-void DynamicGrid::ForEachWeightedCell(F&& f) const {
-  if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
-  if (!sorted_current_)
-    throw std::logic_error("DynamicGrid::ForEachWeightedCell: called after Reframe, before Update");
-  // Storage (sx, sy) holds logical ((sx - sx0) mod nx, (sy - sy0) mod ny): storage order is the
-  // particles' order.
-  const std::int64_t sx0 = ((origin_gx_ % nx_) + nx_) % nx_, sy0 = ((origin_gy_ % ny_) + ny_) % ny_;
-  for (std::int64_t sy = 0; sy < ny_; ++sy) {
-    const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
-    const std::int64_t* const start = cell_start_.data() + sy * nx_;
-    for (std::int64_t sx = 0; sx < nx_; ++sx) {
-      if (start[sx] == start[sx + 1]) continue;
-      const std::int64_t x = sx >= sx0 ? sx - sx0 : sx - sx0 + nx_;
-      f(static_cast<std::size_t>(y * nx_ + x), start[sx], start[sx + 1]);
-    }
-  }
-}
-
-template <typename F>
 void DynamicGrid::ForEachWeightedCellAbove(std::span<const float> layer, double threshold,
                                            F&& f) const {
   if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
@@ -249,7 +228,7 @@ void DynamicGrid::ForEachWeightedCellAbove(std::span<const float> layer, double 
     throw std::invalid_argument("DynamicGrid::ForEachWeightedCellAbove: layer of " +
                                 std::to_string(layer.size()) + " cells for " +
                                 std::to_string(num_cells_));
-  const std::int64_t sx0 = ((origin_gx_ % nx_) + nx_) % nx_, sy0 = ((origin_gy_ % ny_) + ny_) % ny_;
+  const auto [sx0, sy0] = StorageOrigin();
   for (std::int64_t sy = 0; sy < ny_; ++sy) {
     const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
     const float* const row = layer.data() + y * nx_;

@@ -106,8 +106,7 @@ class MeasurementGrid {
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff + one cell).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
-  // BucketOf's 1 / bucket edge [1/m] (with the geometry) and the grid's corner [m] (each Build).
-  double bucket_inv_ = 1.0, bucket_x0_ = 0.0, bucket_y0_ = 0.0;
+  double bucket_inv_ = 1.0;  // 1 / bucket edge [1/m], with bucket_cells_ (BucketOf)
   std::vector<std::int64_t> bucket_count_, bucket_start_;
   std::vector<int> bucket_items_;
   std::vector<double> det_x_, det_y_;     // detection positions in bucket order [m]
@@ -125,8 +124,10 @@ class MeasurementGrid {
 
 inline std::pair<int, int> MeasurementGrid::BucketOf(double px, double py) const {
   // Same formula for detections and queries.
-  const double fx = std::clamp(std::floor((px - bucket_x0_) * bucket_inv_), 0.0, nbx_ - 1.0);
-  const double fy = std::clamp(std::floor((py - bucket_y0_) * bucket_inv_), 0.0, nby_ - 1.0);
+  const double x0 = static_cast<double>(origin_gx_) * params_.resolution;
+  const double y0 = static_cast<double>(origin_gy_) * params_.resolution;
+  const double fx = std::clamp(std::floor((px - x0) * bucket_inv_), 0.0, nbx_ - 1.0);
+  const double fy = std::clamp(std::floor((py - y0) * bucket_inv_), 0.0, nby_ - 1.0);
   return {static_cast<int>(fx), static_cast<int>(fy)};
 }
 
