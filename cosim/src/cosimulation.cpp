@@ -140,6 +140,8 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       guarded(errors[m], [&] {
         pipeline_.UpdateFilter(m);
         TakeSnapshot(pipeline_.grid(m), false, snapshots_[m]);
+        // Here, not in the scorer: it may run on another core (ClassifySnapshot).
+        ClassifySnapshot(pipeline_.config().evaluation.dynamic_threshold, snapshots_[m]);
       });
       raise(filtered[m]);
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);

@@ -19,9 +19,16 @@ void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnaps
   s.dynamic.resize(n);
   s.observed.resize(n);
   grid.ExportMasses(s.free, s.static_occ, s.dynamic, s.observed);
+  s.classes.clear();
   s.mean_vx.clear();
   s.mean_vy.clear();
   if (with_velocity) TakeVelocities(grid, s);
+}
+
+void ClassifySnapshot(double threshold, GridSnapshot& s) {
+  s.classes.resize(s.dynamic.size());
+  eval::ClassifyCells(s.free, s.static_occ, s.dynamic, threshold, s.classes);
+  s.classes_threshold = threshold;
 }
 
 void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s) {
@@ -103,13 +110,22 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
   // Paper Sec. V: particles of cells with P(dynamic) above the threshold are clustered.
   // The weighted persistent particles (before resampling, when all weights become equal), so
   // that the cluster means are the paper's weighted averages and exclude this cycle's births.
+  std::span<const std::uint8_t> classes = snapshot.classes;
+  if (classes.size() != snapshot.dynamic.size() ||
+      snapshot.classes_threshold != config_.dynamic_threshold) {
+    predicted_.resize(snapshot.dynamic.size());
+    eval::ClassifyCells(snapshot.free, snapshot.static_occ, snapshot.dynamic,
+                        config_.dynamic_threshold, predicted_);
+    classes = predicted_;
+  }
   const filter::ParticleSet& p = grid.weighted_particles();
   dynamic_particles_.clear();
   const BoxTest ego(ego_box);
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
-  // visited, in the particles' order.
-  grid.ForEachWeightedCellAbove(
-      snapshot.dynamic, config_.dynamic_threshold,
+  // visited, in the particles' order. kDynamic is ClassifyCell's first test, dynamic > threshold.
+  constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
+  grid.ForEachWeightedCellWhere(
+      classes, [](std::uint8_t c) { return c == kDynamic; },
       [&](std::size_t, std::int64_t first, std::int64_t last) {
         for (std::int64_t i = first; i < last; ++i) {
           if (!(p.weight[i] > 0.0f)) continue;
@@ -120,11 +136,7 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
       });
   clusters_ = clusterer_.Run(dynamic_particles_);
   association_ = tracking_.AddFrame(time, clusters_, objects);
-
-  predicted_.resize(snapshot.dynamic.size());
-  eval::ClassifyCells(snapshot.free, snapshot.static_occ, snapshot.dynamic,
-                      config_.dynamic_threshold, predicted_);
-  cells_.AddFrame(predicted_, truth_classes, snapshot.observed);
+  cells_.AddFrame(classes, truth_classes, snapshot.observed);
 }
 
 void ModeScorer::AddPoints(const filter::DynamicGrid& grid, const GridSnapshot& snapshot,

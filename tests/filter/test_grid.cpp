@@ -347,7 +347,7 @@ TEST_CASE("a MeasurementGrid for another geometry or position is refused",
   CHECK(g.step() == 1);
 }
 
-TEST_CASE("ForEachWeightedCellAbove gives the particles of the cells above a threshold, by CellOf",
+TEST_CASE("ForEachWeightedCellWhere gives the particles of the cells a layer keeps, by CellOf",
           "[filter][grid][property]") {
   // The reference: each weighted particle located with CellOf; consecutive particles in one cell
   // above the threshold form one call. 0.3 m: 1 / r is inexact, so CellOf must share the sort's
@@ -368,7 +368,10 @@ TEST_CASE("ForEachWeightedCellAbove gives the particles of the cells above a thr
   const auto record = [&](std::size_t k, std::int64_t first, std::int64_t last) {
     got.push_back({static_cast<std::int64_t>(k), first, last});
   };
-  g.ForEachWeightedCellAbove(dyn, 0.5, record);  // no particles yet: nothing to visit
+  const auto above = [](double threshold) {
+    return [threshold](float v) { return v > threshold; };
+  };
+  g.ForEachWeightedCellWhere(std::span<const float>(dyn), above(0.5), record);  // no particles yet
   CHECK(got.empty());
   Pose2 ego;
   CounterRng rng(seed, RngPurpose::kTest, 2000, 0);
@@ -382,6 +385,8 @@ TEST_CASE("ForEachWeightedCellAbove gives the particles of the cells above a thr
     int differ = 0;
     std::size_t calls = 0;
     // -1: every cell holding particles, so every particle on the grid is in exactly one call.
+    // The same cells as bytes (a layer of classes): 1 where the mass is above the threshold.
+    std::vector<std::uint8_t> bytes(cells);
     for (const double threshold : {-1.0, 0.3, 0.6}) {
       std::vector<Call> want;
       for (std::int64_t i = 0; i < static_cast<std::int64_t>(g.num_weighted_particles()); ++i) {
@@ -395,16 +400,23 @@ TEST_CASE("ForEachWeightedCellAbove gives the particles of the cells above a thr
           want.push_back({k, i, i + 1});
       }
       got.clear();
-      g.ForEachWeightedCellAbove(dyn, threshold, record);
+      g.ForEachWeightedCellWhere(std::span<const float>(dyn), above(threshold), record);
       differ += want != got;
       calls += got.size();
+      for (std::size_t k = 0; k < cells; ++k) bytes[k] = dyn[k] > threshold ? 1 : 0;
+      got.clear();
+      g.ForEachWeightedCellWhere(
+          std::span<const std::uint8_t>(bytes), [](std::uint8_t b) { return b == 1; }, record);
+      differ += want != got;
     }
     INFO("seed " << seed << " step " << step);
     CHECK(differ == 0);
     CHECK(calls > 0);
-    CHECK_THROWS_AS(g.ForEachWeightedCellAbove(std::span(dyn).first(cells - 1), 0.5, record),
+    CHECK_THROWS_AS(g.ForEachWeightedCellWhere(std::span<const float>(dyn).first(cells - 1),
+                                               above(0.5), record),
                     std::invalid_argument);
   }
   g.Reframe(0.1, ego.position);
-  CHECK_THROWS_AS(g.ForEachWeightedCellAbove(dyn, 0.5, record), std::logic_error);
+  CHECK_THROWS_AS(g.ForEachWeightedCellWhere(std::span<const float>(dyn), above(0.5), record),
+                  std::logic_error);
 }

@@ -25,10 +25,18 @@ struct GridSnapshot {
   std::vector<std::uint8_t> observed;
   /// Mean velocity over ground [m/s] per cell; empty unless taken `with_velocity`.
   std::vector<float> mean_vx, mean_vy;
+  /// eval::CellClass per cell at `classes_threshold` (ClassifySnapshot); empty after TakeSnapshot.
+  std::vector<std::uint8_t> classes;
+  double classes_threshold = 0.0;
 };
 /// Fills `s` (reusing its storage). The velocity moments cost a pass over every particle and are
 /// needed only for figures and particle files, so scoring takes it without them.
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s);
+/// Fills s.classes with eval::ClassifyCells of its masses at `threshold`. The scorer then reads
+/// these bytes and `observed` (2 bytes per cell) instead of the three mass layers (13): called on
+/// the thread that took the snapshot, it keeps the scorer on another core from pulling the masses
+/// over, which the filter's next ExportMasses would pull back (docs/performance.md, round 5).
+void ClassifySnapshot(double threshold, GridSnapshot& s);
 /// Adds the velocity moments to a snapshot taken without them from the same grid state:
 /// TakeSnapshot(grid, false, s) then TakeVelocities(grid, s) equals TakeSnapshot(grid, true, s).
 void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s);
@@ -42,7 +50,9 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame
 class ModeScorer {
  public:
   explicit ModeScorer(const scenario::EvaluationConfig& config);
-  /// Scores one cycle. `snapshot` is TakeSnapshot(grid, ...); `truth_classes` from TruthClasses.
+  /// Scores one cycle. `snapshot` is TakeSnapshot(grid, ...), with its classes if
+  /// ClassifySnapshot ran at this scorer's threshold (else they are computed here, the same
+  /// values); `truth_classes` from TruthClasses.
   /// All positions in the grid frame. Particles inside `ego_box` are not clustered: no other object
   /// can be there, and particles there would chain the vehicles on both sides of the ego into one
   /// cluster.

@@ -122,9 +122,10 @@ class DynamicGrid {
   std::size_t num_weighted_particles() const {
     return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
   }
-  /// Calls f(k, first, last) for every cell holding weighted particles whose value in `layer`
-  /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer) is above
-  /// `threshold`, in the order of weighted_particles(): k = y * cells_x() + x is the logical cell
+  /// Calls f(k, first, last) for every cell holding weighted particles whose value v in `layer`
+  /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer, or a layer
+  /// of classes) passes keep(v), in the order of weighted_particles(): k = y * cells_x() + x is
+  /// the logical cell
   /// and [first, last) its particles in weighted_particles(). Every particle of that range has
   /// CellOf() == (x, y) (the sort and CellOf share their arithmetic); particles off the grid are
   /// in no range. Scans the layer (cells above a threshold are few and clustered) rather than
@@ -132,8 +133,8 @@ class DynamicGrid {
   /// particle. O(cells), no allocation; nothing before the first Update. Valid between an Update
   /// and the next Reframe: throws std::logic_error after a Reframe (the particles are not sorted
   /// into its new cells), std::invalid_argument for a layer of another size.
-  template <typename F>
-  void ForEachWeightedCellAbove(std::span<const float> layer, double threshold, F&& f) const;
+  template <typename T, typename Keep, typename F>
+  void ForEachWeightedCellWhere(std::span<const T> layer, Keep&& keep, F&& f) const;
   const FilterParams& params() const { return params_; }
 
   /// The new-born mass of the last Update summed over the cells (step 7's rho_b, the mass its
@@ -217,27 +218,26 @@ inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
   return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
 }
 
-template <typename F>
-void DynamicGrid::ForEachWeightedCellAbove(std::span<const float> layer, double threshold,
-                                           F&& f) const {
+template <typename T, typename Keep, typename F>
+void DynamicGrid::ForEachWeightedCellWhere(std::span<const T> layer, Keep&& keep, F&& f) const {
   if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
   if (!sorted_current_)
     throw std::logic_error(
-        "DynamicGrid::ForEachWeightedCellAbove: called after Reframe, before Update");
+        "DynamicGrid::ForEachWeightedCellWhere: called after Reframe, before Update");
   if (layer.size() != static_cast<std::size_t>(num_cells_))
-    throw std::invalid_argument("DynamicGrid::ForEachWeightedCellAbove: layer of " +
+    throw std::invalid_argument("DynamicGrid::ForEachWeightedCellWhere: layer of " +
                                 std::to_string(layer.size()) + " cells for " +
                                 std::to_string(num_cells_));
   const auto [sx0, sy0] = StorageOrigin();
   for (std::int64_t sy = 0; sy < ny_; ++sy) {
     const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
-    const float* const row = layer.data() + y * nx_;
+    const T* const row = layer.data() + y * nx_;
     const std::int64_t* const start = cell_start_.data() + sy * nx_;
     // Storage columns [0, sx0) hold logical x = sx + nx - sx0, columns [sx0, nx) x = sx - sx0:
     // two contiguous runs of the logical row, visited in storage (= particle) order.
     const auto run = [&](std::int64_t sx_lo, std::int64_t sx_hi, std::int64_t x_off) {
       for (std::int64_t sx = sx_lo; sx < sx_hi; ++sx) {
-        if (!(row[sx + x_off] > threshold) || start[sx] == start[sx + 1]) continue;
+        if (!keep(row[sx + x_off]) || start[sx] == start[sx + 1]) continue;
         f(static_cast<std::size_t>(y * nx_ + sx + x_off), start[sx], start[sx + 1]);
       }
     };
