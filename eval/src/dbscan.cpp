@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/validation.hpp"
 
 namespace dualgrid::eval {
@@ -218,41 +219,47 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
   // Core points. Independent per point, so parallel; stops counting once both criteria hold.
   core_.assign(n, 0);
   const bool use_weights = !weights.empty() && params_.min_weight > 0.0;
-#pragma omp parallel for schedule(dynamic, 256)
-  for (int i = 0; i < n; ++i) {
-    int count = 0;
-    double weight = 0.0;
-    ForEachNeighbour(points, i, [&](int j) {
-      ++count;
-      if (use_weights) weight += weights[j];
-      const bool done =
-          count >= params_.min_points && (!use_weights || weight >= params_.min_weight);
-      if (done) core_[i] = 1;
-      return !done;
-    });
-  }
+  ParallelFor(
+      n, Schedule::kDynamic,
+      [&](std::int64_t i64) {
+        const int i = static_cast<int>(i64);
+        int count = 0;
+        double weight = 0.0;
+        ForEachNeighbour(points, i, [&](int j) {
+          ++count;
+          if (use_weights) weight += weights[j];
+          const bool done =
+              count >= params_.min_points && (!use_weights || weight >= params_.min_weight);
+          if (done) core_[i] = 1;
+          return !done;
+        });
+      },
+      true, 256);
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);
   const int num_components = CoreComponents(points);
 
   // Border points join their nearest core neighbour's cluster (see class comment for ties).
-#pragma omp parallel for schedule(dynamic, 256)
-  for (int i = 0; i < n; ++i) {
-    if (core_[i]) continue;
-    double best_d2 = std::numeric_limits<double>::infinity();
-    int best = -1;
-    ForEachNeighbour(points, i, [&](int j) {
-      if (!core_[j]) return true;
-      const double d2 = (points[j] - points[i]).squaredNorm();
-      if (d2 < best_d2 || (d2 == best_d2 && LexLess(points[j], points[best]))) {
-        best_d2 = d2;
-        best = j;
-      }
-      return true;
-    });
-    component_[i] = best < 0 ? kNoise : component_[best];
-  }
+  ParallelFor(
+      n, Schedule::kDynamic,
+      [&](std::int64_t i64) {
+        const int i = static_cast<int>(i64);
+        if (core_[i]) return;
+        double best_d2 = std::numeric_limits<double>::infinity();
+        int best = -1;
+        ForEachNeighbour(points, i, [&](int j) {
+          if (!core_[j]) return true;
+          const double d2 = (points[j] - points[i]).squaredNorm();
+          if (d2 < best_d2 || (d2 == best_d2 && LexLess(points[j], points[best]))) {
+            best_d2 = d2;
+            best = j;
+          }
+          return true;
+        });
+        component_[i] = best < 0 ? kNoise : component_[best];
+      },
+      true, 256);
 
   // Final labels numbered by each cluster's lowest input index.
   relabel_.assign(num_components, kNoise);

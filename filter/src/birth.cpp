@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "fast_normal.hpp"
 #include "grid_internal.hpp"
@@ -32,12 +33,14 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
       for (std::int32_t t = 0; t < born_count_[ch]; ++t) f(list[t]);
     }
   };
-#pragma omp parallel for schedule(static) if (blocks > 8)
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    double acc = 0.0;
-    for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
-    tot[b + 1] = acc;
-  }
+  ParallelFor(
+      blocks, Schedule::kStatic,
+      [&](std::int64_t b) {
+        double acc = 0.0;
+        for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
+        tot[b + 1] = acc;
+      },
+      blocks > 8);
   tot[0] = 0.0;
   for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
   const double total = tot[blocks];
@@ -64,18 +67,19 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
   // Running sum at each chunk start (sequential from the block base, as in the loop below), so
   // that the births can be generated chunk by chunk (load balance: births cluster in few blocks).
   double* const chunk_acc = born_chunk_acc_.data();
-#pragma omp parallel for schedule(static) if (blocks > 8)
-  for (std::int64_t b = 0; b < blocks; ++b) {
-    double acc = tot[b];
-    for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
-         ++ch) {
-      chunk_acc[ch] = acc;
-      const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
-      for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
-    }
-  }
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::int64_t ch = 0; ch < n_chunks; ++ch) {
+  ParallelFor(
+      blocks, Schedule::kStatic,
+      [&](std::int64_t b) {
+        double acc = tot[b];
+        for (std::int64_t ch = b * kChunksPerBlock;
+             ch < std::min(n_chunks, (b + 1) * kChunksPerBlock); ++ch) {
+          chunk_acc[ch] = acc;
+          const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+          for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
+        }
+      },
+      blocks > 8);
+  ParallelFor(n_chunks, Schedule::kDynamic, [&](std::int64_t ch) {
     const std::int64_t b = ch / kChunksPerBlock;
     const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;
     const bool has_last = last < (ch + 1) * kCellChunk;  // the block's last cell is in this chunk
@@ -95,7 +99,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
     const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
     for (std::int32_t t = 0; t < born_count_[ch]; ++t) visit(list[t], born_[list[t]]);
     if (has_last && !last_seen) visit(last, 0.0);
-  }
+  });
 }
 
 void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,

@@ -6,6 +6,7 @@
 
 #include <omp.h>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
 #include "fast_normal.hpp"
@@ -80,11 +81,10 @@ void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_
   const std::int64_t n = static_cast<std::int64_t>(p.size());
   constexpr std::int64_t kBlock = detail::kPredictBlock;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < blocks; ++b) {
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
     detail::PredictRange(p, b * kBlock, std::min(n, (b + 1) * kBlock), dt, sp, sv, persistence,
                          seed, step, nullptr);
-  }
+  });
 }
 
 void PredictionNoise::Draw(std::uint64_t seed, std::uint64_t step, std::int64_t n) {
@@ -93,12 +93,11 @@ void PredictionNoise::Draw(std::uint64_t seed, std::uint64_t step, std::int64_t 
   for (auto& c : g_) c.resize(static_cast<std::size_t>(n));
   constexpr std::int64_t kBlock = detail::kPredictBlock;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static) if (!omp_in_parallel())
-  for (std::int64_t b = 0; b < blocks; ++b) {
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
     const std::int64_t b0 = b * kBlock, m = std::min(kBlock, n - b0);
     detail::PredictionNormals(seed, step, b0, m, g_[0].data() + b0, g_[1].data() + b0,
                               g_[2].data() + b0, g_[3].data() + b0);
-  }
+  });
   seed_ = seed;
   step_ = step;
   n_ = n;
@@ -130,26 +129,24 @@ void ExclusiveScanImpl(std::span<const T> in, std::span<T> out) {
   if (base.size() < static_cast<std::size_t>(blocks) + 1) base.resize(blocks + 1);
   T* const tot = base.data();  // the caller's copy, shared with the team below
   // Pass 1: block totals.
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < blocks; ++b) {
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
     const std::int64_t lo = b * kScanBlock, hi = std::min(n, lo + kScanBlock);
     T acc = T(0);
     for (std::int64_t i = lo; i < hi; ++i) acc += in[i];
     tot[b + 1] = acc;
-  }
+  });
   // Serial scan over block totals (few entries).
   tot[0] = T(0);
   for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
-    // Pass 2: local scans from each block's base.
-#pragma omp parallel for schedule(static)
-  for (std::int64_t b = 0; b < blocks; ++b) {
+  // Pass 2: local scans from each block's base.
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
     const std::int64_t lo = b * kScanBlock, hi = std::min(n, lo + kScanBlock);
     T acc = tot[b];
     for (std::int64_t i = lo; i < hi; ++i) {
       out[i] = acc;
       acc += in[i];
     }
-  }
+  });
   out[n] = tot[blocks];
 }
 
@@ -172,11 +169,10 @@ void SystematicRanges(std::span<const double> cumulative, std::size_t n_out, dou
   const std::int64_t n = static_cast<std::int64_t>(n_out);
   // Slot k is drawn from the source whose interval holds (k + u) * total / n_out, i.e. source i
   // owns slots k with cumulative[i] * scale - u <= k < cumulative[i + 1] * scale - u.
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i <= n_src; ++i) {
+  ParallelFor(n_src + 1, Schedule::kStatic, [&](std::int64_t i) {
     const double k = std::ceil(cumulative[i] * scale - u);
     start[i] = std::clamp(static_cast<std::int64_t>(k), std::int64_t{0}, n);
-  }
+  });
   start[0] = 0;
   start[n_src] = n;
 }

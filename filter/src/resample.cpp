@@ -7,6 +7,7 @@
 
 #include <omp.h>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "grid_internal.hpp"
 
@@ -45,18 +46,16 @@ void ConcatScan(const float* a, std::int64_t na, const float* b, std::int64_t n,
   static thread_local std::vector<double> base;
   if (base.size() < static_cast<std::size_t>(blocks) + 1) base.resize(blocks + 1);
   double* const tot = base.data();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < blocks; ++k) {
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t k) {
     const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
     tot[k + 1] = block_sum(lo, hi, 0.0);
-  }
+  });
   tot[0] = 0.0;
   for (std::int64_t k = 0; k < blocks; ++k) tot[k + 1] += tot[k];
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < blocks; ++k) {
+  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t k) {
     const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
     block_scan(lo, hi, tot[k]);
-  }
+  });
   out[n] = tot[blocks];
 }
 
@@ -86,8 +85,7 @@ void DynamicGrid::Resample() {
       Initialize(EgoInput{Pose2{CellCenter({nx_ / 2, ny_ / 2}), 0.0}, Velocity::Zero()});
       return;
     }
-#pragma omp parallel for schedule(static)
-    for (std::int64_t k = 0; k < n; ++k) {
+    ParallelFor(n, Schedule::kStatic, [&](std::int64_t k) {
       const std::int64_t i = k * n_src / n;
       if (i < n_in) {
         particles_.CopyFrom(sorted_, i, k);
@@ -95,7 +93,7 @@ void DynamicGrid::Resample() {
         particles_.CopyFrom(births_, i - n_in, k);
       }
       particles_.weight[k] = particles_.w_position[k] = particles_.w_velocity[k] = 0.0;
-    }
+    });
     return;
   }
   CounterRng rng(seed_, RngPurpose::kFilterResample, step_, 0);
@@ -105,10 +103,8 @@ void DynamicGrid::Resample() {
   const double scale = static_cast<double>(n) / total;
   const double share = total / static_cast<double>(n);
   const double* const cum = scan_out_.data();
-#pragma omp parallel
-  {
-    // Contiguous source ranges per thread; each range boundary is computed once.
-    const std::int64_t nt = omp_get_num_threads(), t = omp_get_thread_num();
+  // Contiguous source ranges per thread; each range boundary is computed once.
+  const auto copy_range = [&](std::int64_t t, std::int64_t nt) {
     const std::int64_t i_lo = n_src * t / nt, i_hi = n_src * (t + 1) / nt;
     std::int64_t k1 = SystematicStart(cum, i_lo, n_src, scale, u, n);
     for (std::int64_t i = i_lo; i < i_hi; ++i) {
@@ -126,7 +122,13 @@ void DynamicGrid::Resample() {
         particles_.w_velocity[k] *= ratio;
       }
     }
+  };
+  if (OneThreadHere()) {
+    copy_range(0, 1);
+    return;
   }
+#pragma omp parallel
+  copy_range(omp_get_thread_num(), omp_get_num_threads());
 }
 
 }  // namespace dualgrid::filter

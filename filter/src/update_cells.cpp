@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include "dualgrid/core/parallel.hpp"
 #include "grid_internal.hpp"
 
 namespace dualgrid::filter {
@@ -145,8 +146,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // same inputs, so results do not depend on the thread count.
   const FastCellInputs fast_in{start, near, view_bits, fm, fm_nr, static_persistence, free_decay};
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
-#pragma omp parallel for schedule(static, 1)
-  for (std::int64_t ch = 0; ch < chunks; ++ch) {
+  ParallelFor(chunks, Schedule::kRoundRobin, [&](std::int64_t ch) {
     const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
     // Fast path (most cells): no particle, no detection (FastCells). The other cells keep their
     // values there and are updated in the loop below, which visits only them.
@@ -398,7 +398,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       if (rho_b != 0.0) born_list[n_born++] = s;
     }
     born_count_[ch] = n_born;
-  }
+  });
 }
 
 }  // namespace dualgrid::filter
