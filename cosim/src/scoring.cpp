@@ -1,12 +1,16 @@
 #include "dualgrid/cosim/scoring.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "dualgrid/cosim/recorded_source.hpp"
 
 namespace dualgrid::cosim {
 
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s) {
+  // First: classes never stand beside masses they were not taken from (even if a step throws).
+  s.classes.clear();
+  s.classes_threshold = std::numeric_limits<double>::quiet_NaN();
   s.cells_x = grid.cells_x();
   s.cells_y = grid.cells_y();
   s.resolution = grid.resolution();
@@ -19,7 +23,6 @@ void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnaps
   s.dynamic.resize(n);
   s.observed.resize(n);
   grid.ExportMasses(s.free, s.static_occ, s.dynamic, s.observed);
-  s.classes.clear();
   s.mean_vx.clear();
   s.mean_vy.clear();
   if (with_velocity) TakeVelocities(grid, s);

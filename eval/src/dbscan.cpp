@@ -234,7 +234,7 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
           return !done;
         });
       },
-      true, 256);
+      /*worth=*/true, /*chunk=*/256);
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);
@@ -259,7 +259,7 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
         });
         component_[i] = best < 0 ? kNoise : component_[best];
       },
-      true, 256);
+      /*worth=*/true, /*chunk=*/256);
 
   // Final labels numbered by each cluster's lowest input index.
   relabel_.assign(num_components, kNoise);

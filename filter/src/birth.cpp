@@ -40,7 +40,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
         for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
         tot[b + 1] = acc;
       },
-      blocks > 8);
+      /*worth=*/blocks > 8);
   tot[0] = 0.0;
   for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
   const double total = tot[blocks];
@@ -78,7 +78,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
           for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
         }
       },
-      blocks > 8);
+      /*worth=*/blocks > 8);
   ParallelFor(n_chunks, Schedule::kDynamic, [&](std::int64_t ch) {
     const std::int64_t b = ch / kChunksPerBlock;
     const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;

@@ -93,11 +93,16 @@ void PredictionNoise::Draw(std::uint64_t seed, std::uint64_t step, std::int64_t 
   for (auto& c : g_) c.resize(static_cast<std::size_t>(n));
   constexpr std::int64_t kBlock = detail::kPredictBlock;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
-  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
-    const std::int64_t b0 = b * kBlock, m = std::min(kBlock, n - b0);
-    detail::PredictionNormals(seed, step, b0, m, g_[0].data() + b0, g_[1].data() + b0,
-                              g_[2].data() + b0, g_[3].data() + b0);
-  });
+  // Inside a parallel region (the co-simulation draws the next step's noise on one mode thread
+  // while the others filter) on that thread alone, whatever nesting would allow.
+  ParallelFor(
+      blocks, Schedule::kStatic,
+      [&](std::int64_t b) {
+        const std::int64_t b0 = b * kBlock, m = std::min(kBlock, n - b0);
+        detail::PredictionNormals(seed, step, b0, m, g_[0].data() + b0, g_[1].data() + b0,
+                                  g_[2].data() + b0, g_[3].data() + b0);
+      },
+      /*worth=*/!omp_in_parallel());
   seed_ = seed;
   step_ = step;
   n_ = n;

@@ -101,8 +101,7 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
     for (std::int64_t b = 0; b < nblocks; ++b) block_offsets(b);
     for (int k = 0; k < chunks; ++k) scatter(k);
   } else {
-    // All passes in one parallel region (the implicit barriers of the worksharing loops order
-    // them).
+    // One parallel region; the worksharing loops' implicit barriers order the passes.
 #pragma omp parallel
     {
 #pragma omp for schedule(static)

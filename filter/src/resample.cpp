@@ -125,10 +125,10 @@ void DynamicGrid::Resample() {
   };
   if (OneThreadHere()) {
     copy_range(0, 1);
-    return;
-  }
+  } else {
 #pragma omp parallel
-  copy_range(omp_get_thread_num(), omp_get_num_threads());
+    copy_range(omp_get_thread_num(), omp_get_num_threads());
+  }
 }
 
 }  // namespace dualgrid::filter

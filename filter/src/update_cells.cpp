@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include "dualgrid/core/parallel.hpp"
 #include "grid_internal.hpp"
 
 namespace dualgrid::filter {
@@ -143,10 +142,14 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // cycle (its cells stay in that core's cache; dynamic scheduling moved them between cores, which
   // cost more than it balanced: docs/performance.md, round 3), and neighbouring blocks, where the
   // particles cluster, go to different threads. Every value is computed by one thread from the
-  // same inputs, so results do not depend on the thread count.
+  // same inputs, so results do not depend on the thread count. A plain pragma, not ParallelFor
+  // (dualgrid/core/parallel.hpp): the loop body as a lambda compiled to 2 % more instructions
+  // (callgrind, bench_filter paper size), more than the one team per cycle costs inside the
+  // co-simulation's per-mode threads (docs/performance.md, round 5).
   const FastCellInputs fast_in{start, near, view_bits, fm, fm_nr, static_persistence, free_decay};
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
-  ParallelFor(chunks, Schedule::kRoundRobin, [&](std::int64_t ch) {
+#pragma omp parallel for schedule(static, 1)
+  for (std::int64_t ch = 0; ch < chunks; ++ch) {
     const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
     // Fast path (most cells): no particle, no detection (FastCells). The other cells keep their
     // values there and are updated in the loop below, which visits only them.
@@ -398,7 +401,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       if (rho_b != 0.0) born_list[n_born++] = s;
     }
     born_count_[ch] = n_born;
-  });
+  }
 }
 
 }  // namespace dualgrid::filter

@@ -1,4 +1,5 @@
-// ModeScorer with and without the classes of ClassifySnapshot: the same scores, bit for bit.
+// ModeScorer with and without the classes of ClassifySnapshot: the same scores, bit for bit, and
+// the same dynamic cells as the mass threshold itself picks.
 #include <catch2/catch.hpp>
 
 #include "../filter/synthetic.hpp"
@@ -6,6 +7,22 @@
 
 using namespace dualgrid;
 using namespace dualgrid::filter::testing;
+
+namespace {
+
+void CheckSameClusters(const std::vector<eval::Cluster>& a, const std::vector<eval::Cluster>& b) {
+  REQUIRE(a.size() == b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    CHECK(a[k].position == b[k].position);
+    CHECK(a[k].velocity == b[k].velocity);
+    CHECK(a[k].weight == b[k].weight);
+    CHECK(a[k].size == b[k].size);
+    CHECK(a[k].min == b[k].min);
+    CHECK(a[k].max == b[k].max);
+  }
+}
+
+}  // namespace
 
 TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them or stale ones",
           "[cosim][scoring]") {
@@ -16,10 +33,14 @@ TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them 
   fp.num_birth = 400;
   filter::DynamicGrid grid(fp, 11);
   const scenario::EvaluationConfig config;
+  const double stale_threshold = config.dynamic_threshold + 0.2;
   cosim::ModeScorer with(config), without(config), stale(config);
+  // The reference: the particles of cells whose dynamic mass is above the threshold, picked on
+  // the float layer itself, clustered as the scorer does.
+  eval::ParticleClusterer reference(config.dbscan, config.min_cluster_mass);
   cosim::GridSnapshot s;
   Pose2 ego;
-  int dynamic_frames = 0;
+  int dynamic_frames = 0, stale_differs = 0;
   for (int step = 0; step < 40; ++step) {
     const double t = 0.05 * step;
     ego.position = {8.0 * t, 0.0};
@@ -39,27 +60,45 @@ TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them 
     cosim::TakeSnapshot(grid, false, s);
     REQUIRE(s.classes.empty());
     without.AddFrame(t, grid, s, objects, truth, ego_box);
-    cosim::ClassifySnapshot(config.dynamic_threshold + 0.2, s);  // another threshold: not used
+    cosim::ClassifySnapshot(stale_threshold, s);  // another threshold: the scorer must not use it
+    const std::vector<std::uint8_t> stale_classes = s.classes;
     stale.AddFrame(t, grid, s, objects, truth, ego_box);
     cosim::ClassifySnapshot(config.dynamic_threshold, s);
     with.AddFrame(t, grid, s, objects, truth, ego_box);
+    stale_differs += stale_classes != s.classes;
+
+    std::vector<eval::WeightedParticle> picked;
+    const filter::ParticleSet& p = grid.weighted_particles();
+    const BoxTest inside_ego(ego_box);
+    grid.ForEachWeightedCellWhere(
+        std::span<const float>(s.dynamic), [&](float m) { return m > config.dynamic_threshold; },
+        [&](std::size_t, std::int64_t first, std::int64_t last) {
+          for (std::int64_t i = first; i < last; ++i) {
+            const Position pos(p.x[i], p.y[i]);
+            if (p.weight[i] > 0.0f && !inside_ego.Contains(pos))
+              picked.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+          }
+        });
 
     INFO("step " << step);
-    REQUIRE(with.clusters().size() == without.clusters().size());
-    REQUIRE(stale.clusters().size() == without.clusters().size());
-    for (std::size_t k = 0; k < with.clusters().size(); ++k) {
-      CHECK(with.clusters()[k].position == without.clusters()[k].position);
-      CHECK(with.clusters()[k].velocity == without.clusters()[k].velocity);
-      CHECK(stale.clusters()[k].weight == without.clusters()[k].weight);
-    }
+    CheckSameClusters(with.clusters(), reference.Run(picked));
+    CheckSameClusters(with.clusters(), without.clusters());
+    CheckSameClusters(stale.clusters(), without.clusters());
     dynamic_frames += with.clusters().empty() ? 0 : 1;
   }
   CHECK(dynamic_frames > 10);  // the comparison saw clusters
+  CHECK(stale_differs > 0);    // the stale classes would have changed the scores
   const auto a = with.Result(), b = without.Result(), c = stale.Result();
   REQUIRE(a.cells);
+  REQUIRE(b.cells);
+  REQUIRE(c.cells);
   CHECK(a.cells->confusion == b.cells->confusion);
   CHECK(c.cells->confusion == b.cells->confusion);
-  CHECK(a.matches == b.matches);
-  CHECK(a.position_error == b.position_error);
-  CHECK(a.velocity_error == b.velocity_error);
+  for (const auto* m : {&a, &c}) {
+    CHECK(m->matches == b.matches);
+    CHECK(m->position_error == b.position_error);
+    CHECK(m->velocity_error == b.velocity_error);
+    CHECK(m->tracked_fraction == b.tracked_fraction);
+    CHECK(m->clusters_per_scan == b.clusters_per_scan);
+  }
 }

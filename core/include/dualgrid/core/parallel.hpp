@@ -4,20 +4,25 @@
 // co-simulation's per-mode threads (nesting off) each such region cost about 4 us and two futex
 // calls on this project's 2-core machine, about 1.2 us at the top level with one thread
 // (docs/performance.md, "Issue 25, round 5"); the filter opens about ten per cycle. ParallelFor
-// runs the loop plainly then. For targets that link OpenMP (filter, eval); elsewhere the pragmas
-// are ignored and every loop is plain.
+// runs the loop plainly then. Compiled without OpenMP (_OPENMP undefined) every loop is plain.
 #pragma once
 
-#include <omp.h>
-
 #include <cstdint>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace dualgrid {
 
 /// True when a parallel region opened here would get one thread: one thread is allowed, or the
 /// caller is inside a region and no further level may be active (omp_get_max_active_levels).
 inline bool OneThreadHere() {
+#ifdef _OPENMP
   return omp_get_max_threads() == 1 || omp_get_active_level() >= omp_get_max_active_levels();
+#else
+  return true;
+#endif
 }
 
 /// How ParallelFor deals out iterations: kStatic = schedule(static) (contiguous ranges),

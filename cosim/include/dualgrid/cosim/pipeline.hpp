@@ -76,8 +76,8 @@ class Pipeline {
   /// reached, or the ego left the network). Needs Start().
   bool Advance();
   /// Updates filter `i` with the inputs of the last Advance(). Independent per filter, so callers
-  /// may run the filters concurrently (each with a one-thread team inside;
-  /// docs/performance.md).
+  /// may run the filters concurrently (a filter's loops then run on its thread alone, without an
+  /// OpenMP team: dualgrid/core/parallel.hpp, docs/performance.md).
   void UpdateFilter(std::size_t i);
   /// Draws the filters' prediction normals (filter::PredictionNoise) once for every mode (they
   /// share seed and step): `ahead` = false for the cycle UpdateFilter runs next (call it before

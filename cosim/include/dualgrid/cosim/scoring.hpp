@@ -2,6 +2,7 @@
 // scores the clusters against the ground truth and classifies cells. Everything in the grid frame.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -25,17 +26,19 @@ struct GridSnapshot {
   std::vector<std::uint8_t> observed;
   /// Mean velocity over ground [m/s] per cell; empty unless taken `with_velocity`.
   std::vector<float> mean_vx, mean_vy;
-  /// eval::CellClass per cell at `classes_threshold` (ClassifySnapshot); empty after TakeSnapshot.
+  /// eval::CellClass per cell at `classes_threshold` (ClassifySnapshot); empty, with a NaN
+  /// threshold, after TakeSnapshot. Code that writes the masses otherwise must clear them too.
   std::vector<std::uint8_t> classes;
-  double classes_threshold = 0.0;
+  double classes_threshold = std::numeric_limits<double>::quiet_NaN();
 };
 /// Fills `s` (reusing its storage). The velocity moments cost a pass over every particle and are
 /// needed only for figures and particle files, so scoring takes it without them.
 void TakeSnapshot(const filter::DynamicGrid& grid, bool with_velocity, GridSnapshot& s);
 /// Fills s.classes with eval::ClassifyCells of its masses at `threshold`. The scorer then reads
-/// these bytes and `observed` (2 bytes per cell) instead of the three mass layers (13): called on
-/// the thread that took the snapshot, it keeps the scorer on another core from pulling the masses
-/// over, which the filter's next ExportMasses would pull back (docs/performance.md, round 5).
+/// these bytes and `observed` (2 bytes per cell) instead of the masses and `observed` (13): called
+/// on the thread that took the snapshot, it keeps the scorer on another core from pulling the
+/// masses over, which the filter's next ExportMasses would pull back (docs/performance.md, round
+/// 5).
 void ClassifySnapshot(double threshold, GridSnapshot& s);
 /// Adds the velocity moments to a snapshot taken without them from the same grid state:
 /// TakeSnapshot(grid, false, s) then TakeVelocities(grid, s) equals TakeSnapshot(grid, true, s).

@@ -31,8 +31,9 @@ inline CellClass ClassifyCell(double p_free, double p_static, double p_dynamic,
 }
 
 /// ClassifyCell for every cell: out[i] = ClassifyCell(free[i], static_occ[i], dynamic[i],
-/// threshold) (as a byte), without branches so that it vectorises (the scorer classifies every
-/// cell of every mode in each step). Throws std::invalid_argument when the sizes differ.
+/// threshold) (as a byte), without branches so that it vectorises (every cell of every mode is
+/// classified in each step, cosim::ClassifySnapshot). Throws std::invalid_argument when the sizes
+/// differ.
 void ClassifyCells(std::span<const float> free, std::span<const float> static_occ,
                    std::span<const float> dynamic, double threshold, std::span<std::uint8_t> out);
 

@@ -124,15 +124,15 @@ class DynamicGrid {
   }
   /// Calls f(k, first, last) for every cell holding weighted particles whose value v in `layer`
   /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer, or a layer
-  /// of classes) passes keep(v), in the order of weighted_particles(): k = y * cells_x() + x is
-  /// the logical cell
-  /// and [first, last) its particles in weighted_particles(). Every particle of that range has
-  /// CellOf() == (x, y) (the sort and CellOf share their arithmetic); particles off the grid are
-  /// in no range. Scans the layer (cells above a threshold are few and clustered) rather than
-  /// every cell's range: the scorer's way to the particles of dynamic cells without locating each
-  /// particle. O(cells), no allocation; nothing before the first Update. Valid between an Update
-  /// and the next Reframe: throws std::logic_error after a Reframe (the particles are not sorted
-  /// into its new cells), std::invalid_argument for a layer of another size.
+  /// of eval::CellClass bytes) passes keep(v) (a callable bool(T)), in the order of
+  /// weighted_particles(): k = y * cells_x() + x is the logical cell and [first, last) its
+  /// particles in weighted_particles(). Every particle of that range has CellOf() == (x, y) (the
+  /// sort and CellOf share their arithmetic); particles off the grid are in no range. Scans the
+  /// layer and reads a cell's range only where keep(v) holds: cheap when the kept cells are few
+  /// and clustered (the scorer's dynamic cells), without locating each particle. O(cells), no
+  /// allocation; nothing before the first Update. Valid between an Update and the next Reframe:
+  /// throws std::logic_error after a Reframe (the particles are not sorted into its new cells),
+  /// std::invalid_argument for a layer of another size.
   template <typename T, typename Keep, typename F>
   void ForEachWeightedCellWhere(std::span<const T> layer, Keep&& keep, F&& f) const;
   const FilterParams& params() const { return params_; }
