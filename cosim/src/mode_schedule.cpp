@@ -1,18 +1,76 @@
 #include "dualgrid/cosim/mode_schedule.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
 namespace dualgrid::cosim {
 
-ModeSchedule::ModeSchedule(int modes, int threads) {
+namespace {
+
+// The placement of `modes` on `threads` (thread t < modes % threads taking one more) whose largest
+// thread cost is smallest; the first found in the search order wins among equals. modes <= ~9,
+// so the search (at most 9! / (3! 2! 2! 2!) = 7,560 leaves for 4 threads) is cheap, and it runs
+// only when the co-simulation re-plans.
+std::vector<int> BestPlacement(int modes, int threads, std::span<const double> costs) {
+  std::vector<int> capacity(threads, modes / threads);
+  for (int t = 0; t < modes % threads; ++t) ++capacity[t];
+  std::vector<double> load(threads, 0.0);
+  std::vector<int> place(modes), best;
+  double best_max = 0.0;
+  const std::function<void(int, double)> search = [&](int m, double max_so_far) {
+    if (!best.empty() && max_so_far >= best_max) return;  // cannot be strictly better
+    if (m == modes) {
+      best = place;
+      best_max = max_so_far;
+      return;
+    }
+    for (int t = 0; t < threads; ++t) {
+      if (capacity[t] == 0) continue;
+      --capacity[t];
+      load[t] += costs[m];
+      place[m] = t;
+      search(m + 1, std::max(max_so_far, load[t]));
+      load[t] -= costs[m];
+      ++capacity[t];
+    }
+  };
+  // Round robin first: anything else must beat it strictly.
+  for (int m = 0; m < modes; ++m) {
+    place[m] = m % threads;
+    load[m % threads] += costs[m];
+  }
+  best = place;
+  best_max = *std::max_element(load.begin(), load.end());
+  std::fill(load.begin(), load.end(), 0.0);
+  search(0, 0.0);
+  return best;
+}
+
+}  // namespace
+
+ModeSchedule::ModeSchedule(int modes, int threads, std::span<const double> costs) {
   if (modes < 1 || threads < 1 || threads > modes)
     throw std::invalid_argument("ModeSchedule: need 1 <= threads <= modes, got " +
                                 std::to_string(threads) + " threads for " + std::to_string(modes) +
                                 " modes");
+  if (!costs.empty() && costs.size() != static_cast<std::size_t>(modes))
+    throw std::invalid_argument("ModeSchedule: " + std::to_string(costs.size()) + " costs for " +
+                                std::to_string(modes) + " modes");
+  for (double c : costs)
+    if (!(std::isfinite(c) && c >= 0.0))
+      throw std::invalid_argument("ModeSchedule: a cost must be finite and >= 0, got " +
+                                  std::to_string(c));
   filters_.resize(threads);
   scores_.resize(threads);
-  for (int m = 0; m < modes; ++m) filters_[m % threads].push_back(m);
+  if (costs.empty()) {
+    for (int m = 0; m < modes; ++m) filters_[m % threads].push_back(m);
+  } else {
+    const std::vector<int> place = BestPlacement(modes, threads, costs);
+    for (int m = 0; m < modes; ++m) filters_[place[m]].push_back(m);  // increasing m
+  }
   // Threads t < extra filter one mode more than the others; thread threads-1-t, if it is one with
   // fewer, scores that thread's first mode (ready earliest) while t filters its next.
   const int extra = modes % threads;
@@ -24,6 +82,16 @@ ModeSchedule::ModeSchedule(int modes, int threads) {
       scores_[handed_over ? helper : t].push_back(own[k]);
     }
   }
+}
+
+double ModeSchedule::MaxLoad(std::span<const double> costs) const {
+  double max_load = 0.0;
+  for (const auto& own : filters_) {
+    double load = 0.0;
+    for (int m : own) load += costs[static_cast<std::size_t>(m)];
+    max_load = std::max(max_load, load);
+  }
+  return max_load;
 }
 
 }  // namespace dualgrid::cosim

@@ -1,6 +1,8 @@
 // ModeSchedule: which thread filters and scores which mode (cosim/include/.../mode_schedule.hpp).
 #include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <vector>
 
@@ -52,4 +54,68 @@ TEST_CASE("ModeSchedule: thread counts outside [1, modes] are refused", "[cosim]
   CHECK_THROWS_AS(ModeSchedule(3, 0), std::invalid_argument);
   CHECK_THROWS_AS(ModeSchedule(3, 4), std::invalid_argument);
   CHECK_THROWS_AS(ModeSchedule(0, 1), std::invalid_argument);
+}
+
+namespace {
+
+// The smallest largest thread load over every placement with ModeSchedule's filter counts
+// (threads t < modes % threads take one more): the reference, by enumerating placements.
+double BestMaxLoad(int modes, int threads, const std::vector<double>& costs) {
+  std::vector<int> place(modes, 0);
+  double best = 1e300;
+  while (true) {
+    std::vector<int> count(threads, 0);
+    std::vector<double> load(threads, 0.0);
+    for (int m = 0; m < modes; ++m) {
+      ++count[place[m]];
+      load[place[m]] += costs[m];
+    }
+    bool valid = true;
+    for (int t = 0; t < threads; ++t)
+      valid = valid && count[t] == modes / threads + (t < modes % threads ? 1 : 0);
+    if (valid) best = std::min(best, *std::max_element(load.begin(), load.end()));
+    int m = 0;  // next placement (odometer)
+    while (m < modes && ++place[m] == threads) place[m++] = 0;
+    if (m == modes) return best;
+  }
+}
+
+}  // namespace
+
+TEST_CASE("ModeSchedule with costs: the smallest largest load, round robin unless strictly better",
+          "[cosim]") {
+  std::uint64_t state = 12345;  // a small LCG: costs in [0.5, 1.5) s
+  const auto cost = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return 0.5 + static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  for (int modes = 1; modes <= 7; ++modes) {
+    for (int threads = 1; threads <= modes; ++threads) {
+      for (int draw = 0; draw < 5; ++draw) {
+        std::vector<double> costs(modes);
+        for (double& c : costs) c = cost();
+        const ModeSchedule s(modes, threads, costs);
+        INFO(modes << " modes, " << threads << " threads, draw " << draw);
+        CHECK(s.MaxLoad(costs) == BestMaxLoad(modes, threads, costs));
+        for (int t = 0; t < threads; ++t) {
+          CHECK(static_cast<int>(s.filters(t).size()) ==
+                modes / threads + (t < modes % threads ? 1 : 0));
+          CHECK(std::is_sorted(s.filters(t).begin(), s.filters(t).end()));
+        }
+      }
+      // Equal costs: nothing beats round robin strictly, so it stays.
+      CHECK(ModeSchedule(modes, threads, std::vector<double>(modes, 1.0)) ==
+            ModeSchedule(modes, threads));
+    }
+  }
+  // The recorded three-mode loop's measured costs (position, velocity, dual; docs/performance.md
+  // round 5): the dual filter alone on one thread, the other two together.
+  const ModeSchedule s(3, 2, std::vector<double>{0.94, 0.89, 1.02});
+  CHECK(s.filters(0) == std::vector<int>{0, 1});
+  CHECK(s.filters(1) == std::vector<int>{2});
+  CHECK(s.scores(1) == std::vector<int>{0, 2});  // the first of thread 0's two, handed over
+  CHECK(s.truth_thread() == 1);
+  CHECK_THROWS_AS(ModeSchedule(3, 2, std::vector<double>{1.0, 1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(ModeSchedule(3, 2, std::vector<double>{1.0, -1.0, 1.0}), std::invalid_argument);
+  CHECK_THROWS_AS(ModeSchedule(3, 2, std::vector<double>{1.0, NAN, 1.0}), std::invalid_argument);
 }

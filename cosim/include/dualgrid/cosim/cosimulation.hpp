@@ -11,9 +11,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "dualgrid/cosim/mode_schedule.hpp"
 #include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/cosim/scoring.hpp"
 #include "dualgrid/eval/metrics.hpp"
@@ -25,7 +27,8 @@ struct CoSimOptions {
   std::vector<filter::WeightMode> modes = {
       filter::WeightMode::kPosition, filter::WeightMode::kVelocity, filter::WeightMode::kDual};
   /// OpenMP threads; 0: the OpenMP default. The modes run concurrently, each on a fixed thread
-  /// (ModeSchedule); threads beyond one per mode go to each filter's own loops. Results do not
+  /// (ModeSchedule, planned from the filters' measured times after the first steps and re-planned
+  /// now and then); threads beyond one per mode go to each filter's own loops. Results do not
   /// depend on it.
   int threads = 0;
 };
@@ -98,6 +101,9 @@ class CoSimulation {
 
  private:
   void FilterAndScore(bool with_velocities);
+  // The schedule of this step for `team` threads: round robin at first, then re-planned from the
+  // filters' measured times (PlanSchedule).
+  const ModeSchedule& ScheduleFor(int modes, int team);
 
   Pipeline pipeline_;
   std::vector<std::string> mode_names_;
@@ -109,6 +115,10 @@ class CoSimulation {
   std::vector<StepObserver*> observers_;
   int threads_ = 0;
   int steps_ = 0;
+  std::optional<ModeSchedule> schedule_;
+  int schedule_team_ = 0;
+  std::vector<double> filter_seconds_;  // per mode, since the last plan [s]
+  int timed_steps_ = 0, next_plan_ = 0;
   std::size_t total_detections_ = 0;
 };
 
