@@ -177,7 +177,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
 // The first plan after a few steps (the first cycles fill the grid and are not typical), then a
 // re-plan every few hundred steps, adopted only when it shortens the most loaded thread by more
 // than 3 % (moving a filter costs its cache: round 3). Only the schedule changes, never a result.
-constexpr int kFirstPlan = 16, kReplanEvery = 256;
+constexpr int kFirstPlan = 16, kReplanEvery = 64;
 constexpr double kReplanGain = 0.97;
 
 const ModeSchedule& CoSimulation::ScheduleFor(int modes, int team) {
