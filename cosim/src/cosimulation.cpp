@@ -174,27 +174,39 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     if (e) std::rethrow_exception(e);
 }
 
-// The first plan after a few steps (the first cycles fill the grid and are not typical), then a
-// re-plan every few hundred steps, adopted only when it shortens the most loaded thread by more
-// than 3 % (moving a filter costs its cache: round 3). Only the schedule changes, never a result.
-constexpr int kFirstPlan = 16, kReplanEvery = 64;
+// The first kWarmUp steps are not timed (the first cycles fill the grid and are not typical);
+// the first plan comes kWindow steps later, and then one every `replan_every_` steps, adopted only
+// when it shortens the most loaded thread by more than 3 % (moving a filter costs its cache:
+// round 3). The period doubles after each adopted change, so that costs which depend on the
+// placement itself cannot make the schedule flip back and forth often. Only the schedule
+// changes, never a result.
+constexpr int kWarmUp = 16, kWindow = 64;
 constexpr double kReplanGain = 0.97;
 
 const ModeSchedule& CoSimulation::ScheduleFor(int modes, int team) {
+  const auto restart_timing = [&](int period) {
+    next_plan_ = steps_ + period;
+    filter_seconds_.assign(modes, 0.0);
+    timed_steps_ = 0;
+  };
   if (!schedule_ || schedule_team_ != team) {
     schedule_.emplace(modes, team);
     schedule_team_ = team;
-    next_plan_ = steps_ + kFirstPlan;
-    filter_seconds_.assign(modes, 0.0);
-    timed_steps_ = 0;
+    replan_every_ = kWindow;
+    warming_up_ = true;
+    restart_timing(kWarmUp);
+  } else if (steps_ >= next_plan_ && warming_up_) {
+    warming_up_ = false;
+    restart_timing(kWindow);  // the warm-up's times are dropped
   } else if (steps_ >= next_plan_ && timed_steps_ > 0) {
     std::vector<double> costs(filter_seconds_);
     for (double& c : costs) c /= timed_steps_;
     const ModeSchedule plan(modes, team, costs);
-    if (plan.MaxLoad(costs) < kReplanGain * schedule_->MaxLoad(costs)) schedule_ = plan;
-    next_plan_ = steps_ + kReplanEvery;
-    filter_seconds_.assign(modes, 0.0);
-    timed_steps_ = 0;
+    if (plan.MaxLoad(costs) < kReplanGain * schedule_->MaxLoad(costs)) {
+      schedule_ = plan;
+      replan_every_ *= 2;
+    }
+    restart_timing(replan_every_);
   }
   return *schedule_;
 }

@@ -10,10 +10,12 @@ namespace dualgrid::cosim {
 
 namespace {
 
+constexpr int kMaxSearchedModes = 8;
+
 // The placement of `modes` on `threads` (thread t < modes % threads taking one more) whose largest
-// thread cost is smallest; the first found in the search order wins among equals. modes <= ~9,
-// so the search (at most 9! / (3! 2! 2! 2!) = 7,560 leaves for 4 threads) is cheap, and it runs
-// only when the co-simulation re-plans.
+// thread cost is smallest; round robin unless something is strictly better, then the first found
+// in the search order. Exhaustive: at most kMaxSearchedModes! leaves (40,320), and it runs only
+// when the co-simulation re-plans; more modes keep round robin.
 std::vector<int> BestPlacement(int modes, int threads, std::span<const double> costs) {
   std::vector<int> capacity(threads, modes / threads);
   for (int t = 0; t < modes % threads; ++t) ++capacity[t];
@@ -29,11 +31,12 @@ std::vector<int> BestPlacement(int modes, int threads, std::span<const double> c
     }
     for (int t = 0; t < threads; ++t) {
       if (capacity[t] == 0) continue;
+      const double before = load[t];  // restored exactly: (x + c) - c may differ from x
       --capacity[t];
-      load[t] += costs[m];
+      load[t] = before + costs[m];
       place[m] = t;
       search(m + 1, std::max(max_so_far, load[t]));
-      load[t] -= costs[m];
+      load[t] = before;
       ++capacity[t];
     }
   };
@@ -44,6 +47,7 @@ std::vector<int> BestPlacement(int modes, int threads, std::span<const double> c
   }
   best = place;
   best_max = *std::max_element(load.begin(), load.end());
+  if (modes > kMaxSearchedModes) return best;
   std::fill(load.begin(), load.end(), 0.0);
   search(0, 0.0);
   return best;

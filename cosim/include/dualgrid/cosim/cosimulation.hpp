@@ -102,7 +102,7 @@ class CoSimulation {
  private:
   void FilterAndScore(bool with_velocities);
   // The schedule of this step for `team` threads: round robin at first, then re-planned from the
-  // filters' measured times (PlanSchedule).
+  // filters' measured times (cosimulation.cpp, before ScheduleFor's definition).
   const ModeSchedule& ScheduleFor(int modes, int team);
 
   Pipeline pipeline_;
@@ -118,7 +118,8 @@ class CoSimulation {
   std::optional<ModeSchedule> schedule_;
   int schedule_team_ = 0;
   std::vector<double> filter_seconds_;  // per mode, since the last plan [s]
-  int timed_steps_ = 0, next_plan_ = 0;
+  int timed_steps_ = 0, next_plan_ = 0, replan_every_ = 0;
+  bool warming_up_ = true;
   std::size_t total_detections_ = 0;
 };
 

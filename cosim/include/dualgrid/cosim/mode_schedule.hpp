@@ -15,8 +15,10 @@ class ModeSchedule {
   /// `modes` >= 1 filters on `threads` in [1, modes] threads. Threads t < modes % threads filter
   /// one mode more than the others. Without `costs`, filter m runs on thread m % threads. With
   /// `costs` (one per mode, finite and >= 0: e.g. measured seconds per cycle), the modes are
-  /// placed so that the largest sum of costs on a thread is smallest (exhaustive search; ties and
-  /// anything not strictly better than m % threads keep m % threads). A thread filters its modes
+  /// placed so that the largest sum of costs on a thread is smallest (exhaustive search, up to 8
+  /// modes; more keep m % threads; ties and anything not strictly better than m % threads keep
+  /// m % threads). Only the filters' costs count: the truth, the noise and the scoring handed to
+  /// a thread with fewer filters (below) are not in the sums. A thread filters its modes
   /// in increasing m. Each mode is scored on the thread that filtered it, except that the first
   /// filter of every thread with one more filter than others is scored by a thread with fewer (3
   /// modes on 2 threads, no costs: thread 0 filters 0 and 2 and scores 2; thread 1 filters 1 and
