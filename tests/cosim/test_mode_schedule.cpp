@@ -10,35 +10,45 @@
 
 using dualgrid::cosim::ModeSchedule;
 
+namespace {
+
+// What every schedule guarantees: each mode filtered and scored once; filters in increasing mode
+// order; a mode scored by its own thread or handed to one that filters fewer; the truth computed
+// by a thread with the fewest filters.
+void CheckInvariants(const ModeSchedule& s, int modes, int threads) {
+  std::vector<int> filtered(modes, 0), scored(modes, 0), filter_thread(modes, -1);
+  std::size_t fewest = modes;
+  for (int t = 0; t < threads; ++t) {
+    fewest = std::min(fewest, s.filters(t).size());
+    for (int m : s.filters(t)) {
+      ++filtered[m];
+      filter_thread[m] = t;
+    }
+    CHECK(std::is_sorted(s.filters(t).begin(), s.filters(t).end()));
+  }
+  for (int t = 0; t < threads; ++t) {
+    for (int m : s.scores(t)) {
+      ++scored[m];
+      const int own = filter_thread[m];
+      CHECK((own == t || s.filters(t).size() < s.filters(own).size()));
+    }
+  }
+  CHECK(std::count(filtered.begin(), filtered.end(), 1) == modes);
+  CHECK(std::count(scored.begin(), scored.end(), 1) == modes);
+  REQUIRE(!s.filters(s.truth_thread()).empty());
+  CHECK(s.filters(s.truth_thread()).size() == fewest);
+}
+
+}  // namespace
+
 TEST_CASE("ModeSchedule: every mode filtered and scored once, filters fixed per thread",
           "[cosim]") {
   for (int modes = 1; modes <= 9; ++modes) {
     for (int threads = 1; threads <= modes; ++threads) {
       const ModeSchedule s(modes, threads);
-      std::vector<int> filtered(modes, 0), scored(modes, 0), filter_thread(modes, -1);
-      std::size_t fewest = modes;
-      for (int t = 0; t < threads; ++t) {
-        fewest = std::min(fewest, s.filters(t).size());
-        for (int m : s.filters(t)) {
-          ++filtered[m];
-          filter_thread[m] = t;
-          CHECK(m % threads == t);  // the same thread every step, whatever the step
-        }
-        CHECK(std::is_sorted(s.filters(t).begin(), s.filters(t).end()));
-      }
-      for (int t = 0; t < threads; ++t) {
-        for (int m : s.scores(t)) {
-          ++scored[m];
-          // Scored by its own thread, or handed to a thread that filters fewer modes.
-          const int own = filter_thread[m];
-          CHECK((own == t || s.filters(t).size() < s.filters(own).size()));
-        }
-      }
-      CHECK(std::count(filtered.begin(), filtered.end(), 1) == modes);
-      CHECK(std::count(scored.begin(), scored.end(), 1) == modes);
-      // The truth is computed after the first filter of a thread with the fewest filters.
-      REQUIRE(!s.filters(s.truth_thread()).empty());
-      CHECK(s.filters(s.truth_thread()).size() == fewest);
+      CheckInvariants(s, modes, threads);
+      for (int t = 0; t < threads; ++t)
+        for (int m : s.filters(t)) CHECK(m % threads == t);  // round robin without costs
     }
   }
   // Three modes on two threads (the default run on two cores): thread 1 scores mode 0 while
@@ -97,27 +107,10 @@ TEST_CASE("ModeSchedule with costs: the smallest largest load, round robin unles
         const ModeSchedule s(modes, threads, costs);
         INFO(modes << " modes, " << threads << " threads, draw " << draw);
         CHECK(s.MaxLoad(costs) == BestMaxLoad(modes, threads, costs));
-        // The invariants of the schedule without costs hold as well.
-        std::vector<int> scored(modes, 0), filter_thread(modes, -1);
-        std::size_t fewest = modes;
-        for (int t = 0; t < threads; ++t) {
-          fewest = std::min(fewest, s.filters(t).size());
-          for (int m : s.filters(t)) filter_thread[m] = t;
-        }
-        for (int t = 0; t < threads; ++t) {
-          for (int m : s.scores(t)) {
-            ++scored[m];
-            const int own = filter_thread[m];
-            CHECK((own == t || s.filters(t).size() < s.filters(own).size()));
-          }
-        }
-        CHECK(std::count(scored.begin(), scored.end(), 1) == modes);
-        CHECK(s.filters(s.truth_thread()).size() == fewest);
-        for (int t = 0; t < threads; ++t) {
+        CheckInvariants(s, modes, threads);
+        for (int t = 0; t < threads; ++t)
           CHECK(static_cast<int>(s.filters(t).size()) ==
                 modes / threads + (t < modes % threads ? 1 : 0));
-          CHECK(std::is_sorted(s.filters(t).begin(), s.filters(t).end()));
-        }
       }
       // Equal costs: nothing beats round robin strictly, so it stays.
       CHECK(ModeSchedule(modes, threads, std::vector<double>(modes, 1.0)) ==
