@@ -12,6 +12,8 @@
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
+#include "dualgrid/filter/particles.hpp"
+#include "dualgrid/filter/prediction_noise.hpp"
 
 using namespace dualgrid;
 using namespace dualgrid::filter;
@@ -169,6 +171,80 @@ BENCHMARK(BM_Scale)
     ->Args({2000000, 2})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0)
+    ->UseRealTime();
+
+// The floor of issue 25's paper-size rows (docs/performance.md, round 6): work that no
+// arrangement of the cycle avoids under the issue's rules, at the paper's size (10,000 particles,
+// 1,000 births, 20,000 cells) and at Nuss scale (2e6 particles, 2e5 births, 1.44e6 cells).
+// Arguments: particles, threads[, cells].
+//   bench_filter --benchmark_filter=Floor
+// 1. The prediction's process noise: four standard normals per particle from Philox keyed by
+//    seed, step and particle index (the determinism rule), drawn as the filter draws them.
+void BM_FloorNoise(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  PredictionNoise noise;
+  std::uint64_t step = 0;
+  for (auto _ : state) {
+    noise.Draw(1, step++, state.range(0));
+    benchmark::DoNotOptimize(noise.channel(0));
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FloorNoise)
+    ->Args({10000, 1})
+    ->Args({10000, 2})
+    ->Args({2000000, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+// 2. One pass that reads and writes every particle (the ParticleSet's 36 bytes, 11,000 with the
+//    births) and every cell (four double mass layers), with the least arithmetic a pass has:
+//    a constant-velocity step and a decay. The cycle needs at least four such passes over the
+//    particles (prediction, sort, weights, resampling) and two over the cells (update, export).
+void BM_FloorPass(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const std::int64_t n = state.range(0) + state.range(0) / 10, cells = state.range(2);
+  ParticleSet q;
+  q.resize(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i) {
+    q.x[i] = 0.01 * i;
+    q.y[i] = 0.02 * i;
+    q.vx[i] = q.vy[i] = 1.0f;
+    q.w_position[i] = q.w_velocity[i] = q.weight[i] = 1e-4f;
+  }
+  std::vector<double> f(cells, 0.1), s(cells, 0.1), d(cells, 0.1), b(cells, 0.0);
+  for (auto _ : state) {
+#pragma omp parallel
+    {
+#pragma omp for schedule(static) nowait
+      for (std::int64_t i = 0; i < n; ++i) {
+        q.x[i] += 0.05 * q.vx[i];
+        q.y[i] += 0.05 * q.vy[i];
+        // Affine updates with fixed points: no value decays into the subnormals (slow).
+        q.vx[i] = 0.999f * q.vx[i] + 0.001f;
+        q.vy[i] = 0.999f * q.vy[i] + 0.001f;
+        q.w_position[i] = 0.99f * q.w_position[i] + 1e-6f;
+        q.w_velocity[i] = 0.99f * q.w_velocity[i] + 1e-6f;
+        q.weight[i] = 0.99f * q.weight[i] + 1e-6f;
+      }
+#pragma omp for schedule(static)
+      for (std::int64_t c = 0; c < cells; ++c) {
+        f[c] = 0.9 * f[c] + 0.01;
+        s[c] = 0.98 * s[c] + 0.002;
+        d[c] = 1.0 - f[c] - s[c];
+        b[c] = 0.5 * d[c];
+      }
+    }
+    benchmark::DoNotOptimize(q.x.data());
+    benchmark::DoNotOptimize(b.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FloorPass)
+    ->Args({10000, 1, 20000})
+    ->Args({10000, 2, 20000})
+    ->Args({2000000, 2, 1440000})
+    ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
 }  // namespace

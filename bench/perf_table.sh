@@ -15,7 +15,10 @@
 #     load, and at Nuss scale (1.44e6 cells, 2e6 particles, 2e5 births), quiet;
 #   - the highway run with the dual mode only, 2 threads and 1 thread, no figures;
 #   - bench_recorded: a 20 s recorded sequence, three modes and the dual mode alone, the default
-#     1 ms batch window.
+#     1 ms batch window;
+#   - the floor (round 6, docs/performance.md): bench_filter's BM_Floor* (the prediction's Philox
+#     noise and one pass over the state, no arithmetic) and bench_sim_step (SUMO and the radar
+#     alone, no filters), beside the budgets they leave of the targets.
 # The benchmarks run with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for
 # itself. Prints a Markdown table: values, targets (issue 25's; issue 23's for the recorded row)
 # and the loaded / quiet slowdown. Takes ~8 min (new build only) to ~16 min (both). Nothing else
@@ -93,9 +96,25 @@ recorded() {
     cut -d= -f2
 }
 
-# Median real time [ms] per cycle of one bench_filter case: bench BUILD NAME_PREFIX.
-bench() {
-  OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 "$1/bench/bench_filter" --benchmark_filter="^$2" \
+# ms per step of SUMO and the radar alone on the highway (no filters, 2 threads; bench_sim_step,
+# multipath off as in the scenario): the part of a highway step no filter change touches.
+sim_step() {
+  [[ -x "$1/bench/bench_sim_step" ]] || return 0
+  OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 "$1/bench/bench_sim_step" \
+    --benchmark_filter='^BM_SimStepMultipath/2/' 2>/dev/null | grep -o 'off_ms_per_step=[0-9.]*' |
+    cut -d= -f2
+}
+
+# Median real time [ms] per cycle of one bench_filter case: bench BUILD NAME_PREFIX, with the wait
+# policy `dualgrid` sets for itself; floor BUILD NAME_PREFIX with libgomp's default (spinning), the
+# lower floor: with PASSIVE each region's wake-up is in it too (~0.05 ms here).
+bench() { OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300 bench_any "$@"; }
+floor() { (
+  unset OMP_WAIT_POLICY GOMP_SPINCOUNT
+  bench_any "$@"
+); }
+bench_any() {
+  "$1/bench/bench_filter" --benchmark_filter="^$2" \
     --benchmark_format=csv --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     2>/dev/null | awk -F, '/_median"?,/ {
       t = $3; u = $5; gsub(/"/, "", u)
@@ -127,6 +146,13 @@ for b in "${BUILDS[@]}"; do
   add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
   add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/)"
+  # The floor (round 6): the Philox noise and one pass over the state, no arithmetic; libgomp's
+  # default wait policy, the lower figure.
+  add "floor_noise|$b" "$(floor "$b" BM_FloorNoise/10000/2/)"
+  add "floor_pass|$b" "$(floor "$b" BM_FloorPass/10000/2/)"
+  add "floor_nuss_noise|$b" "$(floor "$b" BM_FloorNoise/2000000/2/)"
+  add "floor_nuss_pass|$b" "$(floor "$b" BM_FloorPass/2000000/2/)"
+  add "sim_step|$b" "$(sim_step "$b")"
   for ((r = 1; r <= REPS; ++r)); do
     add "recorded_quiet|$b" "$(recorded "$b" 3)"
     add "recorded1|$b" "$(recorded "$b" 1)"
@@ -185,5 +211,14 @@ line="| highway run, dual only, no figures, 2 threads / 1 thread: x real time | 
 for b in "${BUILDS[@]}"; do
   line+=" $(fmt "$(med single2 "$b")" xrt) / $(fmt "$(med single1 "$b")" xrt) | - | - |"
 done
+echo "$line"
+line="| floor, paper size, 2 threads: Philox noise + one pass over particles and cells (BM_Floor*, default wait policy): ms | 5,000/s = 0.200 ms per cycle |"
+for b in "${BUILDS[@]}"; do line+=" $(med floor_noise "$b") + $(med floor_pass "$b") ms | - | - |"; done
+echo "$line"
+line="| floor, Nuss scale, 2 threads: Philox noise + one pass (BM_Floor*, default wait policy): ms | 50 ms per cycle |"
+for b in "${BUILDS[@]}"; do line+=" $(med floor_nuss_noise "$b") + $(med floor_nuss_pass "$b") ms | - | - |"; done
+echo "$line"
+line="| SUMO + radar alone, highway, 2 threads, no filters (bench_sim_step): ms per step | 50x = 1.0 ms per step in all |"
+for b in "${BUILDS[@]}"; do line+=" $(med sim_step "$b") ms | - | - |"; done
 echo "$line"
 echo "(medians of $REPS runs for the highway, video and recorded rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"
