@@ -12,7 +12,7 @@
 namespace dualgrid::cosim {
 
 CoSimulation::CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options)
-    : pipeline_(config, options.modes), threads_(options.threads) {
+    : pipeline_(config, options.modes), threads_(options.threads), read_ahead_(options.read_ahead) {
   for (filter::WeightMode m : options.modes) {
     mode_names_.emplace_back(filter::ToString(m));
     scorers_.emplace_back(config.evaluation);
@@ -22,7 +22,9 @@ CoSimulation::CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions 
 
 CoSimulation::CoSimulation(const scenario::ScenarioConfig& config, CoSimOptions options,
                            const Pipeline::SourceFactory& make_source)
-    : pipeline_(config, options.modes, make_source), threads_(options.threads) {
+    : pipeline_(config, options.modes, make_source),
+      threads_(options.threads),
+      read_ahead_(options.read_ahead) {
   for (filter::WeightMode m : options.modes) {
     mode_names_.emplace_back(filter::ToString(m));
     scorers_.emplace_back(config.evaluation);
@@ -152,8 +154,12 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
       if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
     }
     for (int m : schedule.scores(t)) score(m);
-    if (t == schedule.truth_thread())  // the other slot: no race
+    if (t == schedule.truth_thread()) {  // the other slot: no race
       guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
+      // The next step's measurement grid, in the time this thread would wait for the others
+      // (with one thread there is no such time: Advance builds it).
+      if (read_ahead_ && team > 1) pipeline_.PrepareAhead();
+    }
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and

@@ -3,10 +3,43 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 namespace dualgrid::cosim {
+
+namespace {
+
+bool SameBits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+bool SameBits(const Vector2& a, const Vector2& b) {
+  return SameBits(a.x(), b.x()) && SameBits(a.y(), b.y());
+}
+
+// Step 4's inputs equal bit for bit (so -0.0 differs from 0.0, and NaN can equal NaN: what Build
+// sees, not what == says).
+bool SameInputs(std::span<const filter::Measurement> m, std::span<const filter::SensorCoverage> c,
+                std::span<const filter::Measurement> m2,
+                std::span<const filter::SensorCoverage> c2) {
+  if (m.size() != m2.size() || c.size() != c2.size()) return false;
+  for (std::size_t i = 0; i < m.size(); ++i)
+    if (!SameBits(m[i].position, m2[i].position) ||
+        !SameBits(m[i].radial_velocity, m2[i].radial_velocity) ||
+        !SameBits(m[i].sensor_position, m2[i].sensor_position))
+      return false;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (!SameBits(c[i].origin, c2[i].origin) || !SameBits(c[i].boresight, c2[i].boresight) ||
+        !SameBits(c[i].half_fov, c2[i].half_fov) || !SameBits(c[i].min_range, c2[i].min_range) ||
+        !SameBits(c[i].max_range, c2[i].max_range))
+      return false;
+  return true;
+}
+
+}  // namespace
 
 int IdRegistry::Id(const std::string& name) {
   auto [it, inserted] = ids_.try_emplace(name, static_cast<int>(names_.size()));
@@ -137,7 +170,10 @@ void Pipeline::FixFrame(const sim::Frame& f) {
 
 bool Pipeline::Advance() {
   if (!source_->started()) throw std::logic_error("Pipeline::Advance before Start");
+  // Whatever happens below, a grid read ahead is for this step or never (PrepareAhead).
+  const bool ahead_ready = std::exchange(ahead_.ready, false);
   if (!source_->Advance(ids_)) return false;
+  ++advances_;
   const sim::Frame& f = frame();
   ego_ = source_->ego();
   // The first filter cycle (the ego may depart late) predicts over one step.
@@ -145,14 +181,11 @@ bool Pipeline::Advance() {
   realign_angle_ = 0.0;
   if (first_step_) {
     FixFrame(f);
-  } else if (config_.grid.frame == scenario::GridPlacement::Frame::kFollow) {
+  } else if (const auto yaw = TurnedYaw(f)) {
     // The road has turned: the grid turns with it (the filters follow in UpdateFilter).
-    if (const auto yaw =
-            RealignedYaw(grid_frame_.yaw(), f.ego.lane_yaw, DegToRad(config_.grid.realign_deg))) {
-      realign_angle_ = WrapAngle(*yaw - grid_frame_.yaw());
-      grid_frame_ = GridFrame(*yaw);
-      ++realignments_;
-    }
+    realign_angle_ = WrapAngle(*yaw - grid_frame_.yaw());
+    grid_frame_ = GridFrame(*yaw);
+    ++realignments_;
   }
   first_step_ = false;
   last_time_ = f.time;
@@ -160,27 +193,89 @@ bool Pipeline::Advance() {
   source_->Scan(ids_, &detections_, &scanned_);
 
   if (filters_.empty()) return true;
-  measurements_.clear();
+  // The grid frame has already turned (above).
+  const Position centre =
+      FilterInputs(*source_, grid_frame_, detections_, scanned_, &measurements_, &coverage_);
+  // The grid read ahead is taken only for the very same inputs, bit for bit: Build is a function
+  // of them (and of the geometry, the same), so the filters see what Build would give here.
+  if (ahead_ready && ahead_.step == advances_ && SameBits(centre, ahead_.centre) &&
+      SameInputs(measurements_, coverage_, ahead_.measurements, ahead_.coverage)) {
+    std::swap(measurement_, ahead_.grid);
+    ++ahead_hits_;
+  } else {
+    measurement_->Build(centre, measurements_, coverage_);
+  }
+  return true;
+}
+
+std::optional<double> Pipeline::TurnedYaw(const sim::Frame& f) const {
+  if (config_.grid.frame != scenario::GridPlacement::Frame::kFollow) return std::nullopt;
+  return RealignedYaw(grid_frame_.yaw(), f.ego.lane_yaw, DegToRad(config_.grid.realign_deg));
+}
+
+Position Pipeline::FilterInputs(const DetectionSource& source, const GridFrame& g,
+                                std::span<const radar::Detection> detections,
+                                std::span<const int> scanned,
+                                std::vector<filter::Measurement>* measurements,
+                                std::vector<filter::SensorCoverage>* coverage) const {
+  measurements->clear();
   // Nothing but the ego can be inside the ego's own footprint: returns there (clutter drawn down
   // to the sensors' minimum range) would feed particles that ride along with the ego.
-  const BoxTest ego_box(f.ego.box);
+  const BoxTest ego_box(source.frame().ego.box);
   // The filter works in the grid frame.
-  const GridFrame& g = grid_frame_;
-  for (const radar::Detection& d : detections_) {
+  for (const radar::Detection& d : detections) {
     if (ego_box.Contains(d.position_world)) continue;
-    measurements_.push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world),
+    measurements->push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world),
                              g.ToGrid(d.sensor_position_world)});
   }
-  coverage_.clear();
-  for (int s : scanned_) {
-    const radar::SensorParams& p = radar().sensors()[s];
-    const Pose2 pose = radar().SensorPose(s, ego_.pose);
-    coverage_.push_back(
+  coverage->clear();
+  const Pose2& ego = source.ego().pose;
+  for (int s : scanned) {
+    const radar::SensorParams& p = source.radar().sensors()[s];
+    const Pose2 pose = source.radar().SensorPose(s, ego);
+    coverage->push_back(
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
-  // Every filter's centre (UpdateFilter); the grid frame has already turned (above).
-  measurement_->Build(g.ToGrid(ego_.pose).position + centre_offset_, measurements_, coverage_);
-  return true;
+  // Every filter's centre (UpdateFilter).
+  return g.ToGrid(ego).position + centre_offset_;
+}
+
+void Pipeline::PrepareAhead() noexcept {
+  ahead_.ready = false;
+  if (filters_.empty() || advances_ == 0 || ahead_.given_up) return;
+  try {
+    if (!ahead_.source) {
+      ahead_.source = source_->Twin();
+      if (!ahead_.source) {
+        ahead_.given_up = true;
+        return;
+      }
+      // params() is fixed at construction: safe to read while that filter updates.
+      ahead_.grid = std::make_unique<filter::MeasurementGrid>(filters_[0]->params());
+    }
+    // The twin reads the step after the last Advance() (it catches up if a call was skipped).
+    while (ahead_.advances <= advances_) {
+      if (!ahead_.source->Advance(ahead_.ids)) {
+        ahead_.given_up = true;  // the sequence ends: nothing left to read ahead
+        return;
+      }
+      ahead_.source->Scan(ahead_.ids, &ahead_.detections, &ahead_.scanned);
+      ++ahead_.advances;
+    }
+    const sim::Frame& f = ahead_.source->frame();
+    const std::optional<double> yaw = TurnedYaw(f);
+    const GridFrame g = yaw ? GridFrame(*yaw) : grid_frame_;
+    ahead_.centre = FilterInputs(*ahead_.source, g, ahead_.detections, ahead_.scanned,
+                                 &ahead_.measurements, &ahead_.coverage);
+    ahead_.grid->Build(ahead_.centre, ahead_.measurements, ahead_.coverage);
+    ahead_.step = ahead_.advances;
+    ahead_.ready = true;
+  } catch (...) {
+    // Only speculation failed: Advance builds the step's grid itself and reports any error of
+    // the data at its own step. The twin's state is unknown now, so it is not used again.
+    ahead_.given_up = true;
+    ahead_.source.reset();
+  }
 }
 
 OrientedBox Pipeline::GridFootprint() const {

@@ -107,6 +107,12 @@ RecordedSource::RecordedSource(const RecordedSequence& sequence, RecordedOptions
   first_dt_ = options_.first_dt;
 }
 
+std::unique_ptr<DetectionSource> RecordedSource::Twin() const {
+  auto twin = std::make_unique<RecordedSource>(seq_, options_);
+  twin->Start({}, {});
+  return twin;
+}
+
 double RecordedSource::first_time() const {
   return seq_.scans.empty() ? 0.0 : seq_.Time(seq_.scans.front().timestamp_us);
 }

@@ -31,6 +31,12 @@ struct CoSimOptions {
   /// now and then); threads beyond one per mode go to each filter's own loops. Results do not
   /// depend on it.
   int threads = 0;
+  /// Performance switch: with two or more threads, the thread with the fewest filters reads a
+  /// recorded source one step ahead while the others filter, and builds the next step's
+  /// measurement grid there (Pipeline::PrepareAhead: taken only for the same inputs, so results
+  /// do not depend on it; SUMO runs cannot be read ahead). About 7 % of a three-mode recorded
+  /// run on two threads (docs/performance.md, round 6).
+  bool read_ahead = true;
 };
 
 /// What observers see after a step. Every reference is valid during OnStep() only.
@@ -114,6 +120,7 @@ class CoSimulation {
   std::vector<Position> point_positions_;  // this step's detections, grid frame (labelled data)
   std::vector<StepObserver*> observers_;
   int threads_ = 0;
+  bool read_ahead_ = true;
   int steps_ = 0;
   std::optional<ModeSchedule> schedule_;
   int schedule_team_ = 0;

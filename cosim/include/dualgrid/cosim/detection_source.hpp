@@ -65,6 +65,11 @@ class DetectionSource {
   virtual bool has_labels() const { return false; }
   /// The source reached its own end (SUMO: the duration; recorded: the last scan).
   virtual bool reached_end() const = 0;
+  /// A second, independent source over the same data, started, at the first step: the Pipeline
+  /// reads it one step ahead to build the next step's measurement grid on an idle thread
+  /// (Pipeline::PrepareAhead). nullptr (the default) when the data cannot be read twice (SUMO:
+  /// one simulation per process).
+  virtual std::unique_ptr<DetectionSource> Twin() const { return nullptr; }
 };
 
 /// The co-simulation: SUMO steps, the radar model scans the ground truth. The radars are mounted

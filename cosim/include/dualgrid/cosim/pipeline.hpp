@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,18 @@ class Pipeline {
   /// slot, and it reads no filter). UpdateFilter reads them when they match its cycle and draws
   /// its own otherwise, so calling this only saves work. No-op without filters or when drawn.
   void DrawNoise(bool ahead);
+  /// Reads the source one step ahead and builds the next step's measurement grid (step 4), for
+  /// Advance() to take instead of building it: call it on a thread with time to spare while the
+  /// filters of a step run (it writes only its own buffers and reads none of the filters).
+  /// Advance() takes that grid only when its own inputs (measurements, coverage, centre) are
+  /// the same bits, so results never depend on it. Only for sources with a twin
+  /// (DetectionSource::Twin: recorded data; SUMO has none and this does nothing); costs a second
+  /// source and a second measurement grid (as large as the first), made at the first call. Errors
+  /// are not thrown: the speculation stops for the run, and Advance() meets any error of the data
+  /// at its own step.
+  void PrepareAhead() noexcept;
+  /// Steps whose measurement grid came from PrepareAhead().
+  std::uint64_t ahead_hits() const { return ahead_hits_; }
 
   /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
   const scenario::ScenarioConfig& config() const { return config_; }
@@ -136,6 +149,15 @@ class Pipeline {
   // At the first step: the grid frame.
   void FixFrame(const sim::Frame& f);
   void MakeFilters(bool cycle_is_step);
+  // With `filter.frame: follow`, the grid frame's new yaw when the road of frame `f` has turned
+  // from the current grid frame; nullopt otherwise. Reads only.
+  std::optional<double> TurnedYaw(const sim::Frame& f) const;
+  // Step 4's inputs of `source`'s current step (its frame, ego, and the detections and sensors
+  // of its last Scan) in the grid frame `g`; returns the grid centre. Reads only.
+  Position FilterInputs(const DetectionSource& source, const GridFrame& g,
+                        std::span<const radar::Detection> detections, std::span<const int> scanned,
+                        std::vector<filter::Measurement>* measurements,
+                        std::vector<filter::SensorCoverage>* coverage) const;
 
   scenario::ScenarioConfig config_;
   IdRegistry ids_;
@@ -159,6 +181,24 @@ class Pipeline {
   double realign_angle_ = 0.0;  // the grid frame's turn in the last Advance() [rad]
   int realignments_ = 0;
   Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
+  std::uint64_t advances_ = 0;               // Advance() calls that returned true
+  // PrepareAhead's state: the source's twin, read one step ahead with its own ids, and the next
+  // step's inputs and measurement grid (for Advance number `step`, when `ready`).
+  struct Ahead {
+    std::unique_ptr<DetectionSource> source;
+    IdRegistry ids;
+    std::uint64_t advances = 0;
+    bool given_up = false;  // no twin, the end reached, or an error: no more reading ahead
+    bool ready = false;
+    std::uint64_t step = 0;
+    std::vector<radar::Detection> detections;
+    std::vector<int> scanned;
+    std::vector<filter::Measurement> measurements;
+    std::vector<filter::SensorCoverage> coverage;
+    Position centre = Position::Zero();
+    std::unique_ptr<filter::MeasurementGrid> grid;
+  } ahead_;
+  std::uint64_t ahead_hits_ = 0;
 };
 
 }  // namespace dualgrid::cosim

@@ -94,6 +94,9 @@ class RecordedSource : public DetectionSource {
   const PointLabels& labels() const override { return labels_; }
   bool has_labels() const override { return seq_.has_labels; }
   bool reached_end() const override { return next_ >= seq_.scans.size(); }
+  /// A RecordedSource over the same sequence and options (the sequence is shared, not copied;
+  /// the twin builds its own per-point indexes).
+  std::unique_ptr<DetectionSource> Twin() const override;
   /// Steps (batches of scans) in the whole sequence.
   int StepCount() const { return static_cast<int>(batches_.size()); }
   /// Time of the first and the last step [s].
