@@ -34,8 +34,8 @@ struct CoSimOptions {
   /// Performance switch: with two or more threads, the thread with the fewest filters reads a
   /// recorded source one step ahead while the others filter, and builds the next step's
   /// measurement grid there (Pipeline::PrepareAhead: taken only for the same inputs, so results
-  /// do not depend on it; SUMO runs cannot be read ahead). About 7 % of a three-mode recorded
-  /// run on two threads (docs/performance.md, round 6).
+  /// do not depend on it; SUMO runs cannot be read ahead). -5.8 % wall time on a three-mode
+  /// recorded run on two threads (docs/performance.md, round 6).
   bool read_ahead = true;
 };
 
