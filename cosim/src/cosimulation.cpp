@@ -156,9 +156,11 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     for (int m : schedule.scores(t)) score(m);
     if (t == schedule.truth_thread()) {  // the other slot: no race
       guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
-      // The next step's measurement grid, in the time this thread would wait for the others
-      // (with one thread there is no such time: Advance builds it).
-      if (read_ahead_ && team > 1) pipeline_.PrepareAhead();
+      // The next step's measurement grid, in the time this thread would wait for the others:
+      // only when it runs fewer filters than they do (3 modes on 2 threads); otherwise there is
+      // no such time and Advance builds it with every thread.
+      if (read_ahead_ && team > 1 && schedule.filters(t).size() < schedule.filters(0).size())
+        pipeline_.PrepareAhead();
     }
   };
   if (team == 1) {

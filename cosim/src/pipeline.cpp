@@ -108,8 +108,11 @@ void Pipeline::MakeFilters(bool cycle_is_step) {
   // Step 4 depends on the detections and the grid's geometry only: built once per step for every
   // mode (MeasurementGrid, docs/performance.md).
   measurement_.reset();
-  if (!filters_.empty())
-    measurement_ = std::make_unique<filter::MeasurementGrid>(filters_[0]->params());
+  if (!filters_.empty()) {
+    // A copy: PrepareAhead makes its grid while the filters run.
+    measurement_params_ = filters_[0]->params();
+    measurement_ = std::make_unique<filter::MeasurementGrid>(measurement_params_);
+  }
 }
 
 void Pipeline::Start(const std::filesystem::path& network_dir,
@@ -250,8 +253,7 @@ void Pipeline::PrepareAhead() noexcept {
         ahead_.given_up = true;
         return;
       }
-      // params() is fixed at construction: safe to read while that filter updates.
-      ahead_.grid = std::make_unique<filter::MeasurementGrid>(filters_[0]->params());
+      ahead_.grid = std::make_unique<filter::MeasurementGrid>(measurement_params_);
     }
     // The twin reads the step after the last Advance() (it catches up if a call was skipped).
     while (ahead_.advances <= advances_) {
@@ -270,6 +272,7 @@ void Pipeline::PrepareAhead() noexcept {
     ahead_.grid->Build(ahead_.centre, ahead_.measurements, ahead_.coverage);
     ahead_.step = ahead_.advances;
     ahead_.ready = true;
+    ++ahead_.prepared;
   } catch (...) {
     // Only speculation failed: Advance builds the step's grid itself and reports any error of
     // the data at its own step. The twin's state is unknown now, so it is not used again.

@@ -21,8 +21,10 @@ using namespace dualgrid;
 namespace {
 
 // A short sequence like bench_recorded's: four corner radars scanning in turn (18.75 ms apart),
-// the ego at 10 m/s, three labelled cars passing, static returns around.
-cosim::RecordedSequence MakeSequence(double duration) {
+// the ego at 10 m/s, three labelled cars passing, static returns around; 0-60 detections per
+// scan (some scans empty). `turn_rate` [rad/s]: the ego drives a circle, its lane turning with
+// it, so that the grid (frame: follow) turns now and then.
+cosim::RecordedSequence MakeSequence(double duration, double turn_rate) {
   cosim::RecordedSequence s;
   s.name = "sequence_read_ahead";
   const double mounts[4][3] = {
@@ -45,19 +47,27 @@ cosim::RecordedSequence MakeSequence(double duration) {
     scan.timestamp_us = t0 + i * 18'750;
     const double t = (scan.timestamp_us - t0) / 1e6;
     scan.sensor = i % 4;
-    scan.ego_pose = {{10.0 * t, 0.0}, 0.0};
-    scan.ego_velocity = {10.0, 0.0};
+    const double yaw = turn_rate * t;
+    scan.ego_pose = {turn_rate == 0.0 ? Position(10.0 * t, 0.0)
+                                      : Position(10.0 / turn_rate * std::sin(yaw),
+                                                 10.0 / turn_rate * (1.0 - std::cos(yaw))),
+                     yaw};
+    scan.ego_velocity = 10.0 * UnitVector(yaw);
+    scan.lane_yaw = yaw;
     scan.begin = s.points.size();
     const Pose2 sensor = scan.ego_pose.Compose(s.sensors[scan.sensor].mount);
-    for (int d = 0; d < 30; ++d) {
+    const int count = static_cast<int>(uniform(0.0, 61.0));
+    for (int d = 0; d < count; ++d) {
       cosim::RecordedPoint p;
       const int track = d < 12 ? d / 4 : -1;
       Velocity v = Velocity::Zero();
       if (track >= 0) {
         const double speed = 12.0 + 3.0 * track;
-        p.position = {20.0 + 15.0 * track + speed * t + uniform(-2, 2),
-                      (track - 1) * 3.5 + uniform(-0.8, 0.8)};
-        v = {speed, 0.0};
+        // Beside the ego, along its heading.
+        p.position =
+            scan.ego_pose.ToParent({20.0 + 15.0 * track + (speed - 10.0) * t + uniform(-2, 2),
+                                    (track - 1) * 3.5 + uniform(-0.8, 0.8)});
+        v = speed * UnitVector(yaw);
       } else {
         p.position = sensor.ToParent(uniform(2, 60) * UnitVector(uniform(-1.0, 1.0)));
       }
@@ -119,16 +129,17 @@ struct Digest : cosim::StepObserver {
 struct Outcome {
   std::uint64_t digest = 0;
   std::vector<nlohmann::json> metrics;
-  std::uint64_t hits = 0;
-  int steps = 0;
+  std::uint64_t prepared = 0, hits = 0;
+  int steps = 0, realignments = 0;
 };
 
 Outcome Run(const cosim::RecordedSequence& seq, const cosim::RecordedSequence& twin_data,
-            bool read_ahead) {
+            bool read_ahead, double batch_window = 0.001) {
   scenario::ScenarioConfig config = recorded::DefaultRecordedConfig();
   config.filter.num_particles = 4000;
   config.filter.num_birth = 400;
-  const cosim::RecordedOptions o = recorded::FitConfig(seq, 0.001, &config);
+  REQUIRE(config.grid.frame == scenario::GridPlacement::Frame::kFollow);
+  const cosim::RecordedOptions o = recorded::FitConfig(seq, batch_window, &config);
   cosim::CoSimulation cs(config, {.threads = 2, .read_ahead = read_ahead},
                          [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                            return std::make_unique<LyingSource>(seq, twin_data, o);
@@ -138,7 +149,12 @@ Outcome Run(const cosim::RecordedSequence& seq, const cosim::RecordedSequence& t
   cs.Start({}, {});
   while (cs.Step()) {
   }
-  Outcome out{digest.h, {}, cs.pipeline().ahead_hits(), cs.steps()};
+  Outcome out{digest.h,
+              {},
+              cs.pipeline().ahead_prepared(),
+              cs.pipeline().ahead_hits(),
+              cs.steps(),
+              cs.pipeline().grid_realignments()};
   for (const auto& m : cs.Metrics()) out.metrics.emplace_back(m);
   return out;
 }
@@ -147,29 +163,56 @@ Outcome Run(const cosim::RecordedSequence& seq, const cosim::RecordedSequence& t
 
 TEST_CASE("Reading a recorded source ahead: the same results, bit for bit, and used",
           "[cosim][recorded]") {
-  const cosim::RecordedSequence seq = MakeSequence(3.0);
-  const Outcome off = Run(seq, seq, false);
-  const Outcome on = Run(seq, seq, true);
-  REQUIRE(off.steps == static_cast<int>(seq.scans.size()));
-  CHECK(off.hits == 0);
-  // Every step but the first (nothing read before it) takes the grid read ahead.
-  CHECK(on.hits == static_cast<std::uint64_t>(on.steps - 1));
-  CHECK(on.steps == off.steps);
-  CHECK(on.digest == off.digest);
-  REQUIRE(on.metrics.size() == 3u);
-  for (std::size_t m = 0; m < 3; ++m) CHECK(on.metrics[m] == off.metrics[m]);
-  // The run tracked its cars: the comparison is not vacuous.
-  CHECK(off.metrics[2]["matches"].get<int>() > 0);
+  struct Case {
+    const char* name;
+    double turn_rate, batch_window;
+  };
+  // A scan per step; and a turning ego with two or three scans per step (a 40 ms window), so that
+  // steps differ in their sensors and detection counts and the grid turns between steps.
+  for (const Case c : {Case{"straight, a scan per step", 0.0, 0.001},
+                       Case{"turning, scans batched", 0.25, 0.04}}) {
+    SECTION(c.name) {
+      const cosim::RecordedSequence seq = MakeSequence(3.0, c.turn_rate);
+      const Outcome off = Run(seq, seq, false, c.batch_window);
+      const Outcome on = Run(seq, seq, true, c.batch_window);
+      REQUIRE(off.steps > 50);
+      CHECK(off.prepared == 0);
+      CHECK(off.hits == 0);
+      // Every step but the first (nothing read before it) takes the grid read ahead.
+      CHECK(on.prepared == static_cast<std::uint64_t>(on.steps - 1));
+      CHECK(on.hits == on.prepared);
+      CHECK(on.steps == off.steps);
+      CHECK(on.digest == off.digest);
+      REQUIRE(on.metrics.size() == 3u);
+      for (std::size_t m = 0; m < 3; ++m) CHECK(on.metrics[m] == off.metrics[m]);
+      // The run tracked its cars, and the turning one turned its grid: not vacuous.
+      CHECK(off.metrics[2]["matches"].get<int>() > 0);
+      CHECK((c.turn_rate == 0.0 ? on.realignments == 0 : on.realignments >= 2));
+      CHECK(on.realignments == off.realignments);
+    }
+  }
 }
 
 TEST_CASE("Reading ahead: a twin that reads other data is never taken", "[cosim][recorded]") {
-  const cosim::RecordedSequence seq = MakeSequence(3.0);
-  // Every detection 0.3 m away from where the source has it: inputs that differ from the step's.
-  cosim::RecordedSequence moved = seq;
-  for (cosim::RecordedPoint& p : moved.points) p.position.x() += 0.3;
+  const cosim::RecordedSequence seq = MakeSequence(3.0, 0.0);
   const Outcome off = Run(seq, seq, false);
-  const Outcome lied_to = Run(seq, moved, true);
-  CHECK(lied_to.hits == 0);
-  CHECK(lied_to.digest == off.digest);
-  for (std::size_t m = 0; m < 3; ++m) CHECK(lied_to.metrics[m] == off.metrics[m]);
+  // Inputs that differ from the step's in the measurements (every point 0.3 m away), or only in
+  // the grid centre and the coverage (the ego 0.3 m away, its points where they were).
+  cosim::RecordedSequence moved_points = seq, moved_ego = seq;
+  for (cosim::RecordedPoint& p : moved_points.points) p.position.x() += 0.3;
+  for (cosim::RecordedScan& scan : moved_ego.scans) scan.ego_pose.position.y() += 0.3;
+  // A scan without detections has the same inputs in both (the ego did not move): those steps
+  // after the first may take the grid read ahead, and only those.
+  std::uint64_t empty = 0;
+  for (std::size_t i = 1; i < seq.scans.size(); ++i)
+    empty += seq.scans[i].begin == seq.scans[i].end;
+  REQUIRE(empty > 0);
+  for (const cosim::RecordedSequence* other : {&moved_points, &moved_ego}) {
+    const Outcome lied_to = Run(seq, *other, true);
+    // Prepared in every step (so the comparison was made), taken only where nothing differs.
+    CHECK(lied_to.prepared == static_cast<std::uint64_t>(lied_to.steps - 1));
+    CHECK(lied_to.hits == (other == &moved_points ? empty : 0u));
+    CHECK(lied_to.digest == off.digest);
+    for (std::size_t m = 0; m < 3; ++m) CHECK(lied_to.metrics[m] == off.metrics[m]);
+  }
 }

@@ -31,11 +31,11 @@ struct CoSimOptions {
   /// now and then); threads beyond one per mode go to each filter's own loops. Results do not
   /// depend on it.
   int threads = 0;
-  /// Performance switch: with two or more threads, the thread with the fewest filters reads a
-  /// recorded source one step ahead while the others filter, and builds the next step's
-  /// measurement grid there (Pipeline::PrepareAhead: taken only for the same inputs, so results
-  /// do not depend on it; SUMO runs cannot be read ahead). -5.8 % wall time on a three-mode
-  /// recorded run on two threads (docs/performance.md, round 6).
+  /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
+  /// threads), it reads a recorded source one step ahead while the others filter, and builds
+  /// the next step's measurement grid there (Pipeline::PrepareAhead: taken only for the same
+  /// inputs, so results do not depend on it; SUMO runs cannot be read ahead). -5.8 % wall time on a
+  /// three-mode recorded run on two threads (docs/performance.md, round 6).
   bool read_ahead = true;
 };
 

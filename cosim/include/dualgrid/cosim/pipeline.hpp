@@ -96,7 +96,8 @@ class Pipeline {
   /// are not thrown: the speculation stops for the run, and Advance() meets any error of the data
   /// at its own step.
   void PrepareAhead() noexcept;
-  /// Steps whose measurement grid came from PrepareAhead().
+  /// Steps whose measurement grid PrepareAhead() built, and those of them Advance() took.
+  std::uint64_t ahead_prepared() const { return ahead_.prepared; }
   std::uint64_t ahead_hits() const { return ahead_hits_; }
 
   /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
@@ -164,8 +165,10 @@ class Pipeline {
   std::unique_ptr<DetectionSource> source_;
   std::vector<filter::WeightMode> modes_;
   std::vector<std::unique_ptr<filter::DynamicGrid>> filters_;
-  // This step's measurement grid, shared by the filters that share its geometry (all of ours).
+  // This step's measurement grid, shared by the filters that share its geometry (all of ours),
+  // and the parameters it was made with.
   std::unique_ptr<filter::MeasurementGrid> measurement_;
+  filter::FilterParams measurement_params_;
   // Prediction normals shared by the modes, by cycle parity (DrawNoise).
   std::array<filter::PredictionNoise, 2> noise_;
   std::uint64_t noise_cycle_ = 0;  // the filters' cycle at the last DrawNoise(false)
@@ -187,7 +190,7 @@ class Pipeline {
   struct Ahead {
     std::unique_ptr<DetectionSource> source;
     IdRegistry ids;
-    std::uint64_t advances = 0;
+    std::uint64_t advances = 0, prepared = 0;
     bool given_up = false;  // no twin, the end reached, or an error: no more reading ahead
     bool ready = false;
     std::uint64_t step = 0;
