@@ -201,7 +201,7 @@ bool Pipeline::Advance() {
       FilterInputs(*source_, grid_frame_, detections_, scanned_, &measurements_, &coverage_);
   // The grid read ahead is taken only for the very same inputs, bit for bit: Build is a function
   // of them (and of the geometry, the same), so the filters see what Build would give here.
-  if (ahead_ready && ahead_.step == advances_ && SameBits(centre, ahead_.centre) &&
+  if (ahead_ready && ahead_.advances == advances_ && SameBits(centre, ahead_.centre) &&
       SameInputs(measurements_, coverage_, ahead_.measurements, ahead_.coverage)) {
     std::swap(measurement_, ahead_.grid);
     ++ahead_hits_;
@@ -270,7 +270,6 @@ void Pipeline::PrepareAhead() noexcept {
     ahead_.centre = FilterInputs(*ahead_.source, g, ahead_.detections, ahead_.scanned,
                                  &ahead_.measurements, &ahead_.coverage);
     ahead_.grid->Build(ahead_.centre, ahead_.measurements, ahead_.coverage);
-    ahead_.step = ahead_.advances;
     ahead_.ready = true;
     ++ahead_.prepared;
   } catch (...) {

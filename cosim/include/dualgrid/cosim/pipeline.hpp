@@ -185,15 +185,15 @@ class Pipeline {
   int realignments_ = 0;
   Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
   std::uint64_t advances_ = 0;               // Advance() calls that returned true
-  // PrepareAhead's state: the source's twin, read one step ahead with its own ids, and the next
-  // step's inputs and measurement grid (for Advance number `step`, when `ready`).
+  // PrepareAhead's state: the source's twin, read one step ahead with its own ids (`advances`
+  // calls), and the next step's inputs and measurement grid, for Advance() number `advances`
+  // when `ready`.
   struct Ahead {
     std::unique_ptr<DetectionSource> source;
     IdRegistry ids;
     std::uint64_t advances = 0, prepared = 0;
     bool given_up = false;  // no twin, the end reached, or an error: no more reading ahead
     bool ready = false;
-    std::uint64_t step = 0;
     std::vector<radar::Detection> detections;
     std::vector<int> scanned;
     std::vector<filter::Measurement> measurements;
