@@ -22,6 +22,8 @@ nlohmann::json ConfigToJson(const ScenarioConfig& c) {
   j["scenario"] = c.sim.name;
   j["overrides"] = c.overrides;
   j["seed"] = c.sim.seed;
+  j["begin_s"] = c.sim.begin;  // SUMO time; duration_s counts from it
+  j["begin_source"] = c.sim.begin_source;
   j["duration_s"] = c.sim.duration;
   j["step_length_s"] = c.sim.step_length;
   j["sensors"]["accuracy"] = c.radar.accuracy;

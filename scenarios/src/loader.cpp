@@ -89,6 +89,19 @@ ScenarioConfig LoadScenarioText(const std::string& text, const std::filesystem::
   return LoadDocument([&] { return YAML::Load(text); }, file);
 }
 
+namespace {
+
+// The `auto` rule looks for traffic in the grid as the filter places it round the ego.
+void SetAutoEgoView(ScenarioConfig* config) {
+  const Vector2 off = config->grid.CentreOffset(config->filter.length_x, config->filter.width_y);
+  const double ahead = 0.5 * config->filter.length_x + off.x();
+  const double left = 0.5 * config->filter.width_y + off.y();
+  config->sim.auto_ego_view = {ahead, config->filter.length_x - ahead, left,
+                               config->filter.width_y - left};
+}
+
+}  // namespace
+
 void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out) {
   ScenarioConfig& config = *out;
   MapReader root(doc, name, "");
@@ -98,8 +111,11 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
   std::string error;
   if (!config.sim.IsValid(&error)) Invalid(name, "", error);
   const std::optional<sim::RouteFileIndex> routes = IndexUserFiles(root, name, config.sim);
+  // Again, with the ego's departure from the files against the run's window.
+  if (!config.sim.IsValid(&error)) Invalid(name, "", error);
   ReadRadar(root, config.sim, &config.radar);
   ReadFilter(root, &config);
+  SetAutoEgoView(&config);
   ReadEvaluation(root, &config.evaluation);
   root.Finish();
   // Names the evaluation uses must exist: a typo would silently pick another vehicle.
@@ -123,6 +139,7 @@ void ReadAll(const YAML::Node& doc, const std::string& name, ScenarioConfig* out
     if (!(t > 0.0 && t <= config.sim.duration))
       throw ConfigError(
           name + ": key 'evaluation.snapshot_times' holds " + std::to_string(t) +
-          " s, outside the run (0, duration = " + std::to_string(config.sim.duration) + "] s");
+          " s, outside the run (0, duration = " + std::to_string(config.sim.duration) +
+          "] s (run time: seconds from the begin)");
 }
 }  // namespace dualgrid::scenario

@@ -1,11 +1,15 @@
 #include <filesystem>
+#include <functional>
 
+#include "dualgrid/sim/opendrive.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 #include "sections.hpp"
 
 namespace dualgrid::scenario::detail {
 
 namespace {
+
+using PathFn = std::function<std::string(const std::string&)>;
 
 void ReadVehicle(MapReader& r, sim::VehicleSpec* v) {
   r.Read("id", &v->id);
@@ -19,69 +23,70 @@ void ReadVehicle(MapReader& r, sim::VehicleSpec* v) {
   r.Read("lane_change", &v->lane_change);
 }
 
-}  // namespace
+// `begin`: the scenario's key wins over the configuration's <begin> (as SUMO read it).
+void ReadBegin(MapReader& root, const sim::SumoConfigInputs* cfg, sim::ScenarioSpec* s) {
+  if (cfg) {
+    s->begin = cfg->begin;
+    s->begin_source = "sumo_config";
+    s->config_end = cfg->end;
+  }
+  std::optional<double> begin;
+  root.Read("begin", &begin);
+  if (begin) {
+    s->begin = *begin;
+    s->begin_source = "scenario";
+  }
+}
 
-void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
-  root.Read("name", &s->name);
-  root.Read("description", &s->description);
-  const std::filesystem::path here = std::filesystem::path(root.file()).parent_path();
-  const auto relative_to_file = [&](const std::string& p) {
-    return std::filesystem::absolute(here / p).lexically_normal().string();
-  };
-  // SUMO's own configuration: its network and route files (docs/scenarios.md).
-  std::optional<double> cfg_step;
+// `sumo_config` (its network, files, begin and end, as SUMO reads them) or `network`; an
+// OpenDRIVE map is converted into the cache (sim/opendrive.hpp).
+void ReadSources(MapReader& root, const PathFn& relative_to_file, sim::ScenarioSpec* s) {
+  std::optional<sim::SumoConfigInputs> in;
   if (root.Has("sumo_config")) {
     if (root.Has("network"))
       root.Fail("network", "must not be given with sumo_config (whose net-file is the network)");
     std::string cfg;
     root.Read("sumo_config", &cfg);
     try {
-      const sim::SumoConfigInputs in = sim::ReadSumoConfig(relative_to_file(cfg));
-      s->network = in.net_file.string();
-      for (const auto& f : in.route_files) s->route_files.push_back(f.string());
-      for (const auto& f : in.additional_files) s->additional_files.push_back(f.string());
-      cfg_step = in.step_length;
-    } catch (const std::invalid_argument& e) {
+      in = sim::ReadSumoConfig(relative_to_file(cfg));
+    } catch (const std::exception& e) {
       root.Fail("sumo_config", e.what());
     }
+    s->network = in->net_file.string();
+    for (const auto& f : in->route_files) s->route_files.push_back(f.string());
+    for (const auto& f : in->additional_files) s->additional_files.push_back(f.string());
+    if (in->remote_port)
+      s->warnings.push_back(root.file() + ": key 'sumo_config': its <remote-port value=\"" +
+                            *in->remote_port +
+                            "\"/> (TraCI) is not opened: dualgrid runs SUMO in process "
+                            "(libsumo) and waits for no client");
   } else {
     root.Require("network", &s->network);
   }
-  // A network given as a file (ending in .xml) is read relative to the scenario file, so a
-  // scenario and its network can move together; a bare name is one of the built networks.
+  // A network given as a file (ending in .xml or .xodr) is read relative to the scenario file, so
+  // a scenario and its network can move together; a bare name is one of the built networks.
   if (const std::filesystem::path net(s->network);
-      sim::IsNetworkPath(s->network) && net.is_relative())
+      (sim::IsNetworkPath(s->network) || sim::IsOpenDrive(s->network)) && net.is_relative())
     s->network = relative_to_file(s->network);
+  if (sim::IsOpenDrive(s->network)) {
+    s->network_source = s->network;
+    try {
+      s->network = sim::ConvertOpenDrive(s->network).string();
+    } catch (const std::exception& e) {
+      root.Fail("network", e.what());
+    }
+  }
+  ReadBegin(root, in ? &*in : nullptr, s);
   root.Read("duration", &s->duration);
   root.Read("step_length", &s->step_length);
-  if (cfg_step && *cfg_step != s->step_length)
-    s->warnings.push_back(root.file() + ": key 'sumo_config': its step-length " + Shown(*cfg_step) +
-                          " s is replaced by step_length " + Shown(s->step_length) +
-                          " s (the radar cycle)");
-  root.Read("seed", &s->seed);
-  root.Read("lane_change_duration", &s->lane_change_duration);
+  if (in && in->step_length && *in->step_length != s->step_length)
+    s->warnings.push_back(root.file() + ": key 'sumo_config': its step-length " +
+                          Shown(*in->step_length) + " s is replaced by step_length " +
+                          Shown(s->step_length) + " s (the radar cycle)");
+}
 
-  for (auto& [name, r] : root.NamedMaps("vehicle_types")) {
-    sim::VehicleTypeSpec t;
-    r.Read("length", &t.length);
-    r.Read("width", &t.width);
-    r.Read("max_speed", &t.max_speed);
-    r.Read("accel", &t.accel);
-    r.Read("decel", &t.decel);
-    r.Read("rcs_dbsm", &t.rcs_dbsm);
-    r.Read("vclass", &t.vclass);
-    r.Read("overtake_right", &t.overtake_right);
-    r.Finish();
-    s->vehicle_types[name] = t;
-  }
-  if (s->vehicle_types.empty()) s->vehicle_types["car"] = {};
-
-  if (auto routes = root.Map("routes")) {
-    // Each route is a list of edge ids under its name.
-    for (const std::string& name : routes->Keys()) routes->Read(name, &s->routes[name]);
-    routes->Finish();
-  }
-
+// `ego`: a vehicle the scenario places, or `from_routes` (a vehicle of the user's files, or auto).
+void ReadEgo(MapReader& root, sim::ScenarioSpec* s) {
   auto ego = root.Map("ego");
   if (!ego) root.Fail("ego", "is required");
   s->ego.id = "ego";
@@ -114,7 +119,10 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
     s->ego_speed.speed = s->ego.speed;
   }
   ego->Finish();
+}
 
+// `traffic`: the user's SUMO files, RCS per vType, the scenario's vehicles and flows, random trips.
+void ReadTraffic(MapReader& root, const PathFn& relative_to_file, sim::ScenarioSpec* s) {
   if (auto traffic = root.Map("traffic")) {
     std::vector<std::string> files;
     traffic->Read("route_files", &files);
@@ -151,9 +159,27 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
       r.Finish();
       s->flows.push_back(f);
     }
+    if (traffic->Has("random_trips")) {
+      sim::RandomTripsSpec trips;
+      if (auto r = traffic->Map("random_trips")) {
+        r->Read("period", &trips.period);
+        r->Finish();
+      }
+      if (!(trips.period > 0.0 && trips.period <= 3600.0))
+        traffic->Fail("random_trips",
+                      "expected a period in (0, 3600] s, got " + Shown(trips.period));
+      s->random_trips = trips;
+    }
     traffic->Finish();
   }
+  // A scenario that gives no traffic at all and lets `auto` choose the ego gets random traffic.
+  if (s->ego_from_routes && s->ego.id == sim::kAutoEgo && s->route_files.empty() &&
+      s->additional_files.empty() && s->vehicles.empty() && s->flows.empty())
+    if (!s->random_trips) s->random_trips = sim::RandomTripsSpec{};
+}
 
+// `actions` and `obstacles`.
+void ReadActionsAndObstacles(MapReader& root, sim::ScenarioSpec* s) {
   for (auto& r : root.MapList("actions")) {
     sim::ActionSpec a;
     r.Read("time", &a.time);
@@ -189,6 +215,44 @@ void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
     }
     obstacles->Finish();
   }
+}
+
+}  // namespace
+
+void ReadSim(MapReader& root, sim::ScenarioSpec* s) {
+  root.Read("name", &s->name);
+  root.Read("description", &s->description);
+  const std::filesystem::path here = std::filesystem::path(root.file()).parent_path();
+  const PathFn relative_to_file = [&](const std::string& p) {
+    return std::filesystem::absolute(here / p).lexically_normal().string();
+  };
+  ReadSources(root, relative_to_file, s);
+  root.Read("seed", &s->seed);
+  root.Read("lane_change_duration", &s->lane_change_duration);
+
+  for (auto& [name, r] : root.NamedMaps("vehicle_types")) {
+    sim::VehicleTypeSpec t;
+    r.Read("length", &t.length);
+    r.Read("width", &t.width);
+    r.Read("max_speed", &t.max_speed);
+    r.Read("accel", &t.accel);
+    r.Read("decel", &t.decel);
+    r.Read("rcs_dbsm", &t.rcs_dbsm);
+    r.Read("vclass", &t.vclass);
+    r.Read("overtake_right", &t.overtake_right);
+    r.Finish();
+    s->vehicle_types[name] = t;
+  }
+  if (s->vehicle_types.empty()) s->vehicle_types["car"] = {};
+
+  if (auto routes = root.Map("routes")) {
+    // Each route is a list of edge ids under its name.
+    for (const std::string& name : routes->Keys()) routes->Read(name, &s->routes[name]);
+    routes->Finish();
+  }
+  ReadEgo(root, s);
+  ReadTraffic(root, relative_to_file, s);
+  ReadActionsAndObstacles(root, s);
 }
 
 // The user's SUMO route and additional files, indexed once (std::nullopt when there are none):
@@ -238,6 +302,7 @@ std::optional<sim::RouteFileIndex> IndexUserFiles(MapReader& root, const std::st
                         " (expected a vehicle, a trip, FLOW.k for a flow's k-th vehicle, or "
                         "auto; e.g. " +
                         sim::ExampleVehicleIds(index) + ")");
+    s.ego_departure = sim::DepartureOf(index, ego);  // checked against the run's window
   }
   return index;
 }
