@@ -21,6 +21,11 @@ bool ViewBox::Contains(const Vector2& offset, double yaw) const {
 }
 
 std::string AutoEgoChoice::Reason() const {
+  if (with_traffic == 0)
+    return "no road vehicle of the route files ever had another vehicle in its grid (" +
+           std::to_string(candidates) +
+           " candidates): nothing can be scored; chose the one longest in the run (" +
+           FormatFixed(in_run_s, 1) + " s)";
   return "the road vehicle of the route files with another vehicle in its grid longest (" +
          FormatFixed(seen_s, 1) + " s of its " + FormatFixed(in_run_s, 1) + " s in the run; " +
          std::to_string(with_traffic) + " of " + std::to_string(candidates) +

@@ -14,7 +14,9 @@ namespace dualgrid::sim {
 /// road vehicles (not pedestrians, trams, trains, ships) of the user's files that depart in the
 /// run. The chosen one has another road vehicle in its spec.auto_ego_view for the most steps;
 /// ties go to the longer time in the run (a vehicle that never arrives stays to the end), then
-/// to the earlier departure. std::nullopt when no candidate departed. Throws what libsumo throws.
+/// to the earlier departure (so with no traffic anywhere: the longest in the run, and the
+/// choice's with_traffic is 0). std::nullopt when no candidate departed. Throws what libsumo
+/// throws.
 std::optional<AutoEgoChoice> ChooseAutoEgo(const ScenarioSpec& spec,
                                            const std::vector<std::string>& args);
 

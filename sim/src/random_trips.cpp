@@ -22,7 +22,7 @@ std::filesystem::path WriteRandomTrips(const std::filesystem::path& network,
                    (work_dir / "random_trips.trips.xml").string(), "--route-file", routes.string(),
                    "--seed", std::to_string(spec.seed % 2147483647), "--begin", num(spec.begin),
                    "--end", num(spec.begin + spec.duration), "--period",
-                   num(spec.random_trips->period), "--prefix", "rt"},
+                   num(spec.random_trips->period), "--prefix", "rt", "--allow-fringe"},
                   log);
   if (rc != 0 || !fs::is_regular_file(routes))
     throw std::invalid_argument("traffic.random_trips: randomTrips.py failed on " +

@@ -234,18 +234,13 @@ std::string RunWindow(const ScenarioSpec& spec) {
 
 namespace {
 
-// Why `auto` found no ego: no road vehicle departed in the run, or none ever had another vehicle
-// in its grid (a scene of one vehicle: nothing could be scored).
-std::string NoAutoEgo(const ScenarioSpec& spec, const std::optional<AutoEgoChoice>& choice) {
-  const std::string head = "scenario '" + spec.name + "': ego.from_routes is auto, but ";
-  if (!choice)
-    return head + "no road vehicle of the route files departed within " + RunWindow(spec) +
-           (spec.begin > 0.0 ? "" : "; a scenario that starts later needs `begin` or --begin") +
-           " (vehicles that depart before the begin are skipped, as SUMO skips them)";
-  return head + "no vehicle ever had another vehicle in its grid within " + RunWindow(spec) + " (" +
-         std::to_string(choice->candidates) +
-         " road vehicle(s) departed): nothing could be scored; give more traffic, a longer "
-         "duration, or a larger grid (filter.length_x, filter.width_y)";
+// Why `auto` found no ego: no road vehicle departed in the run.
+std::string NoAutoEgo(const ScenarioSpec& spec) {
+  return "scenario '" + spec.name +
+         "': ego.from_routes is auto, but no road vehicle of the route files departed within " +
+         RunWindow(spec) +
+         (spec.begin > 0.0 ? "" : "; a scenario that starts later needs `begin` or --begin") +
+         " (vehicles that depart before the begin are skipped, as SUMO skips them)";
 }
 
 }  // namespace
@@ -287,7 +282,7 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
       auto_choice_ =
           ChooseAutoEgo(spec_, SumoArgs(spec_, network_file, route_files, additional_list,
                                         work_dir / "sumo_auto_ego.log"));
-      if (auto_choice_ && auto_choice_->seen_s > 0.0) spec_.ego.id = auto_choice_->id;
+      if (auto_choice_) spec_.ego.id = auto_choice_->id;
     }
     if (!spec_.ego_from_routes || spec_.ego.id != kAutoEgo)
       libsumo::Simulation::start(
@@ -301,7 +296,7 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
   }
   if (spec_.ego.id == kAutoEgo && spec_.ego_from_routes) {
     g_simulation_alive = false;
-    throw std::invalid_argument(NoAutoEgo(spec_, auto_choice_));
+    throw std::invalid_argument(NoAutoEgo(spec_));
   }
   try {
     CheckAgainstNetwork();

@@ -65,6 +65,9 @@ std::string FirstErrorLine(const std::filesystem::path& log) {
   }
   if (!python_error.empty() && last.rfind("Error:", 0) != 0) last = python_error;
   if (last.size() > 300) last = last.substr(0, 297) + "...";
+  // The tool may quote the bytes of a binary input: one printable line.
+  for (char& c : last)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
   return last;
 }
 

@@ -344,8 +344,13 @@ void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& 
 
 void NoteAutoEgo(const cosim::Pipeline& pipeline, bool quiet) {
   const sim::ScenarioSpec& spec = pipeline.config().sim;
-  if (quiet || !spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return;
+  if (!spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return;
   const auto& choice = pipeline.simulation().auto_ego_choice();
+  // A scene where no vehicle ever sees another is said even under -q: its results are empty.
+  if (choice && choice->with_traffic == 0)
+    std::cerr << "dualgrid: warning: ego: auto chose '" << choice->id << "', but "
+              << choice->Reason() << "\n";
+  if (quiet) return;
   std::cerr << "dualgrid: ego: auto chose '" << pipeline.simulation().ego_id() << "' ("
             << (choice ? choice->Reason() : std::string()) << "; docs/scenarios.md)\n";
 }

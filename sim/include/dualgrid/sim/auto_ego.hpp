@@ -26,7 +26,8 @@ struct AutoEgoChoice {
   double depart_s = 0.0;         ///< [s, SUMO time] its departure
   std::size_t candidates = 0;    ///< road vehicles of the files that departed in the run
   std::size_t with_traffic = 0;  ///< of which ever had another vehicle in their ViewBox
-  /// The rule and the numbers, in one sentence.
+  /// The rule and the numbers, in one sentence; says that nothing can be scored when no
+  /// candidate ever had traffic in its grid (a scene of one vehicle).
   std::string Reason() const;
 };
 

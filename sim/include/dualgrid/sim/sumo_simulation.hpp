@@ -60,9 +60,9 @@ class SumoSimulation {
   /// additional files that declare outputs (sumo_additional/) and those outputs (sumo_outputs/).
   /// SUMO starts at spec.begin (SUMO time) and runs spec.duration. With `ego: {from_routes:
   /// auto}` a first run of SUMO over that window chooses the ego (auto_ego.hpp,
-  /// docs/scenarios.md); it throws std::invalid_argument when no vehicle departs in the window or
-  /// none ever has another vehicle in its grid. Throws std::invalid_argument with a one-line
-  /// message for input SUMO refuses, std::runtime_error when a file cannot be written.
+  /// docs/scenarios.md); it throws std::invalid_argument when no vehicle departs in the window.
+  /// Throws std::invalid_argument with a one-line message for input SUMO refuses,
+  /// std::runtime_error when a file cannot be written.
   SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                  const std::filesystem::path& work_dir);
   ~SumoSimulation();

@@ -21,7 +21,8 @@ int RunSumoTool(const std::vector<std::string>& args, const std::filesystem::pat
 
 /// The first line of a SUMO program's log that reports an error ("Error: ..." for sumo and
 /// netconvert, a Python traceback's last line for the Python tools), else its last non-empty
-/// line; "" for an empty or unreadable log. Trimmed to one line of at most 300 characters.
+/// line; "" for an empty or unreadable log. Trimmed to one line of at most 300 characters, bytes
+/// outside printable ASCII shown as '?' (a tool may quote a binary input's bytes).
 std::string FirstErrorLine(const std::filesystem::path& log);
 
 }  // namespace dualgrid::sim
