@@ -10,13 +10,7 @@
 set -uo pipefail
 dualgrid=$(realpath "$1")
 netconvert=$2
-export SUMO_HOME=${SUMO_HOME:-/usr/share/sumo}
-work=$(mktemp -d "${TMPDIR:-/tmp}/dualgrid_auto_sparse.XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-failed=0
-fail() { echo "FAIL: $*"; failed=1; }
-json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+source "$(dirname "$0")/run_checks.sh" auto_sparse
 
 {
   echo '<nodes>'
@@ -58,7 +52,7 @@ python3 -c "import sys; sys.exit(0 if $(json $s "d['ego_choice']['seen_s']") > 2
   fail "the chosen ego saw traffic for $(json $s "d['ego_choice']['seen_s']") s only"
 json $s "d['ego_choice']['reason']" | grep -q "with another vehicle in its grid longest" ||
   fail "no reason in summary.json"
-scored=$(python3 -c "import json; t=json.load(open('run/table.json')); print([m for m in t['metrics'] if m['key']=='objects_scored'][0]['values']['dual']['mean'])")
+scored=$(scored run)
 python3 -c "import sys; sys.exit(0 if $scored >= 1 else 1)" || fail "objects scored: $scored"
 # The rule can fail: lonely stays the whole 60 s (its route is 1.6 km at 13.9 m/s), so a rule by
 # time in the run alone picks it; the pair leaves after about 25 s.

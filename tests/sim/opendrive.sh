@@ -15,16 +15,9 @@ if [ ! -f "$SUMO_HOME/tools/randomTrips.py" ]; then
   echo "SKIP: sumo-tools (randomTrips.py) is not installed"
   exit 77
 fi
-work=$(mktemp -d "${TMPDIR:-/tmp}/dualgrid_opendrive.XXXXXX")
-trap 'rm -rf "$work"' EXIT
+source "$here/run_checks.sh" opendrive
 export DUALGRID_CACHE_DIR=$work/cache
 mkdir -p "$work/maps" && cd "$work/maps" || exit 1
-failed=0
-fail() { echo "FAIL: $*"; failed=1; }
-json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
-scored() {
-  python3 -c "import json,sys; t=json.load(open(sys.argv[1])); print([m for m in t['metrics'] if m['key']=='objects_scored'][0]['values']['dual']['mean'])" "$1/table.json"
-}
 for kind in straight curves junction; do python3 "$here/write_xodr.py" "$kind" "$kind.xodr"; done
 listing() { find "$work/maps" -type f -printf '%P %s %T@\n' | sort; }
 

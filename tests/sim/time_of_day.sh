@@ -9,13 +9,7 @@
 set -uo pipefail
 dualgrid=$(realpath "$1")
 netconvert=$2
-export SUMO_HOME=${SUMO_HOME:-/usr/share/sumo}
-work=$(mktemp -d "${TMPDIR:-/tmp}/dualgrid_time_of_day.XXXXXX")
-trap 'rm -rf "$work"' EXIT
-cd "$work" || exit 1
-failed=0
-fail() { echo "FAIL: $*"; failed=1; }
-json() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+source "$(dirname "$0")/run_checks.sh" time_of_day
 
 cat >road.nod.xml <<'X'
 <nodes>
@@ -81,7 +75,7 @@ ego=$(json $s "d['ego']")
 case "$ego" in car* | oncoming.*) ;; *) fail "auto chose '$ego', expected one of the morning's vehicles" ;; esac
 grep -q "auto chose '$ego' (the road vehicle of the route files with another vehicle in its grid longest" run1.log ||
   fail "the choice and its reason are not printed: $(grep auto run1.log)"
-scored=$(python3 -c "import json; t=json.load(open('run1/table.json')); print([m for m in t['metrics'] if m['key']=='objects_scored'][0]['values']['dual']['mean'])")
+scored=$(scored run1)
 python3 -c "import sys; sys.exit(0 if $scored >= 1 else 1)" || fail "objects scored: $scored, expected >= 1"
 # Outputs are in run time: the ground truth's first time is within the 40 s, not 25200 s.
 first=$(awk -F, 'NR == 2 {print $2; exit}' run1/ground_truth.csv)
