@@ -39,12 +39,16 @@ X
   echo '  <flow id="oncoming" begin="25200" end="25300" period="10" route="w"/>'
   echo '</routes>'
 } >morning.rou.xml
+# A detector whose output goes into the run folder (a relative --out, as users type it).
+printf '<additional>\n  <inductionLoop id="loop" lane="east_0" pos="100" period="60" file="loop.xml"/>\n</additional>\n' \
+  >detector.add.xml
 port=$((20000 + $$ % 20000))
 cat >morning.sumocfg <<X
 <configuration>
   <input>
     <net-file value="road.net.xml"/>
     <route-files value="morning.rou.xml"/>
+    <additional-files value="detector.add.xml"/>
   </input>
   <time>
     <begin value="25200"/>
@@ -82,9 +86,10 @@ first=$(awk -F, 'NR == 2 {print $2; exit}' run1/ground_truth.csv)
 python3 -c "import sys; sys.exit(0 if 0 <= $first <= 40 else 1)" ||
   fail "ground_truth.csv's first time $first is not run time"
 # Nothing written beside the configuration's files.
-[ "$(ls | grep -v -E '^(run1|run1.log|road\.(nod|edg|net)\.xml|netconvert\.log|morning\.(rou\.xml|sumocfg|yaml))$')" = "" ] ||
+[ "$(ls | grep -v -E '^(run1|run1.log|road\.(nod|edg|net)\.xml|netconvert\.log|morning\.(rou\.xml|sumocfg|yaml)|detector\.add\.xml)$')" = "" ] ||
   fail "files beside the configuration: $(ls)"
 
+[ -s run1/sumo_outputs/loop.xml ] || fail "the detector's output is not in run1/sumo_outputs/"
 # 2. `begin` in the scenario and --begin on the command line override the configuration's.
 timeout 300 "$dualgrid" run morning.yaml --modes dual --no-figures --no-record --set begin=25210 \
   --duration 10 --out run2 -q >run2.log 2>&1 || fail "--set begin=25210: $(tail -n 1 run2.log)"
