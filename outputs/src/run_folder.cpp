@@ -84,8 +84,9 @@ bool FaultInjected(const std::string& what) {
 std::string AutoEgoNote(const cosim::Pipeline& pipeline) {
   const sim::ScenarioSpec& spec = pipeline.config().sim;
   if (!spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return "";
-  return "ego: auto chose '" + pipeline.simulation().ego_id() +
-         "' (the road vehicle of the route files longest in the run; docs/scenarios.md)";
+  const auto& choice = pipeline.simulation().auto_ego_choice();
+  return "ego: auto chose '" + pipeline.simulation().ego_id() + "' (" +
+         (choice ? choice->Reason() : std::string()) + "; docs/scenarios.md)";
 }
 
 nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status) {
@@ -99,7 +100,18 @@ nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::st
   nlohmann::json r = {{"complete", !stop_signal && ended},
                       {"ego", sumo ? sumo->ego_id() : spec.ego.id},
                       {"ego_departed_s", first},
-                      {"ended_s", last}};
+                      {"ended_s", last},
+                      {"begin_s", spec.begin},
+                      {"begin_source", spec.begin_source}};
+  if (!spec.network_source.empty()) r["network_source"] = spec.network_source;
+  if (const auto& choice = sumo ? sumo->auto_ego_choice() : std::nullopt)
+    r["ego_choice"] = {{"rule", "auto"},
+                       {"reason", choice->Reason()},
+                       {"seen_s", choice->seen_s},
+                       {"in_run_s", choice->in_run_s},
+                       {"depart_sumo_s", choice->depart_s},
+                       {"candidates", choice->candidates},
+                       {"with_traffic", choice->with_traffic}};
   // Where SUMO wrote the outputs that the user's additional files declare.
   r["sumo_outputs"] = nlohmann::json::array();
   if (sumo)
@@ -113,13 +125,15 @@ nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::st
   if (stop_signal) {
     r["end"] = "signal";
     *status = "Incomplete run: stopped by signal " + std::to_string(stop_signal) +
-              " at t = " + FormatFixed(last, 2) + " s of " + FormatFixed(spec.duration, 2) + " s";
+              " at t = " + FormatFixed(last, 2) + " s of " + FormatFixed(spec.duration, 2) +
+              " s (run time; SUMO time " + FormatFixed(spec.begin + last, 2) + " s)";
   } else if (sumo && sumo->ego_left()) {
     r["end"] = "ego_left";
     *status = "Shorter run than asked: the ego '" + sumo->ego_id() +
               "' left the network at t = " + FormatFixed(last, 2) + " s of " +
-              FormatFixed(spec.duration, 2) +
-              " s (its route ended there); the results cover its time in the network";
+              FormatFixed(spec.duration, 2) + " s (run time; SUMO time " +
+              FormatFixed(spec.begin + last, 2) +
+              " s; its route ended there); the results cover its time in the network";
   } else {
     r["end"] = "duration";
   }

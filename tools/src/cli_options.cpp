@@ -1,11 +1,12 @@
 #include "cli_options.hpp"
 
 #include "dualgrid/outputs/run_config.hpp"
+#include "dualgrid/sim/scenario.hpp"
 
 namespace dualgrid::tools {
 
 scenario::ScenarioConfig LoadConfig(const RunOptions& o) {
-  return outputs::LoadRunConfig(o.scenario, o.sets, o.seed, o.duration);
+  return outputs::LoadRunConfig(o.scenario, o.sets, o.seed, o.duration, o.begin);
 }
 
 outputs::RunFolderOptions FilterRunOptions::FolderOptions() const {
@@ -27,6 +28,10 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
   cmd->add_option("--duration", o->duration,
                   "Simulated time [s] (default: the scenario's `duration`)")
       ->check(Number(0.0, kMaxDuration, true));
+  cmd->add_option("--begin", o->begin,
+                  "SUMO time [s] at which the run begins (default: the scenario's `begin`, else "
+                  "its sumo_config's <begin>, else 0); --duration counts from it")
+      ->check(Number(0.0, sim::kMaxBegin, false));
   Opt(cmd, "--network-dir", &o->network_dir,
       "Folder of the built networks named in scenarios (`network: highway`)")
       ->check(CLI::ExistingDirectory);

@@ -50,6 +50,7 @@ std::vector<std::string> RunArgs(const ExperimentOptions& o, std::uint64_t seed,
                                    "--network-dir",
                                    o.run.run.network_dir.string()};
   if (o.run.run.duration) args.insert(args.end(), {"--duration", Exact(*o.run.run.duration)});
+  if (o.run.run.begin) args.insert(args.end(), {"--begin", Exact(*o.run.run.begin)});
   for (const std::string& set : o.run.run.sets) args.insert(args.end(), {"--set", set});
   std::string modes;
   for (const auto& m : o.run.modes) modes += (modes.empty() ? "" : ",") + m;

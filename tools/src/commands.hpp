@@ -25,6 +25,7 @@ struct RunOptions {
   std::filesystem::path out;
   std::optional<std::uint64_t> seed;
   std::optional<double> duration;
+  std::optional<double> begin;  ///< [s, SUMO time] --begin: where SUMO starts
   std::filesystem::path network_dir;
   bool quiet = false;
   /// `--set KEY=VALUE` overrides of scenario keys, in order (scenario::Override).

@@ -15,13 +15,15 @@
 namespace dualgrid::outputs {
 
 /// Loads `scenario` with the `sets` overrides ("KEY=VALUE", scenario::ParseOverride, applied in
-/// order and kept in config.overrides), then the `seed` and `duration` [s] when given. The loader's
+/// order and kept in config.overrides), then the `seed`, `duration` [s] and `begin` [s, SUMO time]
+/// when given (`begin` from here is recorded as coming from the command line). The loader's
 /// warnings go to stderr. Throws scenario::ConfigError / std::invalid_argument naming the file and
 /// key of bad input, including overrides that break the scenario's validation.
 scenario::ScenarioConfig LoadRunConfig(const std::filesystem::path& scenario,
                                        const std::vector<std::string>& sets,
                                        std::optional<std::uint64_t> seed,
-                                       std::optional<double> duration);
+                                       std::optional<double> duration,
+                                       std::optional<double> begin = std::nullopt);
 
 /// Writes out/scenario.yaml: the scenario file as used, headed by the overrides and the resolved
 /// network, so a run can be repeated. Throws std::runtime_error naming the file when a write fails.
