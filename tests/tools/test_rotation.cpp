@@ -32,7 +32,13 @@ struct Turned {
   double c, s;
   std::string X(double x, double y) const { return Num(c * x - s * y); }
   std::string Y(double x, double y) const { return Num(s * x + c * y); }
-  std::string Point(double x, double y) const { return "[" + X(x, y) + ", " + Y(x, y) + "]"; }
+  std::string Point(double x, double y) const {
+    std::string p = "[";
+    p += X(x, y);
+    p += ", ";
+    p += Y(x, y);
+    return p += "]";
+  }
   static std::string Num(double v) {
     std::ostringstream os;
     os.precision(12);
@@ -65,10 +71,15 @@ fs::path WriteScene(const fs::path& dir, double deg, bool bend = false, double d
   // of place): --offset.disable-normalization keeps the coordinates.
   const auto line = RoadLine(bend);
   std::string shape, back;
-  for (const auto& [x, y] : line) shape += (shape.empty() ? "" : " ") + t.X(x, y) + "," + t.Y(x, y);
-  for (auto it = line.rbegin(); it != line.rend(); ++it)
-    back +=
-        (back.empty() ? "" : " ") + t.X(it->first, it->second) + "," + t.Y(it->first, it->second);
+  // "x,y" pairs separated by spaces.
+  const auto add = [&t](std::string* to, double x, double y) {
+    if (!to->empty()) *to += ' ';
+    *to += t.X(x, y);
+    *to += ',';
+    *to += t.Y(x, y);
+  };
+  for (const auto& [x, y] : line) add(&shape, x, y);
+  for (auto it = line.rbegin(); it != line.rend(); ++it) add(&back, it->first, it->second);
   const auto [ex, ey] = line.back();
   std::ofstream(dir / "road.nod.xml")
       << "<nodes>\n"

@@ -1,10 +1,8 @@
 // Parallel loops that cost nothing when they would run on one thread anyway.
 //
-// An OpenMP region that gets one thread still builds a team and runs its barriers: inside the
-// co-simulation's per-mode threads (nesting off) each such region cost about 4 us and two futex
-// calls on this project's 2-core machine, about 1.2 us at the top level with one thread
-// (docs/performance.md, "Issue 25, round 5"); the filter opens about ten per cycle. ParallelFor
-// runs the loop plainly then. Compiled without OpenMP (_OPENMP undefined) every loop is plain.
+// An OpenMP region that gets one thread still builds a team and runs its barriers (a few
+// microseconds each; measured in docs/performance.md). ParallelFor runs the loop plainly when it
+// would get one thread. Compiled without OpenMP (_OPENMP undefined) every loop is plain.
 #pragma once
 
 #include <cstdint>

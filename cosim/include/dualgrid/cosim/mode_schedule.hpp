@@ -2,9 +2,9 @@
 // Which thread filters and scores which weight mode in one co-simulation step.
 //
 // Fixed for a given (modes, threads, costs), so that a filter runs on the same thread every step
-// and its state stays in that core's cache (docs/performance.md, "Issue 25, round 3"); the
-// co-simulation re-plans it from measured filter times now and then (round 5). Results never
-// depend on it: every value is computed by one thread from the same inputs.
+// and its state stays in that core's cache; the co-simulation re-plans it from measured filter
+// times now and then (docs/performance.md). Results never depend on it: every value is computed
+// by one thread from the same inputs.
 #include <span>
 #include <vector>
 
