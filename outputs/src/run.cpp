@@ -50,7 +50,7 @@ std::vector<double> SnapshotTimes(const std::vector<double>& requested,
     if (!(t > 0.0 && t <= config.sim.duration))
       throw std::invalid_argument("--snapshots: time " + FormatFixed(t, 2) +
                                   " s is outside the run (0, " +
-                                  FormatFixed(config.sim.duration, 2) + "] s");
+                                  FormatFixed(config.sim.duration, 2) + "] s of run time");
   return times;
 }
 

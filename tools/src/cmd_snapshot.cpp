@@ -24,9 +24,10 @@ int RunSnapshot(const SnapshotOptions& options) {
                                 "' is a folder; give a .png, .svg or .pdf file name");
   scenario::ScenarioConfig config = LoadConfig(run);
   if (!(options.time >= config.sim.step_length && options.time <= config.sim.duration))
-    throw std::invalid_argument("--time must be in [" + FormatFixed(config.sim.step_length, 2) +
-                                ", " + FormatFixed(config.sim.duration, 2) +
-                                "] s (one step to the duration)");
+    throw std::invalid_argument(
+        "--time must be in [" + FormatFixed(config.sim.step_length, 2) + ", " +
+        FormatFixed(config.sim.duration, 2) +
+        "] s of run time (one step to the duration, counted from the begin)");
   config.sim.duration = options.time;
   // SUMO's route file and log are working files of this command only: a temporary folder,
   // removed afterwards (kept, and named, only if SUMO fails, for its log).
