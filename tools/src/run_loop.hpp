@@ -14,9 +14,11 @@ namespace dualgrid::tools {
 
 /// What `filter` adds to a run folder: where its detections came from.
 struct RecordedRun {
-  nlohmann::json input;  ///< summary.json's `input`: the files, scans, cycles, skips, labels
-  bool labels = false;   ///< the data carry labels (point scores and tracks)
+  nlohmann::json input;    ///< summary.json's `input`: the files, scans, cycles, skips, labels
+  bool labels = false;     ///< the data carry labels (point scores and tracks)
+  bool annotated = false;  ///< the references are the data set's annotated boxes (nuScenes)
   std::size_t skipped_points = 0;
+  std::vector<std::string> notes;  ///< the reader's notes for the table
 };
 
 /// Runs `cosim` to its end and writes the run folder options.run.out: the files while it runs,

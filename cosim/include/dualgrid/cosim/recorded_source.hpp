@@ -32,6 +32,8 @@ struct RecordedScan {
   Velocity ego_velocity = Velocity::Zero();  ///< of the box centre [m/s]
   double ego_yaw_rate = 0.0;                 ///< [rad/s]
   double lane_yaw = 0.0;  ///< the road's direction [rad]: the heading unless the data say
+  /// Its reference objects (annotated data): RecordedSequence::references[ref_begin, ref_end).
+  std::size_t ref_begin = 0, ref_end = 0;
 };
 
 /// A recorded sequence, validated by its reader: scans in non-decreasing time, every point index
@@ -51,6 +53,11 @@ struct RecordedSequence {
   std::int64_t time_origin_us = 0;
   /// Detections dropped by the reader (NaN position or velocity), for the run's notes.
   std::size_t skipped_points = 0;
+  /// The data set's own reference objects (nuScenes' annotated boxes, interpolated by the
+  /// reader to each scan's time; id = instance token, type = category). When `annotated`, a
+  /// cycle's vehicles are its first scan's references, not boxes estimated from track points.
+  bool annotated = false;
+  std::vector<sim::VehicleState> references;
 
   double Time(std::int64_t timestamp_us) const {
     return static_cast<double>(timestamp_us - time_origin_us) / 1e6;
