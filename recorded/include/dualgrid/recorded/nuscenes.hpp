@@ -88,18 +88,26 @@ struct NuScenesKeyFrame {
   std::vector<sim::VehicleState> vehicles;  ///< id, box, velocity; type = category name
 };
 
-/// Writes `seq` as scene `scene_name` of ROOT/`version`: its scans as the five channels'
-/// sample_data (the sensor whose mount points most nearly along a channel's direction becomes
-/// it; exactly five sensors needed), `key_frames` as the samples with their annotations (each
-/// channel's scan nearest a key frame is its key frame), `scenario` (a scenario file, optional)
-/// copied beside the tables and named in dualgrid.json. Throws std::invalid_argument when the
-/// sequence does not fit (not five radars, no key frame) and std::runtime_error naming the file
-/// when a write fails.
+struct NuScenesWriteOptions {
+  std::string version = "v1.0-mini";  ///< the version folder
+  std::string scene = "scene-0001";   ///< the scene's name
+  /// A scenario file copied beside the tables and named in dualgrid.json (the run's settings
+  /// travel with the export), or none.
+  std::optional<std::filesystem::path> scenario;
+  /// Positions and velocities in the PCD files as float64 (the devkit reads either; the
+  /// published files have float32, which round the run's values: docs/recorded-data.md).
+  bool float64 = false;
+};
+
+/// Writes `seq` as one scene of ROOT/options.version: its scans as the five channels'
+/// sample_data (the assignment of sensors to the channels' directions with the least summed
+/// angle; exactly five sensors needed), `key_frames` as the samples with their annotations (each
+/// channel's scan nearest a key frame is its key frame; the others are sweeps of the next
+/// sample). Throws std::invalid_argument when the sequence does not fit (not five radars, no key
+/// frame) and std::runtime_error naming the file when a write fails.
 void WriteNuScenes(const cosim::RecordedSequence& seq,
                    const std::vector<NuScenesKeyFrame>& key_frames,
-                   const std::filesystem::path& root, const std::string& version,
-                   const std::string& scene_name,
-                   const std::optional<std::filesystem::path>& scenario);
+                   const std::filesystem::path& root, const NuScenesWriteOptions& options);
 
 /// nuScenes' category of RadarScenes label `label` (docs/recorded-data.md) and back (-1 for a
 /// category that is no vehicle).
