@@ -70,6 +70,8 @@ scenario::ScenarioConfig RecordedConfig(const FilterRunOptions& o) {
 void NuScenesInput(const recorded::NuScenesScene& n, const cosim::RecordedSequence& seq,
                    RecordedRun* r) {
   r->input["scene_token"] = n.scene_token;
+  for (const recorded::NuScenesAnnotation& a : n.annotations)
+    r->categories[a.instance] = a.category;
   r->input["sample_data"] = n.sample_data;
   r->input["filtered_points"] = n.filtered_points;
   r->input["empty_clouds"] = n.empty_clouds;

@@ -149,7 +149,9 @@ int RunLoop(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
   for (const auto& o : metrics.front().objects)
     mj["object_names"][std::to_string(o.id)] = ids.Name(o.id);
   WriteTextFile(out / "metrics.json", mj.dump(2) + "\n");
-  WriteObjects(mode_names, metrics, ids, out / "objects.csv");
+  WriteObjects(
+      mode_names, metrics, ids, out / "objects.csv",
+      recorded_run && !recorded_run->categories.empty() ? &recorded_run->categories : nullptr);
   eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
   table.SetStatus(status);
   for (std::string& note :

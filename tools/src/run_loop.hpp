@@ -2,6 +2,7 @@
 // CoSimulation, whatever its detection source, with the same observers and writers.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,8 @@ struct RecordedRun {
   bool annotated = false;  ///< the references are the data set's annotated boxes (nuScenes)
   std::size_t skipped_points = 0;
   std::vector<std::string> notes;  ///< the reader's notes for the table
+  /// Annotated data: each reference object's category (objects.csv's last column).
+  std::map<std::string, std::string> categories;
 };
 
 /// Runs `cosim` to its end and writes the run folder options.run.out: the files while it runs,
