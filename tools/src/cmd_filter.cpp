@@ -141,6 +141,7 @@ int RunFilterCommand(FilterInputOptions o) {
     if (!o.run.run.quiet)
       std::cout << "filter settings: " << in.scenario->string() << " (travelled with the export)\n";
   }
+  o.run.references = in.sequence.annotated ? "annotated" : "tracks";
   scenario::ScenarioConfig config = RecordedConfig(o.run);
   const cosim::RecordedSequence& seq = in.sequence;
   const cosim::RecordedOptions ropts = recorded::FitConfig(seq, o.batch_window, &config);

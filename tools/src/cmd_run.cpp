@@ -188,7 +188,8 @@ int RunLoop(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
             RenderTrackedShares(mode_names, RunTrackedShares(metrics, ids, v),
                                 config.sim.name + ": tracked share " + what + " per object (seed " +
                                     std::to_string(config.sim.seed) + ")",
-                                "tracked share " + what + " [%]", p, {}, options.figure_captions);
+                                "tracked share " + what + " [%]", p, {}, options.figure_captions,
+                                WordsFor(options.references));
           },
           &warnings);
     }

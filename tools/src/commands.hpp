@@ -40,6 +40,9 @@ struct FilterRunOptions {
   std::vector<std::string> figure_formats = {"png", "svg", "pdf"};
   /// Captions under the figures (`--figure-captions on|off`; off for a paper that sets its own).
   bool figure_captions = true;
+  /// What the figures call the reference objects (figures.hpp, WordsFor): "sumo", "annotated"
+  /// (nuScenes) or "tracks" (estimated from labelled points: RadarScenes, run folders).
+  std::string references = "sumo";
   /// detections.csv: "none", "csv" or "csv.gz" (gzip-compressed, about 3.5x smaller).
   std::string detections = "none";
   /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).

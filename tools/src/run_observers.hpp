@@ -105,6 +105,7 @@ class PictureObserver : public cosim::StepObserver {
   bool figures_, particles_;
   std::vector<std::string> formats_;
   bool captions_;
+  ReferenceWords words_;
   std::vector<std::string>* warnings_;
 };
 
