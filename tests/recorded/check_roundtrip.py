@@ -69,6 +69,76 @@ def float32_checks(runs, trip):
     return errors
 
 
+TABLES = ("attribute", "calibrated_sensor", "category", "ego_pose", "instance", "log", "map",
+          "sample", "sample_annotation", "sample_data", "scene", "sensor", "visibility")
+# (table, field, target table): the schema's foreign keys (docs/schema_nuscenes.md).
+KEYS_TO = [("sample", "scene_token", "scene"), ("sample_data", "sample_token", "sample"),
+           ("sample_data", "ego_pose_token", "ego_pose"),
+           ("sample_data", "calibrated_sensor_token", "calibrated_sensor"),
+           ("calibrated_sensor", "sensor_token", "sensor"),
+           ("sample_annotation", "sample_token", "sample"),
+           ("sample_annotation", "instance_token", "instance"),
+           ("sample_annotation", "visibility_token", "visibility"),
+           ("instance", "category_token", "category"),
+           ("instance", "first_annotation_token", "sample_annotation"),
+           ("instance", "last_annotation_token", "sample_annotation"),
+           ("scene", "log_token", "log"), ("scene", "first_sample_token", "sample"),
+           ("scene", "last_sample_token", "sample")]
+
+
+def devkit_pcd(path):
+    """A PCD file read as RadarPointCloud.from_file documents it: fixed header lines, 18
+    fields, the data at least one byte longer than the points."""
+    with open(path, "rb") as f:
+        data = f.read()
+    head, _, body = data.partition(b"DATA binary\n")
+    meta = head.decode().splitlines() + ["DATA binary"]
+    if not (meta[0].startswith("#") and meta[1].startswith("VERSION") and len(meta) == 11):
+        return f"{path}: header lines not as the devkit reads them"
+    sizes = [int(x) for x in meta[3].split()[1:]]
+    width = int(meta[6].split()[1])
+    if len(sizes) != 18 or meta[7] != "HEIGHT 1" or not len(body) > width * sum(sizes):
+        return f"{path}: {len(sizes)} fields, {len(body)} bytes for {width} points"
+    return None
+
+
+def check_nuscenes_export(root):
+    """Every table the devkit loads, every foreign key resolved, prev/next chains consistent,
+    five channels with a key frame in every sample, num_radar_pts counted, PCDs the devkit reads."""
+    t = {}
+    for name in TABLES:
+        with open(os.path.join(root, "v1.0-mini", name + ".json")) as f:
+            t[name] = {r["token"]: r for r in json.load(f)}
+    errors = []
+    for table, field, target in KEYS_TO:
+        bad = [r["token"] for r in t[table].values() if r[field] not in t[target]]
+        if bad:
+            errors.append(f"{table}.{field}: {len(bad)} token(s) point nowhere")
+    for table in ("sample", "sample_data", "sample_annotation"):
+        for r in t[table].values():
+            if (r["next"] and t[table][r["next"]]["prev"] != r["token"]) or \
+                    (r["prev"] and t[table][r["prev"]]["next"] != r["token"]):
+                errors.append(f"{table} {r['token']}: prev/next not mutual")
+                break
+    channels = {t["sensor"][c["sensor_token"]]["channel"] for c in t["calibrated_sensor"].values()}
+    if len(channels) != 5:
+        errors.append(f"channels {sorted(channels)}")
+    keys = {}
+    for r in t["sample_data"].values():
+        if r["is_key_frame"]:
+            keys.setdefault(r["sample_token"], set()).add(r["calibrated_sensor_token"])
+    if any(len(keys.get(s, ())) != 5 for s in t["sample"]):
+        errors.append("a sample without a key frame of each of the five channels")
+    if not sum(a["num_radar_pts"] for a in t["sample_annotation"].values()) > 0:
+        errors.append("num_radar_pts all 0")
+    for r in list(t["sample_data"].values())[:50]:
+        e = devkit_pcd(os.path.join(root, r["filename"]))
+        if e:
+            errors.append(e)
+            break
+    return ["nuScenes export: " + e for e in errors]
+
+
 def reference_error(runs, export, trip):
     """The annotations' reference velocity (2 Hz boxes, the devkit's differences, interpolated)
     against SUMO's truth at every cycle: printed, and bounded (mean < 0.5 m/s: the highway's
@@ -135,6 +205,7 @@ def main():
     e = compare("nuScenes float64", ref, clusters(os.path.join(work, "trip64", "clusters.csv")))
     if e:
         errors.append(e)
+    errors += check_nuscenes_export(ns32)
     errors += float32_checks(os.path.join(work, "trip64"), os.path.join(work, "trip32"))
     errors += reference_error(runs, ns64, os.path.join(work, "trip64"))
     if errors:
