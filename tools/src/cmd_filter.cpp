@@ -171,6 +171,9 @@ int RunFilterCommand(FilterInputOptions o) {
              {"sensors", sensors},
              {"filter_cycle_s", config.filter.cycle},
              {"scenario", o.run.run.scenario.empty() ? "" : o.run.run.scenario.string()}};
+  if (seq.has_labels && !seq.annotated)
+    r.input["reference_velocity"] =
+        "estimated from each track's labelled points (docs/recorded-data.md, \"Track velocity\")";
   if (in.nuscenes) NuScenesInput(*in.nuscenes, in.sequence, &r);
   return RunLoop(cosim, config, o.run, &r);
 }
