@@ -22,6 +22,13 @@ RecordedInput ReadRecordedInput(const std::filesystem::path& input,
   }
   r.radarscenes = std::filesystem::exists(input / "scenes.json");
   if (!r.radarscenes && !std::filesystem::exists(input / "scans.csv") &&
+      std::filesystem::is_directory(input))
+    for (const auto& e : std::filesystem::directory_iterator(input))
+      if (std::filesystem::exists(e.path() / "scene.json"))
+        throw std::invalid_argument(input.string() + ": a nuScenes root (" +
+                                    e.path().filename().string() +
+                                    "/scene.json): give --scene NAME_OR_TOKEN");
+  if (!r.radarscenes && !std::filesystem::exists(input / "scans.csv") &&
       !std::filesystem::exists(input / "summary.json"))
     throw std::invalid_argument(input.string() +
                                 ": neither a RadarScenes sequence folder (scenes.json) nor a "

@@ -222,6 +222,17 @@ check "nuscenes:unknown_scene" 2 "scene.json: field 'name': no scene named (or w
   "$dualgrid" filter "$work/ns_ok" --scene scene-none --no-figures -q --out "$work/nso_scene"
 check "nuscenes:unknown_version" 2 "v1.0-trainval: missing: no version folder" \
   "$dualgrid" filter "$work/ns_ok" --scene scene-test --version v1.0-trainval --no-figures -q --out "$work/nso_version"
+check "nuscenes:version_without_scene" 2 "only with --scene" \
+  "$dualgrid" filter "$work/ns_ok" --version v1.0-trainval --no-figures -q --out "$work/nso_noscene"
+check "nuscenes:root_without_scene" 2 "a nuScenes root (v1.0-mini/scene.json): give --scene" \
+  "$dualgrid" filter "$work/ns_ok" --no-figures -q --out "$work/nso_noscene2"
+# A run with one radar cannot be the five channels.
+mkdir -p "$work/onerun"
+printf 'step,time,sensor,sensor_name,ego_x,ego_y,ego_yaw,ego_vx,ego_vy,ego_yaw_rate,ego_length,ego_width,lane_yaw,mount_x,mount_y,mount_yaw,fov,min_range,max_range\n1,0.5,0,front,0,0,0,10,0,0,4.5,1.8,0,2.25,0,0,1,0.5,80\n' >"$work/onerun/scans.csv"
+printf 'step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter,vclass\n' >"$work/onerun/detections.csv"
+printf 'step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,x_ego,y_ego,vx_ego,vy_ego,rcs_dbsm\n1,0.5,ego,ego,1,0,0,0,10,0,10,0,0,4.5,1.8,l,0,0,0,0,10\n' >"$work/onerun/ground_truth.csv"
+check "nuscenes:export_not_five_radars" 2 "nuScenes has five channels" \
+  "$dualgrid" export "$work/onerun" --format nuscenes --out "$work/nso_export"
 check "nuscenes:bad_states" 2 "--ambig-states: expected 'all' or whole numbers" \
   "$dualgrid" filter "$work/ns_ok" --scene scene-test --ambig-states 3,x --no-figures -q --out "$work/nso_states"
 
