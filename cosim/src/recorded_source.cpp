@@ -141,9 +141,19 @@ bool RecordedSource::Advance(IdRegistry& ids) {
   ego_ = {first.ego_pose, first.ego_velocity, first.ego_yaw_rate, seq_.ego_length, seq_.ego_width};
   if (seq_.annotated) {
     // The references are sorted by id per scan (the reader's contract).
-    frame_.vehicles.assign(seq_.references.begin() + static_cast<std::ptrdiff_t>(first.ref_begin),
-                           seq_.references.begin() + static_cast<std::ptrdiff_t>(first.ref_end));
-    for (const sim::VehicleState& v : frame_.vehicles) ids.Id(v.id);
+    frame_.vehicles.clear();
+    for (std::size_t k = first.ref_begin; k < first.ref_end; ++k) {
+      const recorded::ReferenceObject& r = seq_.references[k];
+      sim::VehicleState v;
+      v.id = r.id;
+      v.type = r.type;
+      v.box = r.box;
+      v.velocity = r.velocity;
+      v.speed = r.velocity.norm();
+      v.lane_yaw = r.box.yaw;
+      ids.Id(v.id);
+      frame_.vehicles.push_back(std::move(v));
+    }
   } else {
     EstimateTracks(ids);
   }
@@ -226,6 +236,28 @@ void RecordedSource::Scan(IdRegistry& ids, std::vector<radar::Detection>* detect
       labels_.push_back(p.label);
     }
   }
+}
+
+scenario::ScenarioConfig DefaultRecordedConfig() {
+  scenario::ScenarioConfig c;
+  c.filter.length_x = 100.0;
+  c.filter.width_y = 60.0;
+  return c;
+}
+
+RecordedOptions FitConfig(const RecordedSequence& seq, double batch_window,
+                          scenario::ScenarioConfig* config) {
+  RecordedOptions o;
+  o.batch_window = batch_window;
+  o.first_dt = config->filter.cycle;
+  const RecordedSource probe(seq, o);
+  config->sim.name = seq.name;
+  config->sim.duration = probe.last_time();
+  config->sim.step_length = probe.last_time() / probe.StepCount();
+  if (!(config->sim.step_length > 0.0))
+    throw std::invalid_argument(seq.name + ": the scans span no time (the last at t = 0)");
+  config->radar.sensors.clear();  // the sequence's radars
+  return o;
 }
 
 }  // namespace dualgrid::cosim

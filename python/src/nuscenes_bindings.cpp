@@ -22,14 +22,14 @@ namespace fs = std::filesystem;
 
 // points: one row per detection with its scan's time and sensor; scans: one row per scan with
 // the ego's state and its points' range [begin, end).
-void SequenceColumns(const cosim::RecordedSequence& seq, py::dict* out) {
+void SequenceColumns(const recorded::RecordedSequence& seq, py::dict* out) {
   std::vector<double> x, y, range, azimuth, range_rate, radial, rcs, time;
   std::vector<std::int64_t> timestamp, sensor, scan, label;
   std::vector<std::string> track;
   std::vector<double> s_time, ex, ey, eyaw, evx, evy, ewz;
   std::vector<std::int64_t> s_ts, s_sensor, s_begin, s_end;
   for (std::size_t k = 0; k < seq.scans.size(); ++k) {
-    const cosim::RecordedScan& s = seq.scans[k];
+    const recorded::RecordedScan& s = seq.scans[k];
     s_ts.push_back(s.timestamp_us);
     s_time.push_back(seq.Time(s.timestamp_us));
     s_sensor.push_back(s.sensor);
@@ -42,7 +42,7 @@ void SequenceColumns(const cosim::RecordedSequence& seq, py::dict* out) {
     s_begin.push_back(static_cast<std::int64_t>(s.begin));
     s_end.push_back(static_cast<std::int64_t>(s.end));
     for (std::size_t i = s.begin; i < s.end; ++i) {
-      const cosim::RecordedPoint& p = seq.points[i];
+      const recorded::RecordedPoint& p = seq.points[i];
       x.push_back(p.position.x());
       y.push_back(p.position.y());
       range.push_back(p.range);
@@ -173,7 +173,7 @@ py::dict ReadNuScenes(const fs::path& root, const std::string& scene, const std:
 }
 
 py::dict ReadRadarScenesArrays(const fs::path& sequence, std::optional<fs::path> sensors) {
-  cosim::RecordedSequence seq;
+  recorded::RecordedSequence seq;
   {
     py::gil_scoped_release release;
     seq = recorded::ReadRadarScenes(sequence, sensors);

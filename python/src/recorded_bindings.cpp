@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "dualgrid/cosim/recorded_source.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 #include "run_results.hpp"
 
@@ -31,7 +32,7 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
     config.filter.cycle = config.sim.step_length;  // its factors are per its step
   } else {
     if (!overrides.empty()) throw py::value_error("run_recorded: overrides need a scenario file");
-    config = recorded::DefaultRecordedConfig();
+    config = cosim::DefaultRecordedConfig();
   }
   if (seed) config.sim.seed = *seed;
   if (!(batch_window >= 0.0 && batch_window <= 1.0))
@@ -49,7 +50,7 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
   if (threads < 0) throw py::value_error("run_recorded: threads must be >= 0");
   options.threads = threads;
   const recorded::RecordedInput in = recorded::ReadRecordedInput(path, sensors);
-  const cosim::RecordedOptions ropts = recorded::FitConfig(in.sequence, batch_window, &config);
+  const cosim::RecordedOptions ropts = cosim::FitConfig(in.sequence, batch_window, &config);
   cosim::CoSimulation cs(config, options, [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
     return std::make_unique<cosim::RecordedSource>(in.sequence, ropts);
   });

@@ -93,7 +93,7 @@ SceneInstances ReadInstances(Tables& tables, const std::map<std::string, std::in
   return out;
 }
 
-std::optional<sim::VehicleState> Interpolate(const Instance& instance, std::int64_t t) {
+std::optional<ReferenceObject> Interpolate(const Instance& instance, std::int64_t t) {
   const auto& k = instance.keys;
   if (k.empty() || t < k.front().timestamp_us || t > k.back().timestamp_us) return std::nullopt;
   std::size_t j = 1;
@@ -108,7 +108,7 @@ std::optional<sim::VehicleState> Interpolate(const Instance& instance, std::int6
       span > 0.0 ? Velocity((b.center - a.center) / (span / 1e6)) : Velocity::Zero();
   const Velocity va = std::isfinite(a.velocity.x()) ? a.velocity : segment;
   const Velocity vb = std::isfinite(b.velocity.x()) ? b.velocity : segment;
-  sim::VehicleState v;
+  ReferenceObject v;
   v.id = instance.token;
   v.type = instance.category;
   v.box.center = a.center + f * (b.center - a.center);
@@ -116,8 +116,6 @@ std::optional<sim::VehicleState> Interpolate(const Instance& instance, std::int6
   v.box.length = b.length;
   v.box.width = b.width;
   v.velocity = va + f * (vb - va);
-  v.speed = v.velocity.norm();
-  v.lane_yaw = v.box.yaw;
   return v;
 }
 

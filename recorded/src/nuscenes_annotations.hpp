@@ -34,6 +34,6 @@ SceneInstances ReadInstances(Tables& tables, const std::map<std::string, std::in
 
 /// The instance's box and velocity at `t` [us]: linear in position and velocity, the shorter way
 /// round in yaw, the later annotation's size; nullopt outside its first..last annotation.
-std::optional<sim::VehicleState> Interpolate(const Instance& instance, std::int64_t t);
+std::optional<ReferenceObject> Interpolate(const Instance& instance, std::int64_t t);
 
 }  // namespace dualgrid::recorded::nuscenes

@@ -176,7 +176,7 @@ radar::SensorParams Mount(Tables& tables, const SampleData& s, const Extension& 
 // axle's), its velocity and yaw rate from dualgrid's keys of the record, else from the poses
 // around it (docs/recorded-data.md, "The ego's velocity").
 void EgoStates(Tables& tables, const std::vector<SampleData>& sds, const Extension& ext,
-               std::vector<cosim::RecordedScan>* scans, bool* estimated) {
+               std::vector<RecordedScan>* scans, bool* estimated) {
   const Table& ep = tables.Get("ego_pose");
   std::vector<Position> axle(sds.size());
   std::vector<const Json*> rec(sds.size());
@@ -194,7 +194,7 @@ void EgoStates(Tables& tables, const std::vector<SampleData>& sds, const Extensi
   *estimated = false;
   for (std::size_t i = 0; i < sds.size(); ++i) {
     const Json& r = *rec[i];
-    cosim::RecordedScan& s = (*scans)[i];
+    RecordedScan& s = (*scans)[i];
     if (r.contains("dualgrid_velocity")) {
       const std::vector<double> v = nuscenes::Numbers(ep, r, "dualgrid_velocity", 2);
       s.ego_velocity = {v[0], v[1]};
@@ -225,7 +225,7 @@ bool Keep(const std::vector<int>& states, double v) {
 // The points of one sample_data's PCD file, moved to the world frame; counts what the filters
 // removed. `sensor`: the sequence's index of its channel.
 void ReadPoints(const std::filesystem::path& root, Tables& tables, const SampleData& s,
-                const NuScenesOptions& o, NuScenesScene* out, cosim::RecordedScan* scan) {
+                const NuScenesOptions& o, NuScenesScene* out, RecordedScan* scan) {
   const std::filesystem::path file = root / s.filename;
   const PcdCloud cloud = ReadPcd(file);
   auto column = [&](const char* name, bool needed) -> const std::vector<double>* {
@@ -279,7 +279,7 @@ void ReadPoints(const std::filesystem::path& root, Tables& tables, const SampleD
     }
     std::vector<double> q = nuscenes::Rotate(cq, {px, py, pz});
     q = nuscenes::Rotate(eq, {q[0] + ct[0], q[1] + ct[1], q[2] + ct[2]});
-    cosim::RecordedPoint p;
+    RecordedPoint p;
     p.range = range;
     p.azimuth = std::atan2(py, px);
     // vx_comp, vy_comp: the ego-motion-compensated radial velocity as a vector in the sensor
@@ -296,7 +296,7 @@ void ReadPoints(const std::filesystem::path& root, Tables& tables, const SampleD
 // The references of every scan (moving instances interpolated to its time, sorted by token) and
 // the labels of its points (the moving box they fall in, else static).
 void Label(const nuscenes::SceneInstances& inst, double margin, NuScenesScene* out) {
-  cosim::RecordedSequence& seq = out->sequence;
+  RecordedSequence& seq = out->sequence;
   seq.annotated = true;
   seq.has_labels = true;
   std::vector<int> track_of(inst.instances.size(), -1);
@@ -305,9 +305,9 @@ void Label(const nuscenes::SceneInstances& inst, double margin, NuScenesScene* o
       track_of[k] = static_cast<int>(seq.track_names.size());
       seq.track_names.push_back(inst.instances[k].token);
     }
-  for (cosim::RecordedScan& s : seq.scans) {
+  for (RecordedScan& s : seq.scans) {
     s.ref_begin = seq.references.size();
-    for (std::size_t i = s.begin; i < s.end; ++i) seq.points[i].label = cosim::kStaticLabel;
+    for (std::size_t i = s.begin; i < s.end; ++i) seq.points[i].label = kStaticLabel;
     for (std::size_t k = 0; k < inst.instances.size(); ++k) {
       const auto box = nuscenes::Interpolate(inst.instances[k], s.timestamp_us);
       if (!box || track_of[k] < 0) continue;
@@ -391,7 +391,7 @@ NuScenesScene ReadNuScenes(const std::filesystem::path& root, const NuScenesOpti
   out.sequence.scans.resize(sds.size());
   EgoStates(tables, sds, ext, &out.sequence.scans, &out.ego_velocity_estimated);
   for (std::size_t i = 0; i < sds.size(); ++i) {
-    cosim::RecordedScan& scan = out.sequence.scans[i];
+    RecordedScan& scan = out.sequence.scans[i];
     scan.timestamp_us = sds[i].timestamp;
     scan.sensor = sensor_of[sds[i].channel];
     ReadPoints(root, tables, sds[i], o, &out, &scan);

@@ -47,8 +47,7 @@ std::vector<int> Channels(const std::vector<radar::SensorParams>& sensors) {
 }
 
 // The devkit's 18 radar fields, with the sizes and types of the published files.
-PcdCloud RadarCloud(const cosim::RecordedSequence& seq, const cosim::RecordedScan& s,
-                    bool float64) {
+PcdCloud RadarCloud(const RecordedSequence& seq, const RecordedScan& s, bool float64) {
   PcdCloud c;
   const char* names[] = {"x",
                          "y",
@@ -83,7 +82,7 @@ PcdCloud RadarCloud(const cosim::RecordedSequence& seq, const cosim::RecordedSca
     return c;
   }
   for (std::size_t i = s.begin; i < s.end; ++i) {
-    const cosim::RecordedPoint& p = seq.points[i];
+    const RecordedPoint& p = seq.points[i];
     const double cx = std::cos(p.azimuth), cy = std::sin(p.azimuth);
     const double dyn = std::abs(p.radial_speed) > 0.5 ? 0 : 1;  // moving, stationary
     row({p.range * cx, p.range * cy, 0.0, dyn, static_cast<double>(i - s.begin), p.rcs,
@@ -94,7 +93,7 @@ PcdCloud RadarCloud(const cosim::RecordedSequence& seq, const cosim::RecordedSca
 }
 
 struct Writer {
-  const cosim::RecordedSequence& seq;
+  const RecordedSequence& seq;
   std::filesystem::path root;
   std::string scene;
   bool float64 = false;
@@ -199,7 +198,7 @@ void Writer::SampleData(const std::vector<std::size_t>& sample_of_scan,
   }
   std::fill(prev.begin(), prev.end(), seq.scans.size());
   for (std::size_t i = 0; i < seq.scans.size(); ++i) {
-    const cosim::RecordedScan& s = seq.scans[i];
+    const RecordedScan& s = seq.scans[i];
     const std::string ch = kNuScenesChannels[channel[s.sensor]];
     const std::int64_t ts = kEpochUs + s.timestamp_us;
     const std::string file = std::string(key[i] ? "samples/" : "sweeps/") + ch + "/" + scene +
@@ -244,7 +243,7 @@ void Writer::Annotations(const std::vector<NuScenesKeyFrame>& keys,
   categories["vehicle.car"] = HexId("category/vehicle.car", 0);
   Json& rows = tables["sample_annotation"];
   for (std::size_t k = 0; k < keys.size(); ++k)
-    for (const sim::VehicleState& v : keys[k].vehicles) {
+    for (const ReferenceObject& v : keys[k].vehicles) {
       const auto [it, added] = instance_of.try_emplace(v.id, anns.size());
       if (added) {
         anns.emplace_back();
@@ -291,7 +290,7 @@ void Writer::Annotations(const std::vector<NuScenesKeyFrame>& keys,
 
 }  // namespace
 
-void WriteNuScenes(const cosim::RecordedSequence& seq, const std::vector<NuScenesKeyFrame>& keys,
+void WriteNuScenes(const RecordedSequence& seq, const std::vector<NuScenesKeyFrame>& keys,
                    const std::filesystem::path& root, const NuScenesWriteOptions& o) {
   if (keys.empty())
     throw std::invalid_argument(

@@ -15,9 +15,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/radar_model/sensor_params.hpp"
-#include "output.hpp"
 
 extern char** environ;
 
@@ -233,8 +236,8 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
   const std::filesystem::path base = out.parent_path() / out.stem();
   const auto nod_path = base.string() + ".nod.xml", edg_path = base.string() + ".edg.xml",
              net_path = base.string() + ".net.xml", log_path = base.string() + ".netconvert.log";
-  WriteTextFile(nod_path, nod.str());
-  WriteTextFile(edg_path, edg.str());
+  outputs::WriteTextFile(nod_path, nod.str());
+  outputs::WriteTextFile(edg_path, edg.str());
   Netconvert(nod_path, edg_path, net_path, log_path);
 
   const double ego_front = 100.0 + kEgoStartX + 0.5 * kEgoLength;  // along ego_road (from -100)
@@ -287,7 +290,7 @@ std::string WriteAspectCase(const AspectCase& asked, const std::filesystem::path
   for (std::size_t k = 0; k < targets.size(); ++k)
     y << (k ? ", " : "") << FormatFixed(targets[k].t_ref, 2);
   y << "]\n";
-  WriteTextFile(out, y.str());
+  outputs::WriteTextFile(out, y.str());
   return "aspect " + FormatFixed(c.angle_deg, 1) + " deg to the " + c.sensor + " radar at " +
          FormatFixed(c.range, 1) +
          " m, v cos(theta) = " + FormatFixed(c.speed * std::cos(theta), 2) + " m/s";

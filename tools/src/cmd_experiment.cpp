@@ -17,13 +17,15 @@
 #include "cli_checks.hpp"
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/eval/aggregate.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/figures.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/read_back.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "exit_codes.hpp"
-#include "figures.hpp"
-#include "output.hpp"
 #include "progress.hpp"
-#include "read_back.hpp"
-#include "run_outputs.hpp"
 #include "signals.hpp"
 
 namespace dualgrid::tools {
@@ -53,18 +55,19 @@ std::vector<std::string> RunArgs(const ExperimentOptions& o, std::uint64_t seed,
   for (const auto& m : o.run.modes) modes += (modes.empty() ? "" : ",") + m;
   args.insert(args.end(), {"--modes", modes});
   if (!figures) args.push_back("--no-figures");
-  if (!o.run.snapshots.empty()) {
+  if (!o.run.folder.snapshots.empty()) {
     std::string times;
-    for (double t : o.run.snapshots) times += (times.empty() ? "" : ",") + Exact(t);
+    for (double t : o.run.folder.snapshots) times += (times.empty() ? "" : ",") + Exact(t);
     args.insert(args.end(), {"--snapshots", times});
   }
-  args.insert(args.end(), {"--detections", o.run.detections});
+  args.insert(args.end(), {"--detections", o.run.folder.detections});
   std::string formats;
-  for (const auto& f : o.run.figure_formats) formats += (formats.empty() ? "" : ",") + f;
+  for (const auto& f : o.run.folder.figure_formats) formats += (formats.empty() ? "" : ",") + f;
   if (figures) args.insert(args.end(), {"--figure-formats", formats});
-  if (figures && !o.run.figure_captions) args.insert(args.end(), {"--figure-captions", "off"});
-  if (o.run.write_particles) args.push_back("--write-particles");
-  if (o.run.check_invariants) args.push_back("--check-invariants");
+  if (figures && !o.run.folder.figure_captions)
+    args.insert(args.end(), {"--figure-captions", "off"});
+  if (o.run.folder.write_particles) args.push_back("--write-particles");
+  if (o.run.folder.check_invariants) args.push_back("--check-invariants");
   args.insert(args.end(), {"--threads", std::to_string(threads)});
   return args;
 }
@@ -82,7 +85,7 @@ int RunExperiment(const ExperimentOptions& o) {
   ParseModes(o.run.modes);  // fail early on a bad mode
   scenario::ScenarioConfig config = LoadConfig(o.run.run);
   cosim::CheckFilterMemory(config, o.run.modes.size());
-  DetectionPath(o.run.run.out, o.run.detections);  // fail early on a bad format
+  DetectionPath(o.run.run.out, o.run.folder.detections);  // fail early on a bad format
   const auto& out = o.run.run.out;
   PrepareOutputFolder(out);
   std::filesystem::create_directories(out / "figures");
@@ -110,7 +113,8 @@ int RunExperiment(const ExperimentOptions& o) {
       const auto dir = seed_dir(seed);
       std::filesystem::create_directories(dir.parent_path());
       // The log beside the run folder, which the run itself prepares (docs/output.md).
-      pool.Start(seed, RunArgs(o, seed, dir, o.run.figures && seed == o.first_seed, split.threads),
+      pool.Start(seed,
+                 RunArgs(o, seed, dir, o.run.folder.figures && seed == o.first_seed, split.threads),
                  LogPath(dir));
     }
     const auto ended = pool.Wait();
@@ -251,7 +255,7 @@ int RunExperiment(const ExperimentOptions& o) {
   if (!o.run.run.quiet) std::cout << table.ToMarkdown() << "\n";
 
   std::vector<std::string> warnings;
-  if (o.run.figures && !StopSignal()) {
+  if (o.run.folder.figures && !StopSignal()) {
     for (const bool v : {false, true}) {
       TrackedShares shares, errors;
       for (const auto& [id, r] : rows[v]) shares.emplace_back(names.Name(id), r);
@@ -259,13 +263,13 @@ int RunExperiment(const ExperimentOptions& o) {
       const auto png = out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
       const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
       TryFigures(
-          png, o.run.figure_formats,
+          png, o.run.folder.figure_formats,
           [&](const auto& p) {
-            RenderTrackedShares(o.run.modes, shares,
-                                config.sim.name + ": " + (v ? "D_v" : "D") +
-                                    " per object, mean and 95 % CI over " +
-                                    std::to_string(finished.size()) + " seeds",
-                                "tracked share " + what + " [%]", p, errors, o.run.figure_captions);
+            RenderTrackedShares(
+                o.run.modes, shares,
+                config.sim.name + ": " + (v ? "D_v" : "D") + " per object, mean and 95 % CI over " +
+                    std::to_string(finished.size()) + " seeds",
+                "tracked share " + what + " [%]", p, errors, o.run.folder.figure_captions);
           },
           &warnings);
     }
@@ -321,7 +325,7 @@ Command AddExperimentCommand(CLI::App& app, const CliContext& ctx) {
                   "Seed runs at a time (default: one per core, each with one OpenMP thread)")
       ->check(WholeNumber(1, kMaxThreadsPerCore * Cores()));
   return {cmd, [o, no_figures] {
-            o->run.figures = !*no_figures;
+            o->run.folder.figures = !*no_figures;
             // Parallel runs share the cores: one OpenMP thread each unless told otherwise.
             const int jobs = o->jobs > 0 ? o->jobs : Cores();
             if (o->run.threads == 0 && jobs > 1) o->run.threads = 1;

@@ -6,10 +6,12 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
-#include "output.hpp"
 
 namespace dualgrid::tools {
 
@@ -25,7 +27,7 @@ struct ExportOptions {
 };
 
 int RunExport(const ExportOptions& o) {
-  cosim::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
+  recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
   if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))

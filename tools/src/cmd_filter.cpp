@@ -6,9 +6,8 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/outputs/run.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
-#include "output.hpp"
-#include "run_loop.hpp"
 
 namespace dualgrid::tools {
 
@@ -56,7 +55,7 @@ scenario::ScenarioConfig RecordedConfig(const FilterRunOptions& o) {
   if (o.run.scenario.empty()) {
     if (!o.run.sets.empty())
       throw std::invalid_argument("--set: needs --scenario FILE (the keys it overrides)");
-    scenario::ScenarioConfig c = recorded::DefaultRecordedConfig();
+    scenario::ScenarioConfig c = cosim::DefaultRecordedConfig();
     if (o.run.seed) c.sim.seed = *o.run.seed;
     return c;
   }
@@ -67,8 +66,8 @@ scenario::ScenarioConfig RecordedConfig(const FilterRunOptions& o) {
 
 // summary.json's and the table notes' account of a nuScenes scene: what the devkit's filters
 // removed, which instances are references, and that their velocities are estimated.
-void NuScenesInput(const recorded::NuScenesScene& n, const cosim::RecordedSequence& seq,
-                   RecordedRun* r) {
+void NuScenesInput(const recorded::NuScenesScene& n, const recorded::RecordedSequence& seq,
+                   outputs::RecordedRun* r) {
   r->input["scene_token"] = n.scene_token;
   for (const recorded::NuScenesAnnotation& a : n.annotations)
     r->categories[a.instance] = a.category;
@@ -97,34 +96,6 @@ void NuScenesInput(const recorded::NuScenesScene& n, const cosim::RecordedSequen
 
 }  // namespace
 
-std::vector<std::string> RecordedNotes(const RecordedRun& r, const std::vector<std::string>& modes,
-                                       const std::vector<eval::ScenarioMetrics>& metrics) {
-  std::vector<std::string> notes;
-  if (!r.labels) {
-    notes.push_back(
-        "Recorded data without labels (label_id): no point-level scores and no tracks, so D, "
-        "D_v and the cell scores are empty; the grids, clusters and figures are complete.");
-  }
-  for (std::size_t m = 0; m < modes.size() && r.labels; ++m) {
-    const auto& p = metrics[m].points;
-    if (!p) continue;
-    auto f = [](const std::optional<double>& v) { return v ? FormatFixed(*v, 3) : "—"; };
-    notes.push_back(
-        "Point-level dynamic classification, " + modes[m] + ": precision " + f(p->precision) +
-        ", recall " + f(p->recall) + ", F1 " + f(p->f1) + " (" + std::to_string(p->true_positives) +
-        " TP, " + std::to_string(p->false_positives) + " FP, " +
-        std::to_string(p->false_negatives) + " FN over " + std::to_string(p->frames) + " cycles; " +
-        (r.annotated ? std::string("D and D_v per instance against its annotated boxes).")
-                     : std::string("D and D_v per track_id against boxes estimated from "
-                                   "the tracks' points).")));
-  }
-  notes.insert(notes.end(), r.notes.begin(), r.notes.end());
-  if (r.skipped_points > 0)
-    notes.push_back(std::to_string(r.skipped_points) +
-                    " detection(s) skipped: NaN position, azimuth, range or velocity.");
-  return notes;
-}
-
 int RunFilterCommand(FilterInputOptions o) {
   const std::vector<filter::WeightMode> modes = ParseModes(o.run.modes);
   std::optional<recorded::NuScenesOptions> nuscenes;
@@ -141,16 +112,16 @@ int RunFilterCommand(FilterInputOptions o) {
     if (!o.run.run.quiet)
       std::cout << "filter settings: " << in.scenario->string() << " (travelled with the export)\n";
   }
-  o.run.references = in.sequence.annotated ? "annotated" : "tracks";
+  o.run.folder.references = in.sequence.annotated ? "annotated" : "tracks";
   scenario::ScenarioConfig config = RecordedConfig(o.run);
   const cosim::RecordedSequence& seq = in.sequence;
-  const cosim::RecordedOptions ropts = recorded::FitConfig(seq, o.batch_window, &config);
+  const cosim::RecordedOptions ropts = cosim::FitConfig(seq, o.batch_window, &config);
   const cosim::RecordedSource probe(seq, ropts);
   cosim::CoSimulation cosim(config, {modes, o.run.threads},
                             [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                               return std::make_unique<cosim::RecordedSource>(seq, ropts);
                             });
-  RecordedRun r;
+  outputs::RecordedRun r;
   r.labels = seq.has_labels;
   r.annotated = seq.annotated;
   r.skipped_points = seq.skipped_points;
@@ -175,7 +146,7 @@ int RunFilterCommand(FilterInputOptions o) {
     r.input["reference_velocity"] =
         "estimated from each track's labelled points (docs/recorded-data.md, \"Track velocity\")";
   if (in.nuscenes) NuScenesInput(*in.nuscenes, in.sequence, &r);
-  return RunLoop(cosim, config, o.run, &r);
+  return WriteRunFolderAndReport(cosim, config, o.run.FolderOptions(), &r);
 }
 
 Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
@@ -226,11 +197,12 @@ Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
   cmd->add_flag("--quiet,-q", o->run.run.quiet, "No progress or summary output");
   AddFilterOptions(cmd, &o->run, no_figures.get());
   cmd->add_flag("--no-record", *no_record, "Do not record the replay frames (RUN_DIR/replay/)");
-  cmd->add_flag("--viewer", o->run.viewer, "Also write the interactive viewer (replay.html)");
+  cmd->add_flag("--viewer", o->run.folder.viewer,
+                "Also write the interactive viewer (replay.html)");
   return {cmd, [o, no_figures, no_record] {
-            o->run.figures = !*no_figures;
-            o->run.record = o->run.figures && !*no_record;
-            if (o->run.viewer && !o->run.record)
+            o->run.folder.figures = !*no_figures;
+            o->run.folder.record = o->run.folder.figures && !*no_record;
+            if (o->run.folder.viewer && !o->run.folder.record)
               throw std::invalid_argument("--viewer needs the recording: drop --no-record");
             if (!o->scene &&
                 (o->nuscenes.version != recorded::NuScenesOptions().version ||

@@ -13,10 +13,13 @@
 #include "cli_checks.hpp"
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/read_results.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/suite.hpp"
 #include "exit_codes.hpp"
-#include "output.hpp"
-#include "read_results.hpp"
 #include "signals.hpp"
 
 namespace dualgrid::tools {
@@ -130,7 +133,7 @@ int RunRegress(const RegressOptions& o) {
     e.run.run.duration = c.duration;
     e.run.run.quiet = true;
     e.run.modes = c.modes;
-    e.run.figures = false;
+    e.run.folder.figures = false;
     e.seeds = c.seeds;
     e.first_seed = c.first_seed;
     e.jobs = o.jobs;

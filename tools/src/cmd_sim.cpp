@@ -9,9 +9,13 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_config.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/loader.hpp"
-#include "output.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
 
@@ -29,7 +33,8 @@ int RunSim(const SimOptions& sim_options) {
   const auto wall_start = std::chrono::steady_clock::now();
   cosim.Start(options.network_dir, options.out);
   const cosim::Pipeline& pipeline = cosim.pipeline();
-  NoteAutoEgo(pipeline, options.quiet);
+  if (const std::string note = AutoEgoNote(pipeline); !note.empty() && !options.quiet)
+    std::cerr << "dualgrid: " << note << "\n";
   GroundTruthWriter truth(options.out / "ground_truth.csv");
   std::unique_ptr<DetectionWriter> detections;
   const bool multipath = config.radar.options.multipath.enabled;

@@ -13,9 +13,12 @@
 #include "aspect_case.hpp"
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "guardrail_case.hpp"
-#include "output.hpp"
 
 namespace dualgrid::tools {
 namespace {

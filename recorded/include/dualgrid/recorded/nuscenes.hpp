@@ -1,5 +1,5 @@
 // nuScenes-layout datasets (docs/recorded-data.md, "nuScenes"): one scene's five radar channels
-// read into a cosim::RecordedSequence with its annotated vehicles as reference objects, and a
+// read into a RecordedSequence with its annotated vehicles as reference objects, and a
 // recorded sequence written as a nuScenes version folder that the public devkit loads.
 //
 // Read: ROOT/VERSION/*.json (scene, sample, sample_data, calibrated_sensor, sensor, ego_pose,
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/recorded/sequence.hpp"
 
 namespace dualgrid::recorded {
 
@@ -64,7 +64,7 @@ struct NuScenesAnnotation {
 };
 
 struct NuScenesScene {
-  cosim::RecordedSequence sequence;  ///< annotated: references = the moving instances
+  RecordedSequence sequence;  ///< annotated: references = the moving instances
   std::string scene_token;
   std::vector<std::string> channels;            ///< per sensor of the sequence
   std::vector<NuScenesAnnotation> annotations;  ///< the vehicle instances used, by time
@@ -85,7 +85,7 @@ NuScenesScene ReadNuScenes(const std::filesystem::path& root, const NuScenesOpti
 /// The sample (key) frames of an export: annotations of `vehicles` per key frame time.
 struct NuScenesKeyFrame {
   std::int64_t timestamp_us = 0;
-  std::vector<sim::VehicleState> vehicles;  ///< id, box, velocity; type = category name
+  std::vector<ReferenceObject> vehicles;  ///< id, box, velocity; type = category name
 };
 
 struct NuScenesWriteOptions {
@@ -105,8 +105,7 @@ struct NuScenesWriteOptions {
 /// channel's scan nearest a key frame is its key frame; the others are sweeps of the next
 /// sample). Throws std::invalid_argument when the sequence does not fit (not five radars, no key
 /// frame) and std::runtime_error naming the file when a write fails.
-void WriteNuScenes(const cosim::RecordedSequence& seq,
-                   const std::vector<NuScenesKeyFrame>& key_frames,
+void WriteNuScenes(const RecordedSequence& seq, const std::vector<NuScenesKeyFrame>& key_frames,
                    const std::filesystem::path& root, const NuScenesWriteOptions& options);
 
 /// nuScenes' category of RadarScenes label `label` (docs/recorded-data.md) and back (-1 for a

@@ -1,18 +1,18 @@
 // What `dualgrid filter` and Python's run_recorded share: reading an input folder (a RadarScenes
-// sequence or a dualgrid run folder) and fitting a scenario configuration to the sequence.
+// sequence or a dualgrid run folder). cosim::FitConfig fits a configuration to the sequence.
 #pragma once
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
-#include "dualgrid/cosim/recorded_source.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
-#include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/recorded/sequence.hpp"
 
 namespace dualgrid::recorded {
 
 struct RecordedInput {
-  cosim::RecordedSequence sequence;
+  RecordedSequence sequence;
   bool radarscenes = false;  ///< a RadarScenes sequence
   std::string kind = "run";  ///< radarscenes, nuscenes or run
   /// nuScenes only: what the reader counted (its `sequence` is moved into `sequence` above).
@@ -29,16 +29,5 @@ struct RecordedInput {
 RecordedInput ReadRecordedInput(const std::filesystem::path& input,
                                 const std::optional<std::filesystem::path>& sensors,
                                 const std::optional<NuScenesOptions>& nuscenes = std::nullopt);
-
-/// The configuration of a recorded run without a scenario file: the defaults with a 100 m x 60 m
-/// grid (RadarScenes' radars look ahead and to both sides) and filter.cycle 0.05 s.
-scenario::ScenarioConfig DefaultRecordedConfig();
-
-/// Fits `config` to `seq`: name, duration (the last cycle's time), step length (the mean cycle,
-/// for step-based schedules), no simulated radars; returns the source options for its filter
-/// cycle (first_dt = filter.cycle) and `batch_window` [s]. Throws std::invalid_argument for a
-/// sequence that spans no time.
-cosim::RecordedOptions FitConfig(const cosim::RecordedSequence& seq, double batch_window,
-                                 scenario::ScenarioConfig* config);
 
 }  // namespace dualgrid::recorded

@@ -14,9 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "dualgrid/eval/regression.hpp"
-#include "read_back.hpp"
+#include "dualgrid/outputs/read_back.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 /// One metric of a table.json, per mode; a mode whose mean is null (undefined in that run, e.g.
 /// no detection time) is absent.
@@ -79,4 +79,4 @@ SweepPlan ParseSweepPlan(const JsonFile& doc);
 std::filesystem::path RunFolder(const std::filesystem::path& sweep_dir, const std::string& setting,
                                 std::uint64_t seed);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

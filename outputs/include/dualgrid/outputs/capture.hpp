@@ -6,9 +6,9 @@
 
 #include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/cosim/scoring.hpp"
-#include "recording.hpp"
+#include "dualgrid/outputs/recording.hpp"
 
-namespace dualgrid::tools::replay {
+namespace dualgrid::outputs::replay {
 
 /// Running per-mode totals for the live metrics; Count() every step (recorded or not).
 class LiveCounter {
@@ -36,4 +36,4 @@ Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnap
               const std::vector<LiveCounter>& counters, const std::vector<Live>& live,
               const std::vector<eval::TruthObject>& objects, const Header& header);
 
-}  // namespace dualgrid::tools::replay
+}  // namespace dualgrid::outputs::replay

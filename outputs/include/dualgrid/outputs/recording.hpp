@@ -19,9 +19,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "read_back.hpp"
+#include "dualgrid/outputs/read_back.hpp"
 
-namespace dualgrid::tools::replay {
+namespace dualgrid::outputs::replay {
 
 /// Current format version; the reader refuses others with a clear error.
 inline constexpr int kFormatVersion = 2;
@@ -155,4 +155,4 @@ class Reader {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> blobs_;  ///< [offset, length] [bytes]
 };
 
-}  // namespace dualgrid::tools::replay
+}  // namespace dualgrid::outputs::replay

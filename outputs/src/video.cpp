@@ -1,4 +1,4 @@
-#include "video.hpp"
+#include "dualgrid/outputs/video.hpp"
 
 #include <fcntl.h>
 #include <sys/prctl.h>
@@ -15,14 +15,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "child_process.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/viz/color.hpp"
 #include "dualgrid/viz/replay_frame.hpp"
-#include "output.hpp"
-#include "progress.hpp"
-#include "signals.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 namespace fs = std::filesystem;
 
@@ -251,7 +248,8 @@ viz::ReplayPicture ToPicture(const replay::Reader& reader, const replay::Frame& 
 
 }  // namespace
 
-fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
+fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o,
+                    const Callbacks& callbacks) {
   if (o.preview != "gif" && o.preview != "webm" && o.preview != "none")
     throw std::invalid_argument("--preview: expected gif, webm or none, got '" + o.preview + "'");
   if (!(o.speed >= 0.1 && o.speed <= 20.0))
@@ -304,7 +302,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
                    "-s",
                    std::to_string(renderer.width()) + "x" + std::to_string(renderer.height()),
                    "-framerate",
-                   Exact(fps),
+                   FormatSignificant(fps, 17),
                    "-i",
                    "-",
                    "-c:v",
@@ -321,18 +319,17 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
                    "mp4",
                    part.string()},
                   log);
-  Progress progress("replay video " + out.filename().string(), static_cast<int>(last - first),
-                    !o.quiet);
+  callbacks.Begin("replay video " + out.filename().string(), static_cast<int>(last - first));
   const std::size_t bytes = static_cast<std::size_t>(renderer.width()) * renderer.height() * 4;
   try {
     for (std::size_t i = first; i < last; ++i) {
-      if (StopSignal()) throw Stopped();
+      if (callbacks.StopRequested()) throw Stopped();
       const replay::Frame f = i == first ? first_frame : reader.Load(i);
       const std::uint8_t* raster = renderer.Render(ToPicture(reader, f, modes, o));
       if (!pipe.Write(raster, bytes)) break;  // ffmpeg stopped: Close() reports why
-      progress.Update(static_cast<int>(i - first + 1), "t=" + FormatFixed(f.time, 1) + " s");
+      callbacks.Progress(static_cast<int>(i - first + 1), "t=" + FormatFixed(f.time, 1) + " s");
     }
-    progress.Finish();
+    callbacks.End();
     pipe.Close();
   } catch (...) {
     pipe.Kill();
@@ -371,4 +368,4 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o) {
   return out;
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

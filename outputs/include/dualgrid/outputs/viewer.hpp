@@ -5,13 +5,13 @@
 
 #include <filesystem>
 
-#include "commands.hpp"
-#include "recording.hpp"
+#include "dualgrid/outputs/recording.hpp"
+#include "dualgrid/outputs/video.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 /// Writes options.html_out (default RUN_DIR/replay.html) with the frames within --from/--to.
 /// Throws std::runtime_error naming the file when it cannot be written. Returns its path.
 std::filesystem::path WriteViewer(const replay::Reader& reader, const ReplayOptions& options);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

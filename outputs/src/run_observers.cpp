@@ -1,4 +1,4 @@
-#include "run_observers.hpp"
+#include "dualgrid/outputs/run_observers.hpp"
 
 #include <unistd.h>
 
@@ -7,9 +7,10 @@
 #include <fstream>
 #include <iostream>
 
-#include "figures.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/figures.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 double ResidentMegabytes() {
   std::ifstream in("/proc/self/statm");
@@ -129,7 +130,7 @@ nlohmann::json InvariantObserver::Samples(double end_time) const {
 }
 
 PictureObserver::PictureObserver(const std::filesystem::path& out, std::vector<double> times,
-                                 const FilterRunOptions& options,
+                                 const RunFolderOptions& options,
                                  std::vector<std::string>* warnings)
     : out_(out),
       times_(std::move(times)),
@@ -173,4 +174,4 @@ void PictureObserver::OnStep(const cosim::StepView& v) {
                      out_ / "figures" / ("particles_" + v.mode_names[m] + "_t" + stamp + ".csv"));
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

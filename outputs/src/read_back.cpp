@@ -1,4 +1,4 @@
-#include "read_back.hpp"
+#include "dualgrid/outputs/read_back.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -6,7 +6,7 @@
 #include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/text.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 using nlohmann::json;
 
@@ -201,4 +201,4 @@ JsonFile ReadJsonFile(const std::filesystem::path& path, const std::string& what
   return ParseJsonText(text, path.string());
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

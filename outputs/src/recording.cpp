@@ -1,4 +1,4 @@
-#include "recording.hpp"
+#include "dualgrid/outputs/recording.hpp"
 
 #include <zlib.h>
 
@@ -10,9 +10,10 @@
 #include <type_traits>
 
 #include "dualgrid/core/input_file.hpp"
-#include "output.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/output_file.hpp"
 
-namespace dualgrid::tools::replay {
+namespace dualgrid::outputs::replay {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -371,4 +372,4 @@ Frame Reader::Load(std::size_t i) const {
   return f;
 }
 
-}  // namespace dualgrid::tools::replay
+}  // namespace dualgrid::outputs::replay

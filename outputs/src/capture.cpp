@@ -1,11 +1,13 @@
-#include "capture.hpp"
+#include "dualgrid/outputs/capture.hpp"
+
+#include "dualgrid/core/text.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
 
-namespace dualgrid::tools::replay {
+namespace dualgrid::outputs::replay {
 
 namespace {
 
@@ -168,4 +170,4 @@ Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnap
   return f;
 }
 
-}  // namespace dualgrid::tools::replay
+}  // namespace dualgrid::outputs::replay

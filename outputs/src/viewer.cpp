@@ -1,13 +1,13 @@
-#include "viewer.hpp"
+#include "dualgrid/outputs/viewer.hpp"
 
 #include <stdexcept>
 #include <string>
 
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/video.hpp"
 #include "dualgrid/viz/viewer_template.hpp"
-#include "output.hpp"
-#include "video.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 namespace fs = std::filesystem;
 
@@ -90,4 +90,4 @@ fs::path WriteViewer(const replay::Reader& reader, const ReplayOptions& o) {
   return out;
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

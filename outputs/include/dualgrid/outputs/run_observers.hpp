@@ -1,6 +1,6 @@
-// What `dualgrid run` does after each co-simulation step, as cosim::StepObserver hooks: the CSV
-// files, the weight traces, the replay recording, the invariant checks and the pictures. Each
-// owns its files; RunFilters (cmd_run.cpp) only wires them to the CoSimulation.
+// What a run does after each co-simulation step, as cosim::StepObserver hooks: the CSV files, the
+// weight traces, the replay recording, the invariant checks and the pictures. Each owns its
+// files; WriteRunFolder (run.hpp) wires them to the CoSimulation.
 #pragma once
 
 #include <filesystem>
@@ -11,14 +11,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "capture.hpp"
-#include "commands.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
-#include "output.hpp"
-#include "recording.hpp"
-#include "run_outputs.hpp"
+#include "dualgrid/outputs/capture.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/figures.hpp"
+#include "dualgrid/outputs/recording.hpp"
+#include "dualgrid/outputs/run.hpp"
+#include "dualgrid/outputs/weight_traces.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 /// ground_truth.csv, grid.csv, detections (optional; with `exact` also scans.csv), clusters.csv,
 /// and the weight traces of one mode.
@@ -93,7 +94,7 @@ class InvariantObserver : public cosim::StepObserver {
 class PictureObserver : public cosim::StepObserver {
  public:
   PictureObserver(const std::filesystem::path& out, std::vector<double> times,
-                  const FilterRunOptions& options, std::vector<std::string>* warnings);
+                  const RunFolderOptions& options, std::vector<std::string>* warnings);
   bool WantsVelocities(int step, double time) override;
   void OnStep(const cosim::StepView& v) override;
 
@@ -112,4 +113,4 @@ class PictureObserver : public cosim::StepObserver {
 /// Resident memory of this process [MB] (/proc/self/statm), 0 if unreadable.
 double ResidentMegabytes();
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

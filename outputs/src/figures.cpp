@@ -1,16 +1,17 @@
-#include "figures.hpp"
+#include "dualgrid/outputs/figures.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <optional>
 
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/viz/birds_eye_view.hpp"
 #include "dualgrid/viz/charts.hpp"
 #include "dualgrid/viz/grid_panels.hpp"
-#include "output.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
                std::vector<std::string>* warnings) {
@@ -318,4 +319,4 @@ void RenderWeightTrace(const WeightTrace& trace, const std::string& object, cons
   viz::RenderLineChart(chart, path.string());
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

@@ -10,8 +10,9 @@
 #include "dualgrid/cosim/pipeline.hpp"
 #include "dualgrid/cosim/scoring.hpp"
 #include "dualgrid/eval/metrics.hpp"
+#include "dualgrid/outputs/weight_traces.hpp"
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 /// Figures come after the results they show and never cost them: draws one figure and turns a
 /// failure into a warning naming the file (printed to stderr and appended to `warnings`, which
@@ -37,7 +38,7 @@ struct ReferenceWords {
   std::string object = "object (SUMO vehicle id)";
   std::string legend = "ground truth";  ///< the grid figure's legend entry of the boxes
 };
-/// `references`: "sumo", "annotated" or "tracks" (FilterRunOptions::references).
+/// `references`: "sumo", "annotated" or "tracks" (RunFolderOptions::references).
 ReferenceWords WordsFor(const std::string& references);
 
 /// Bird's-eye picture of the current step: lanes, guard rails, parked boxes, vehicles, radar
@@ -76,20 +77,9 @@ void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedSha
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
                                const cosim::IdRegistry& ids, bool velocity_aware);
 
-/// Particle weights on one object over time (paper Fig. 4). The filter normalises both weights
-/// per cell, so their sums over an object are equal; what differs is *which* particles carry
-/// them: the shares are the fraction of each weight held by particles whose velocity is within
-/// `kGoodVelocity` of the object's true velocity.
-struct WeightTrace {
-  static constexpr double kGoodVelocity = 2.0;  ///< [m/s]
-  std::vector<double> time, w_position, w_velocity, weight;
-  std::vector<double> position_share, velocity_share;
-  /// Share of the object's detections whose |compensated Doppler| is below half its speed.
-  std::vector<double> tangential_share;
-};
 /// The caption explains the shares for the run's `likelihood` (f_v of eq. (8)).
 void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
                        filter::VelocityLikelihood likelihood, const std::filesystem::path& path,
                        bool captions = true);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

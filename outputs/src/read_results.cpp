@@ -1,9 +1,9 @@
-#include "read_results.hpp"
+#include "dualgrid/outputs/read_results.hpp"
 
 #include <set>
 #include <stdexcept>
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -140,4 +140,4 @@ SweepPlan ReadSweepPlan(const fs::path& file) {
   return ParseSweepPlan(ReadJsonFile(file, "sweep plan"));
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs

@@ -17,7 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace dualgrid::tools {
+namespace dualgrid::outputs {
 
 /// A value inside a read-back JSON document, with the file and the key path that lead to it.
 /// Borrows the document (JsonFile keeps it alive); copies are cheap enough for the non-hot paths
@@ -87,4 +87,4 @@ JsonFile ParseJsonText(const std::string& text, const std::string& file);
 JsonFile ReadJsonFile(const std::filesystem::path& path, const std::string& what,
                       std::uint64_t max_bytes = std::uint64_t{64} << 20);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::outputs
