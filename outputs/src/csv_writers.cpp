@@ -66,8 +66,8 @@ DetectionWriter::DetectionWriter(const std::filesystem::path& path, bool multipa
     : out_(path), multipath_(multipath), exact_(exact) {
   out_.buffer() += recorded::JoinColumns(recorded::kDetectionColumns);
   // The path columns only with multipath on.
-  if (multipath_) out_.buffer() += "," + recorded::JoinColumns(recorded::kMultipathColumns);
-  if (exact_) out_.buffer() += "," + std::string(recorded::kVClassColumn);
+  if (multipath_) (out_.buffer() += ',') += recorded::JoinColumns(recorded::kMultipathColumns);
+  if (exact_) (out_.buffer() += ',') += recorded::kVClassColumn;
   out_.buffer() += "\n";
 }
 

@@ -246,6 +246,96 @@ viz::ReplayPicture ToPicture(const replay::Reader& reader, const replay::Frame& 
   return pic;
 }
 
+// The renderer's layout: the view fixed relative to the ego (the grid as placed at the first
+// frame), one panel per mode. Errors name the option a user can change.
+viz::ReplayLayoutOptions Layout(const replay::Header& h, const replay::Frame& first_frame,
+                                std::size_t modes, const ReplayOptions& o) {
+  viz::ReplayLayoutOptions layout;
+  layout.width = o.width;
+  // The view stays fixed relative to the ego: the grid as placed at the first frame.
+  const Position lo =
+      Position(first_frame.origin_x - first_frame.ego.x, first_frame.origin_y - first_frame.ego.y);
+  layout.view = {lo, lo + Vector2(h.cells_x * h.resolution, h.cells_y * h.resolution)};
+  layout.panels = static_cast<int>(modes);
+  if (o.detections) layout.sensors = h.sensors;
+  layout.particles = o.particles;
+  try {
+    layout.Validate();
+  } catch (const std::invalid_argument& e) {
+    // Name the option a user can change: --width for the width, --modes for the panel count.
+    const std::string what = e.what();
+    throw std::invalid_argument(what.rfind("width", 0) == 0    ? "--" + what
+                                : what.rfind("panels", 0) == 0 ? "--modes: " + what
+                                                               : "replay: " + what);
+  }
+  return layout;
+}
+
+// ffmpeg's arguments for raw BGRA frames of `width` x `height` at `fps` into an H.264 MP4 `part`.
+// yuv420p: the pixel format every player decodes; +faststart: playable while downloading.
+std::vector<std::string> EncoderArgs(const fs::path& ffmpeg, int width, int height, double fps,
+                                     const fs::path& part) {
+  return {ffmpeg.string(),
+          "-hide_banner",
+          "-nostdin",
+          "-loglevel",
+          "error",
+          "-y",
+          "-f",
+          "rawvideo",
+          "-pix_fmt",
+          "bgra",
+          "-s",
+          std::to_string(width) + "x" + std::to_string(height),
+          "-framerate",
+          FormatSignificant(fps, 17),
+          "-i",
+          "-",
+          "-c:v",
+          "libx264",
+          "-preset",
+          "veryfast",
+          "-crf",
+          "23",
+          "-pix_fmt",
+          "yuv420p",
+          "-movflags",
+          "+faststart",
+          "-f",
+          "mp4",
+          part.string()};
+}
+
+// The preview beside the video (replay_preview.gif/.webm): the run at 4x, 480 px wide, 6
+// frames/s, at most 15 s.
+void WritePreview(const fs::path& ffmpeg, const fs::path& out, const std::string& format,
+                  const fs::path& log) {
+  const fs::path preview = out.parent_path() / (out.stem().string() + "_preview." + format);
+  const fs::path preview_part = fs::path(preview).concat(".part");
+  // The run at 4x, 480 px wide, 6 frames/s, at most 15 s (the first minute of the run): a
+  // few MB (the cells' noise defeats GIF's compression; fewer colours and no dithering help).
+  std::vector<std::string> args = {
+      ffmpeg.string(), "-hide_banner", "-nostdin", "-loglevel", "error", "-y", "-i",
+      out.string(),    "-t",           "15"};
+  if (format == "gif")
+    args.insert(args.end(), {"-vf",
+                             "setpts=PTS/4,fps=6,scale=480:-2:flags=lanczos,split[a][b];"
+                             "[a]palettegen=max_colors=64[p];[b][p]paletteuse=dither=none",
+                             "-loop", "0", "-f", "gif"});
+  else
+    args.insert(args.end(), {"-vf", "setpts=PTS/4,fps=6,scale=480:-2", "-c:v", "libvpx-vp9", "-b:v",
+                             "0", "-crf", "40", "-deadline", "realtime", "-f", "webm"});
+  args.push_back(preview_part.string());
+  try {
+    RunFfmpeg(args, log);
+  } catch (const std::exception& e) {
+    fs::remove(preview_part);
+    throw std::runtime_error(std::string(e.what()) + " (the video itself, " + out.string() +
+                             ", is complete)");
+  }
+  fs::rename(preview_part, preview);
+}
+
 }  // namespace
 
 fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o,
@@ -265,60 +355,11 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o,
 
   const replay::Header& h = reader.header();
   const replay::Frame first_frame = reader.Load(first);
-  viz::ReplayLayoutOptions layout;
-  layout.width = o.width;
-  // The view stays fixed relative to the ego: the grid as placed at the first frame.
-  const Position lo =
-      Position(first_frame.origin_x - first_frame.ego.x, first_frame.origin_y - first_frame.ego.y);
-  layout.view = {lo, lo + Vector2(h.cells_x * h.resolution, h.cells_y * h.resolution)};
-  layout.panels = static_cast<int>(modes.size());
-  if (o.detections) layout.sensors = h.sensors;
-  layout.particles = o.particles;
-  try {
-    layout.Validate();
-  } catch (const std::invalid_argument& e) {
-    // Name the option a user can change: --width for the width, --modes for the panel count.
-    const std::string what = e.what();
-    throw std::invalid_argument(what.rfind("width", 0) == 0    ? "--" + what
-                                : what.rfind("panels", 0) == 0 ? "--modes: " + what
-                                                               : "replay: " + what);
-  }
-  viz::ReplayRenderer renderer(layout);
-
-  const double fps = o.speed / h.interval;
+  viz::ReplayRenderer renderer(Layout(h, first_frame, modes.size(), o));
   const fs::path part = fs::path(out).concat(".part");
   const fs::path log = fs::path(out).replace_extension(".ffmpeg.log");
-  // yuv420p: the pixel format every player decodes; +faststart: playable while downloading.
-  FfmpegPipe pipe({ffmpeg->string(),
-                   "-hide_banner",
-                   "-nostdin",
-                   "-loglevel",
-                   "error",
-                   "-y",
-                   "-f",
-                   "rawvideo",
-                   "-pix_fmt",
-                   "bgra",
-                   "-s",
-                   std::to_string(renderer.width()) + "x" + std::to_string(renderer.height()),
-                   "-framerate",
-                   FormatSignificant(fps, 17),
-                   "-i",
-                   "-",
-                   "-c:v",
-                   "libx264",
-                   "-preset",
-                   "veryfast",
-                   "-crf",
-                   "23",
-                   "-pix_fmt",
-                   "yuv420p",
-                   "-movflags",
-                   "+faststart",
-                   "-f",
-                   "mp4",
-                   part.string()},
-                  log);
+  FfmpegPipe pipe(
+      EncoderArgs(*ffmpeg, renderer.width(), renderer.height(), o.speed / h.interval, part), log);
   callbacks.Begin("replay video " + out.filename().string(), static_cast<int>(last - first));
   const std::size_t bytes = static_cast<std::size_t>(renderer.width()) * renderer.height() * 4;
   try {
@@ -338,32 +379,7 @@ fs::path WriteVideo(const replay::Reader& reader, const ReplayOptions& o,
   }
   fs::rename(part, out);
 
-  if (o.preview != "none") {
-    const fs::path preview = out.parent_path() / (out.stem().string() + "_preview." + o.preview);
-    const fs::path preview_part = fs::path(preview).concat(".part");
-    // The run at 4x, 480 px wide, 6 frames/s, at most 15 s (the first minute of the run): a
-    // few MB (the cells' noise defeats GIF's compression; fewer colours and no dithering help).
-    std::vector<std::string> args = {
-        ffmpeg->string(), "-hide_banner", "-nostdin", "-loglevel", "error", "-y", "-i",
-        out.string(),     "-t",           "15"};
-    if (o.preview == "gif")
-      args.insert(args.end(), {"-vf",
-                               "setpts=PTS/4,fps=6,scale=480:-2:flags=lanczos,split[a][b];"
-                               "[a]palettegen=max_colors=64[p];[b][p]paletteuse=dither=none",
-                               "-loop", "0", "-f", "gif"});
-    else
-      args.insert(args.end(), {"-vf", "setpts=PTS/4,fps=6,scale=480:-2", "-c:v", "libvpx-vp9",
-                               "-b:v", "0", "-crf", "40", "-deadline", "realtime", "-f", "webm"});
-    args.push_back(preview_part.string());
-    try {
-      RunFfmpeg(args, log);
-    } catch (const std::exception& e) {
-      fs::remove(preview_part);
-      throw std::runtime_error(std::string(e.what()) + " (the video itself, " + out.string() +
-                               ", is complete)");
-    }
-    fs::rename(preview_part, preview);
-  }
+  if (o.preview != "none") WritePreview(*ffmpeg, out, o.preview, log);
   fs::remove(log);
   return out;
 }

@@ -57,10 +57,11 @@ def installed_network_dir():
 
 
 def run_scenario(path, seed=None, duration=None, modes=("position", "velocity", "dual"),
-                 overrides=(), network_dir=None, work_dir=None, threads=0):
+                 overrides=(), network_dir=None, work_dir=None, threads=0, out=None):
     """Runs a scenario file as `dualgrid run` does and returns its results as a dict.
 
     The same scenario and seed give the command line's numbers (metrics, objects, clusters).
+    out: a folder to write the run folder of `dualgrid run --out` to (the same files).
     network_dir defaults to $DUALGRID_NETWORK_DIR, else this installation's networks
     (installed_network_dir()), else the build tree's. Full description:
     help(dualgrid._dualgrid.run_scenario) and docs/python.md.
@@ -69,7 +70,7 @@ def run_scenario(path, seed=None, duration=None, modes=("position", "velocity", 
         network_dir = installed_network_dir()
     return _run_scenario(str(path), seed=seed, duration=duration, modes=list(modes),
                          overrides=list(overrides), network_dir=network_dir, work_dir=work_dir,
-                         threads=threads)
+                         threads=threads, out=None if out is None else str(out))
 
 
 

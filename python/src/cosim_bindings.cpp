@@ -18,6 +18,8 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/outputs/run.hpp"
+#include "dualgrid/outputs/run_config.hpp"
 #include "run_results.hpp"
 
 namespace dualgrid::python {
@@ -25,20 +27,46 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// SUMO's route file and log go to `work_dir`, or a temporary folder removed afterwards.
+void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
+              std::optional<fs::path> work_dir) {
+  const fs::path work =
+      work_dir ? *work_dir
+               : fs::temp_directory_path() /
+                     ("dualgrid_py_" + std::to_string(getpid()) + "_" + cs.config().sim.name);
+  fs::create_directories(work);
+  {
+    py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
+    cs.Start(network_dir, work);
+    while (cs.Step()) {
+    }
+    cs.Finish();
+  }
+  if (!work_dir) {
+    std::error_code ec;
+    fs::remove_all(work, ec);
+  }
+}
+
+// The run folder `out`, as `dualgrid run` writes it with its default options.
+void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config,
+                 const fs::path& network_dir, const fs::path& out) {
+  outputs::RunFolderOptions folder;
+  folder.out = out;
+  folder.network_dir = network_dir;
+  folder.quiet = true;
+  py::gil_scoped_release release;
+  outputs::WriteRunFolder(cs, config, folder);
+}
+
 py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
                      std::optional<double> duration, const std::vector<std::string>& modes,
                      const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
-                     std::optional<fs::path> work_dir, int threads) {
-  std::vector<scenario::Override> sets;
-  for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
-  scenario::ScenarioConfig config = scenario::LoadScenario(path, sets);
-  if (seed) config.sim.seed = *seed;
-  if (duration) {
-    if (!(*duration > 0.0 && *duration <= 3600.0))
-      throw py::value_error("run_scenario: duration must be in (0, 3600] s, got " +
-                            std::to_string(*duration));
-    config.sim.duration = *duration;
-  }
+                     std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out) {
+  if (duration && !(*duration > 0.0 && *duration <= 3600.0))
+    throw py::value_error("run_scenario: duration must be in (0, 3600] s, got " +
+                          std::to_string(*duration));
+  const scenario::ScenarioConfig config = outputs::LoadRunConfig(path, overrides, seed, duration);
   cosim::CoSimOptions options;
   options.modes.clear();
   for (const std::string& name : modes) {
@@ -50,31 +78,18 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
   }
   if (options.modes.empty()) throw py::value_error("run_scenario: modes must not be empty");
   if (threads < 0) throw py::value_error("run_scenario: threads must be >= 0");
+  if (out && work_dir)
+    throw py::value_error("run_scenario: work_dir: not with out (SUMO's files go there)");
   options.threads = threads;
-  // SUMO's route file and log: the caller's folder, or a temporary one removed afterwards.
-  const bool own_work = !work_dir;
-  const fs::path work =
-      work_dir ? *work_dir
-               : fs::temp_directory_path() /
-                     ("dualgrid_py_" + std::to_string(getpid()) + "_" + config.sim.name);
-  fs::create_directories(work);
-
   cosim::CoSimulation cs(config, options);
   ClusterColumns clusters;
-  {
-    py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
-    cs.Start(network_dir ? *network_dir : sim::DefaultNetworkDir(), work);
-    cs.AddObserver(&clusters);
-    while (cs.Step()) {
-    }
-    cs.Finish();
-  }
-  if (own_work) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
-  }
-  py::dict r = Results(cs, config, clusters);
-  return r;
+  cs.AddObserver(&clusters);
+  const fs::path networks = network_dir ? *network_dir : sim::DefaultNetworkDir();
+  if (out)
+    RunToFolder(cs, config, networks, *out);
+  else
+    RunToEnd(cs, networks, work_dir);
+  return Results(cs, config, clusters);
 }
 
 }  // namespace
@@ -92,7 +107,7 @@ void BindCosim(py::module_& m) {
         py::arg("duration") = py::none(),
         py::arg("modes") = std::vector<std::string>{"position", "velocity", "dual"},
         py::arg("overrides") = std::vector<std::string>{}, py::arg("network_dir") = py::none(),
-        py::arg("work_dir") = py::none(), py::arg("threads") = 0,
+        py::arg("work_dir") = py::none(), py::arg("threads") = 0, py::arg("out") = py::none(),
         R"doc(Runs a scenario file as `dualgrid run` does (SUMO, radar, one filter per mode, the
 paper's scoring) and returns its results; the same scenario and seed give the CLI's numbers.
 
@@ -101,7 +116,10 @@ by side on the same detections. overrides: "KEY=VALUE" texts as `--set` (e.g.
 "filter.preset=paper"). network_dir: folder of the built networks (default: the installed or
 build tree's, or $DUALGRID_NETWORK_DIR). work_dir: where SUMO's route file and sumo.log go
 (default: a temporary folder, removed). threads: OpenMP threads (0: default; results do not
-depend on it). One run at a time per process (libsumo).
+depend on it). out: a folder to write the run folder to, as `dualgrid run --out DIR` with its
+default options does (metrics, tables, CSV files, figures, the replay recording, summary.json
+last; the same bytes as the command line's except the wall-clock times of summary.json; SUMO's
+files go there too, so not with work_dir). One run at a time per process (libsumo).
 
 Returns a dict: scenario, seed, steps, simulated_s, requested_s, complete (False when the ego
 left the network early), detections_per_step, metrics ({mode: metrics.json's entry}),

@@ -59,7 +59,8 @@ void CheckNetworkFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor,
+                                  const std::filesystem::path& package_dir) {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("DUALGRID_NETWORK_DIR"); env && *env)
     return {env, "DUALGRID_NETWORK_DIR"};
@@ -70,13 +71,12 @@ NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
     const fs::path installed = self.parent_path().parent_path() / "share" / "dualgrid" / "networks";
     if (fs::is_directory(installed, ec)) return {installed, "installed"};
   }
+  if (!package_dir.empty()) return {package_dir, "package"};
 #ifdef DUALGRID_NETWORK_DIR
   if (fs::is_directory(DUALGRID_NETWORK_DIR, ec)) return {DUALGRID_NETWORK_DIR, "build tree"};
 #endif
   return {"networks", "none"};
 }
-
-std::filesystem::path DefaultNetworkDir() { return FindNetworkDir().dir; }
 
 bool IsNetworkPath(const std::string& network) {
   return network.ends_with(".xml") || network.ends_with(".xml.gz") ||

@@ -21,18 +21,31 @@ namespace dualgrid::sim {
 struct NetworkDirLocation {
   std::filesystem::path dir;
   /// "DUALGRID_NETWORK_DIR" (the environment), "installed" (share/dualgrid/networks beside the
-  /// program or library), "build tree" (the build's networks/ folder, compiled in), or "none".
+  /// program), "package" (the installed package's, compiled into a find_package(dualgrid)
+  /// consumer), "build tree" (the build's networks/ folder, compiled in), or "none".
   std::string source;
 };
 /// The first of: the environment variable DUALGRID_NETWORK_DIR; `PREFIX/share/dualgrid/networks`
 /// where PREFIX is the parent of the folder holding `anchor` (the running program by default,
-/// /proc/self/exe: an installed bin/dualgrid finds its own tree wherever it was moved); the build
-/// tree's networks/ folder compiled into this library. Only folders that exist count (the
-/// environment variable excepted: it is the user's explicit choice); source "none" with the
-/// relative path "networks" when none does.
-NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {});
-/// FindNetworkDir().dir.
-std::filesystem::path DefaultNetworkDir();
+/// /proc/self/exe: an installed bin/dualgrid finds its own tree wherever it was moved);
+/// `package_dir` when given (then nothing else is looked at: a consumer of the installed package
+/// never uses a build tree); the build tree's networks/ folder compiled into this library. Only
+/// folders that exist count, except the environment variable and `package_dir` (explicit
+/// choices: a missing one is named by the error of the first network looked up in it); source
+/// "none" with the relative path "networks" when none does. Never throws.
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {},
+                                  const std::filesystem::path& package_dir = {});
+/// FindNetworkDir().dir; in a program built against the installed package (find_package(dualgrid)
+/// defines DUALGRID_PACKAGE_NETWORK_DIR for it), the package's networks. Never throws: a folder
+/// without the network asked for is an std::invalid_argument of CoSimulation::Start
+/// (ResolveNetwork) naming the folder and DUALGRID_NETWORK_DIR.
+inline std::filesystem::path DefaultNetworkDir() {
+#ifdef DUALGRID_PACKAGE_NETWORK_DIR
+  return FindNetworkDir({}, DUALGRID_PACKAGE_NETWORK_DIR).dir;
+#else
+  return FindNetworkDir().dir;
+#endif
+}
 
 /// True when a scenario's `network` is a file path (it ends in .xml or .xml.gz, or has a '/'),
 /// false for the name of a built network ("highway").

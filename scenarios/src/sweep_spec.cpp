@@ -1,4 +1,4 @@
-#include "sweep_spec.hpp"
+#include "dualgrid/scenario/sweep_spec.hpp"
 #include "dualgrid/core/text.hpp"
 
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <set>
 #include <stdexcept>
 
-namespace dualgrid::tools {
+namespace dualgrid::scenario {
 namespace {
 
 constexpr std::size_t kMaxValues = 1000;
@@ -94,4 +94,4 @@ std::vector<std::vector<std::string>> SweepSettings(const std::vector<SweepAxis>
   return out;
 }
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::scenario

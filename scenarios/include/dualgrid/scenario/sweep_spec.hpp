@@ -1,11 +1,12 @@
-// The `--set KEY=LIST` grammar of `dualgrid sweep` (docs/stress.md): LIST is comma-separated
-// items, each a value ("0.5", "paper") or an inclusive numeric range "first:step:last".
+// Sweeps over scenario keys: the `--set KEY=LIST` grammar of `dualgrid sweep` (docs/stress.md).
+// LIST is comma-separated items, each a value ("0.5", "paper") or an inclusive numeric range
+// "first:step:last".
 #pragma once
 
 #include <string>
 #include <vector>
 
-namespace dualgrid::tools {
+namespace dualgrid::scenario {
 
 struct SweepAxis {
   std::string key;
@@ -24,4 +25,4 @@ SweepAxis ParseSweepAxis(const std::string& text);
 /// The cartesian product of the axes' values (the first axis varies slowest).
 std::vector<std::vector<std::string>> SweepSettings(const std::vector<SweepAxis>& axes);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::scenario

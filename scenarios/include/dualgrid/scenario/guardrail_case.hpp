@@ -1,12 +1,13 @@
-// `dualgrid tangential --kind guardrail`: the ego beside a guard rail with vehicles passing on the
-// other side of it, the multipath stress case of issue 27 (docs/stress.md). The rail is the only
-// obstacle, so every ghost in the run is a ghost off it (or off a passing truck's flank).
+// The guard-rail stress case (`dualgrid tangential --kind guardrail`, docs/stress.md): the ego
+// beside a guard rail with vehicles passing on the other side of it, for multipath. The rail is
+// the only obstacle, so every ghost in the run is a ghost off it (or off a passing truck's flank).
+// Pure: it returns the scenario's text.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
-namespace dualgrid::tools {
+namespace dualgrid::scenario {
 
 struct GuardRailCase {
   double offset = 3.75;     ///< ego centre line -> rail [m] (3.75: the highway's median rail)
@@ -24,4 +25,4 @@ struct GuardRailCase {
 /// insertion gap, a rail angle that brings the rail into the ego's lane at the pivot.
 std::string GuardRailScenario(const GuardRailCase& c);
 
-}  // namespace dualgrid::tools
+}  // namespace dualgrid::scenario
