@@ -128,7 +128,7 @@ bool RecordedSource::Advance(IdRegistry& ids) {
   advanced_ = true;
   const RecordedScan& first = seq_.scans[batches_[batch_]];
   next_ = batches_[batch_ + 1];
-  frame_.step = static_cast<int>(batch_);
+  frame_.step = static_cast<int>(batch_) + 1;  // as `run`: the first step is 1
   frame_.time = seq_.Time(first.timestamp_us);
   sim::VehicleState& e = frame_.ego;
   e.id = "ego";
@@ -139,7 +139,24 @@ bool RecordedSource::Advance(IdRegistry& ids) {
   e.speed = first.ego_velocity.norm();
   e.lane_yaw = first.lane_yaw;
   ego_ = {first.ego_pose, first.ego_velocity, first.ego_yaw_rate, seq_.ego_length, seq_.ego_width};
-  EstimateTracks(ids);
+  if (seq_.annotated) {
+    // The references are sorted by id per scan (the reader's contract).
+    frame_.vehicles.clear();
+    for (std::size_t k = first.ref_begin; k < first.ref_end; ++k) {
+      const recorded::ReferenceObject& r = seq_.references[k];
+      sim::VehicleState v;
+      v.id = r.id;
+      v.type = r.type;
+      v.box = r.box;
+      v.velocity = r.velocity;
+      v.speed = r.velocity.norm();
+      v.lane_yaw = r.box.yaw;
+      ids.Id(v.id);
+      frame_.vehicles.push_back(std::move(v));
+    }
+  } else {
+    EstimateTracks(ids);
+  }
   return true;
 }
 

@@ -205,18 +205,25 @@ void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m,
 
 void WriteObjects(const std::vector<std::string>& modes,
                   const std::vector<eval::ScenarioMetrics>& metrics, const cosim::IdRegistry& ids,
-                  const std::filesystem::path& path) {
+                  const std::filesystem::path& path,
+                  const std::map<std::string, std::string>* categories) {
   std::ostringstream os;
   os << "mode,id,name,frames_in_grid,frames_tracked,frames_tracked_v,scored,D,D_v,t_d,delta_x,"
-        "delta_v\n";
+        "delta_v"
+     << (categories ? ",category\n" : "\n");
   auto opt = [](const std::optional<double>& v) { return v ? FormatFixed(*v, 4) : std::string(); };
+  auto category = [&](const std::string& name) {
+    if (!categories) return std::string();
+    const auto it = categories->find(name);
+    return "," + (it != categories->end() ? it->second : std::string());
+  };
   for (std::size_t m = 0; m < modes.size(); ++m)
     for (const auto& o : metrics[m].objects)
       os << modes[m] << ',' << o.id << ',' << ids.Name(o.id) << ',' << o.frames_in_grid << ','
          << o.frames_tracked << ',' << o.frames_tracked_v << ',' << (o.scored ? 1 : 0) << ','
          << opt(o.tracked_fraction) << ',' << opt(o.tracked_fraction_v) << ','
          << opt(o.detection_time) << ',' << opt(o.position_error) << ',' << opt(o.velocity_error)
-         << '\n';
+         << category(ids.Name(o.id)) << '\n';
   WriteTextFile(path, os.str());
 }
 

@@ -60,8 +60,20 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
   return all;
 }
 
+ReferenceWords WordsFor(const std::string& references) {
+  if (references == "annotated")
+    return {"annotated instance boxes (2 Hz annotations, interpolated)",
+            "an instance's velocity (estimated from its annotations)",
+            "object (annotated instance token)", "annotated"};
+  if (references == "tracks")
+    return {"track boxes estimated from their labelled points",
+            "a track's velocity (estimated from its points)", "object (track id)",
+            "track estimate"};
+  return {};
+}
+
 void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
-                 double ahead, double half_width, bool captions) {
+                 double ahead, double half_width, bool captions, const ReferenceWords& words) {
   const sim::Frame& f = pipeline.frame();
   const GridFrame& g = pipeline.grid_frame();
   // Drawn relative to the ego in the grid frame, like the grid figures: the axes read as metres
@@ -81,7 +93,8 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
   options.y_label = "y [m]";
   options.caption =
       AxesNote(g) + " Arrows: motion over ground in " + FormatFixed(kArrowSeconds, 1) +
-      " s; black: a vehicle's velocity (SUMO); coloured: a detection's radial velocity, ego "
+      " s; black: " + words.velocity +
+      "; coloured: a detection's radial velocity, ego "
       "motion compensated (short where a vehicle moves across the line of sight). Colour: the "
       "radar (field of view outline, its detections). A label that finds no free place is left "
       "out; one set apart from its box has a leader line.";
@@ -146,7 +159,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
                       const std::vector<cosim::GridSnapshot>& snapshots,
                       const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
                       const sim::Frame& frame, double time, const std::filesystem::path& path,
-                      bool captions) {
+                      bool captions, const ReferenceWords& words) {
   // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
   // not with the network's (often UTM-sized) coordinates.
   const Position ego = g.ToGrid(frame.ego.box.center);
@@ -179,14 +192,18 @@ void RenderGridFigure(const std::vector<std::string>& modes,
   options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the caption)
   options.y_label = "y [m]";
   options.title = "Dynamic grids at t = " + FormatFixed(time, 2) + " s";
+  options.truth_label = words.legend;
   options.caption =
       "Cells: white free, black static, grey unknown; dynamic mass in the hue of its direction "
       "of motion over ground (the cell's mean particle velocity, grid frame: wheel), colours "
-      "blended by the cell's masses. Black outlines: ground-truth vehicle boxes (SUMO); green: "
+      "blended by the cell's masses. Black outlines: " +
+      words.boxes +
+      "; green: "
       "the ego. Coloured outlines: the mode's clusters of dynamic particles (blue-violet "
       "matched to a vehicle, orange duplicate, magenta false) with their estimated velocity; "
-      "black arrows: true velocity. Arrows: motion over ground in " +
-      FormatFixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
+      "black arrows: " +
+      words.velocity + ". Arrows: motion over ground in " + FormatFixed(options.arrow_seconds, 1) +
+      " s. " + AxesNote(g);
   if (!captions) options.caption.clear();
   viz::RenderGridPanels(panels, path.string(), options);
 }
@@ -209,10 +226,10 @@ TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
                          const std::filesystem::path& path, const TrackedShares& errors,
-                         bool captions) {
+                         bool captions, const ReferenceWords& words) {
   viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
   chart.title = title;
-  chart.x_label = "object (SUMO vehicle id)";
+  chart.x_label = words.object;
   chart.y_label = y_label;
   chart.percent = true;
   // One column wide whatever the number of objects: a wider chart would need larger fonts

@@ -122,14 +122,16 @@ std::vector<std::string> RecordedNotes(const RecordedRun& r, const std::vector<s
     const auto& p = metrics[m].points;
     if (!p) continue;
     auto f = [](const std::optional<double>& v) { return v ? FormatFixed(*v, 3) : "—"; };
-    notes.push_back("Point-level dynamic classification, " + modes[m] + ": precision " +
-                    f(p->precision) + ", recall " + f(p->recall) + ", F1 " + f(p->f1) + " (" +
-                    std::to_string(p->true_positives) + " TP, " +
-                    std::to_string(p->false_positives) + " FP, " +
-                    std::to_string(p->false_negatives) + " FN over " + std::to_string(p->frames) +
-                    " cycles; D and D_v per track_id against "
-                    "boxes estimated from the tracks' points).");
+    notes.push_back(
+        "Point-level dynamic classification, " + modes[m] + ": precision " + f(p->precision) +
+        ", recall " + f(p->recall) + ", F1 " + f(p->f1) + " (" + std::to_string(p->true_positives) +
+        " TP, " + std::to_string(p->false_positives) + " FP, " +
+        std::to_string(p->false_negatives) + " FN over " + std::to_string(p->frames) + " cycles; " +
+        (r.annotated ? std::string("D and D_v per instance against its annotated boxes).")
+                     : std::string("D and D_v per track_id against boxes estimated from "
+                                   "the tracks' points).")));
   }
+  notes.insert(notes.end(), r.notes.begin(), r.notes.end());
   if (r.skipped_points > 0)
     notes.push_back(std::to_string(r.skipped_points) +
                     " detection(s) skipped: NaN position, azimuth, range or velocity.");
@@ -162,7 +164,8 @@ std::string WriteResults(const cosim::CoSimulation& cosim, const scenario::Scena
   const std::vector<std::string>& modes = cosim.mode_names();
   const cosim::IdRegistry& ids = cosim.pipeline().ids();
   WriteTextFile(out / "metrics.json", metrics_json.dump(2) + "\n");
-  WriteObjects(modes, metrics, ids, out / "objects.csv");
+  WriteObjects(modes, metrics, ids, out / "objects.csv",
+               recorded && !recorded->categories.empty() ? &recorded->categories : nullptr);
   std::vector<eval::ModeRuns> runs;
   for (std::size_t m = 0; m < modes.size(); ++m) runs.push_back({modes[m], {metrics[m]}});
   eval::ComparisonTable table = eval::MakeComparisonTable(config.sim.name, runs);
@@ -204,7 +207,8 @@ void WriteRunFigures(const cosim::CoSimulation& cosim, const scenario::ScenarioC
           RenderTrackedShares(modes, RunTrackedShares(metrics, cosim.pipeline().ids(), v),
                               config.sim.name + ": tracked share " + what + " per object (seed " +
                                   std::to_string(config.sim.seed) + ")",
-                              "tracked share " + what + " [%]", p, {}, o.figure_captions);
+                              "tracked share " + what + " [%]", p, {}, o.figure_captions,
+                              WordsFor(o.references));
         },
         warnings);
   }

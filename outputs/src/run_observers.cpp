@@ -138,6 +138,7 @@ PictureObserver::PictureObserver(const std::filesystem::path& out, std::vector<d
       particles_(options.write_particles),
       formats_(options.figure_formats),
       captions_(options.figure_captions),
+      words_(WordsFor(options.references)),
       warnings_(warnings) {}
 
 bool PictureObserver::WantsVelocities(int, double time) {
@@ -159,12 +160,13 @@ void PictureObserver::OnStep(const cosim::StepView& v) {
         out_ / "figures" / ("grid_t" + stamp + ".png"), formats_,
         [&](const auto& p) {
           RenderGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f, f.time,
-                           p, captions_);
+                           p, captions_, words_);
         },
         warnings_);
     TryFigures(
         out_ / "figures" / ("scene_t" + stamp + ".png"), formats_,
-        [&](const auto& p) { RenderScene(v.pipeline, p, 60, 140, 22, captions_); }, warnings_);
+        [&](const auto& p) { RenderScene(v.pipeline, p, 60, 140, 22, captions_, words_); },
+        warnings_);
   }
   if (particles_)
     for (std::size_t m = 0; m < v.mode_names.size(); ++m)

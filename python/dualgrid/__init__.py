@@ -34,6 +34,8 @@ from ._dualgrid import (
     preset,
     preset_names,
     run_recorded,
+    read_nuscenes,
+    read_radarscenes,
     set_num_threads,
 )
 from ._dualgrid import run_scenario as _run_scenario
@@ -142,6 +144,8 @@ __all__ = [
     "preset",
     "preset_names",
     "run_recorded",
+    "read_nuscenes",
+    "read_radarscenes",
     "run_scenario",
     "set_num_threads",
 ]

@@ -8,33 +8,13 @@
 
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "h5.hpp"
+#include "write_util.hpp"
 
 namespace dualgrid::recorded {
 
 namespace {
 
 using Json = nlohmann::json;
-
-void WriteJson(const std::filesystem::path& file, const Json& j) {
-  std::ofstream out(file);
-  out << j.dump(1) << "\n";
-  out.close();
-  if (!out) throw std::runtime_error(file.string() + ": write failed");
-}
-
-// A deterministic 32-hex-digit id per detection (FNV-1a 64 of the sequence and the row, twice).
-std::string Uuid(const std::string& sequence, std::size_t row) {
-  auto fnv = [&](std::uint64_t h) {
-    for (char c : sequence + "#" + std::to_string(row))
-      h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
-    return h;
-  };
-  char buf[33];
-  std::snprintf(buf, sizeof buf, "%016llx%016llx",
-                static_cast<unsigned long long>(fnv(14695981039346656037ull)),
-                static_cast<unsigned long long>(fnv(0x9e3779b97f4a7c15ull)));
-  return buf;
-}
 
 }  // namespace
 
@@ -143,7 +123,7 @@ void WriteRadarScenes(const RecordedSequence& seq, const std::filesystem::path& 
       ycc[i] = cc.y();
       xs[i] = p.position.x();
       ys[i] = p.position.y();
-      uuid[i] = Uuid(seq.name, i);
+      uuid[i] = HexId(seq.name, i);
       track[i] = p.track >= 0 ? seq.track_names[p.track] : "";
       label[i] = static_cast<std::uint8_t>(p.label >= 0 ? p.label : kStaticLabel);
     }

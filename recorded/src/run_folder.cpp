@@ -216,4 +216,40 @@ RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   return seq;
 }
 
+std::vector<NuScenesKeyFrame> ReadKeyFrames(const std::filesystem::path& run_dir,
+                                            const RecordedSequence& seq, double period) {
+  std::map<std::string, std::string> category;  // track -> category
+  for (const RecordedPoint& p : seq.points)
+    if (p.track >= 0) category.try_emplace(seq.track_names[p.track], CategoryOfLabel(p.label));
+  std::filesystem::path file = run_dir / "ground_truth.csv";
+  if (!std::filesystem::exists(file)) file = run_dir / "ground_truth.csv.gz";
+  CsvReader in(file);
+  const std::size_t c_step = in.Column("step"), c_time = in.Column("time"), c_id = in.Column("id"),
+                    c_ego = in.Column("is_ego"), c_x = in.Column("x"), c_y = in.Column("y"),
+                    c_yaw = in.Column("yaw"), c_vx = in.Column("vx"), c_vy = in.Column("vy"),
+                    c_len = in.Column("length"), c_wid = in.Column("width");
+  std::vector<NuScenesKeyFrame> out;
+  long last_step = -1;
+  while (in.Next()) {
+    const double t = in.Number(c_time);
+    const double k = t / period;
+    if (std::abs(k - std::round(k)) > 1e-6) continue;
+    const long step = in.Int(c_step);
+    if (step != last_step) {
+      out.push_back({std::llround(t * 1e6), {}});
+      last_step = step;
+    }
+    if (in.Int(c_ego) != 0) continue;
+    ReferenceObject v;
+    v.id = in.Text(c_id);
+    const auto c = category.find(v.id);
+    v.type = c != category.end() ? c->second : "vehicle.car";
+    v.box = {
+        {in.Number(c_x), in.Number(c_y)}, in.Number(c_yaw), in.Number(c_len), in.Number(c_wid)};
+    v.velocity = {in.Number(c_vx), in.Number(c_vy)};
+    out.back().vehicles.push_back(std::move(v));
+  }
+  return out;
+}
+
 }  // namespace dualgrid::recorded

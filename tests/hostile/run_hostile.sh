@@ -205,5 +205,36 @@ printf 'step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego
 check "recorded:run_nan_number" 2 "detections.csv: row 2, column 'x': expected a finite number, got 'nan'" \
   "$dualgrid" filter "$work/runfolder" --no-figures -q --out "$work/rso_run3"
 
+# nuScenes (issue 40): a scene written by numpy + json (tests/recorded/make_nuscenes.py --mutate
+# KIND), each broken one way: one error line naming the file and the field, exit 2.
+ns_case() {  # ns_case KIND CODE TEXT
+  "$py" "$repo/tests/recorded/make_nuscenes.py" --out "$work/ns_$1" --duration 1 --mutate "$1" >/dev/null
+  check "nuscenes:$1" "$2" "$3" "$dualgrid" filter "$work/ns_$1" --scene scene-test --no-figures -q --out "$work/nso_$1"
+}
+ns_case missing_table 2 "v1.0-mini/ego_pose.json: missing: table 'ego_pose' is needed"
+ns_case dangling_token 2 "sample_data.json: record 'sd-RADAR_FRONT-3', field 'ego_pose_token': token 'nowhere' points nowhere"
+ns_case pcd_header 2 ".pcd: header keys 'TYPE'/'SIZE': field 'y' has type X"
+ns_case pcd_short 2 "bytes after the header, fewer than its POINTS x row size"
+ns_case nan_field 2 ".pcd: field 'vx_comp': not finite at point 1"
+ns_case unknown_channel 2 "sensor.json: record 'sensor-RADAR_FRONT_LEFT', field 'channel': unknown radar channel 'RADAR_TOP'"
+"$py" "$repo/tests/recorded/make_nuscenes.py" --out "$work/ns_ok" --duration 1 >/dev/null
+check "nuscenes:unknown_scene" 2 "scene.json: field 'name': no scene named (or with token) 'scene-none'" \
+  "$dualgrid" filter "$work/ns_ok" --scene scene-none --no-figures -q --out "$work/nso_scene"
+check "nuscenes:unknown_version" 2 "v1.0-trainval: missing: no version folder" \
+  "$dualgrid" filter "$work/ns_ok" --scene scene-test --version v1.0-trainval --no-figures -q --out "$work/nso_version"
+check "nuscenes:version_without_scene" 2 "only with --scene" \
+  "$dualgrid" filter "$work/ns_ok" --version v1.0-trainval --no-figures -q --out "$work/nso_noscene"
+check "nuscenes:root_without_scene" 2 "a nuScenes root (v1.0-mini/scene.json): give --scene" \
+  "$dualgrid" filter "$work/ns_ok" --no-figures -q --out "$work/nso_noscene2"
+# A run with one radar cannot be the five channels.
+mkdir -p "$work/onerun"
+printf 'step,time,sensor,sensor_name,ego_x,ego_y,ego_yaw,ego_vx,ego_vy,ego_yaw_rate,ego_length,ego_width,lane_yaw,mount_x,mount_y,mount_yaw,fov,min_range,max_range\n1,0.5,0,front,0,0,0,10,0,0,4.5,1.8,0,2.25,0,0,1,0.5,80\n' >"$work/onerun/scans.csv"
+printf 'step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter,vclass\n' >"$work/onerun/detections.csv"
+printf 'step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,x_ego,y_ego,vx_ego,vy_ego,rcs_dbsm\n1,0.5,ego,ego,1,0,0,0,10,0,10,0,0,4.5,1.8,l,0,0,0,0,10\n' >"$work/onerun/ground_truth.csv"
+check "nuscenes:export_not_five_radars" 2 "nuScenes has five channels" \
+  "$dualgrid" export "$work/onerun" --format nuscenes --out "$work/nso_export"
+check "nuscenes:bad_states" 2 "--ambig-states: expected 'all' or whole numbers" \
+  "$dualgrid" filter "$work/ns_ok" --scene scene-test --ambig-states 3,x --no-figures -q --out "$work/nso_states"
+
 echo "hostile inputs: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -9,6 +9,7 @@
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
+#include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
 
@@ -21,20 +22,43 @@ struct ExportOptions {
   std::filesystem::path out;
   std::string format = "radarscenes";
   std::string sequence = "sequence_1";
+  recorded::NuScenesWriteOptions nuscenes;
   bool quiet = false;
 };
 
 int RunExport(const ExportOptions& o) {
   recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
-  seq.name = o.sequence;
+  // The run's settings travel with the export (docs/recorded-data.md, "Export").
+  std::optional<std::filesystem::path> scenario;
+  if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))
+    scenario = o.run_dir / "scenario.yaml";
   PrepareOutputFolder(o.out);
-  // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end.
-  const double a = std::max(0.0, 0.5 * seq.ego_length - 1.0);
-  recorded::WriteRadarScenes(seq, o.out, a);
+  std::filesystem::path written;
+  if (o.format == "nuscenes") {
+    const auto keys = recorded::ReadKeyFrames(o.run_dir, seq, 0.5);
+    recorded::NuScenesWriteOptions n = o.nuscenes;
+    n.scenario = scenario;
+    recorded::WriteNuScenes(seq, keys, o.out, n);
+    written = o.out / n.version;
+  } else {
+    seq.name = o.sequence;
+    // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end.
+    const double a = std::max(0.0, 0.5 * seq.ego_length - 1.0);
+    recorded::WriteRadarScenes(seq, o.out, a);
+    if (scenario) {
+      std::error_code ec;
+      std::filesystem::copy_file(*scenario, o.out / recorded::kTravellingScenario,
+                                 std::filesystem::copy_options::overwrite_existing, ec);
+      if (ec)
+        throw std::runtime_error((o.out / recorded::kTravellingScenario).string() + ": " +
+                                 ec.message());
+    }
+    written = o.out / "data" / seq.name;
+  }
   if (!o.quiet)
     std::cout << "exported " << seq.scans.size() << " scans, " << seq.points.size()
               << " detections, " << seq.track_names.size() << " tracks of " << o.run_dir.string()
-              << " to " << (o.out / "data" / seq.name).string() << "\n";
+              << " to " << written.string() << "\n";
   return 0;
 }
 
@@ -44,16 +68,23 @@ Command AddExportCommand(CLI::App& app, const CliContext&) {
   auto o = std::make_shared<ExportOptions>();
   auto* cmd = app.add_subcommand(
       "export",
-      "Write a run (recorded with --detections exact) as a RadarScenes dataset root: "
-      "sensors.json, sequences.json, data/<sequence>/scenes.json and radar_data.h5");
+      "Write a run (recorded with --detections exact) as a RadarScenes dataset root "
+      "(sensors.json, sequences.json, data/<sequence>/) or a nuScenes root (<version>/*.json, "
+      "samples/, sweeps/); the run's scenario travels with it");
   cmd->add_option("run_dir", o->run_dir, "Run folder of `dualgrid run` or `dualgrid sim`")
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--out,-o", o->out, "Dataset root to write")->required()->check(NonEmptyPath());
-  Opt(cmd, "--format", &o->format, "Output format (radarscenes)")
-      ->check(CLI::IsMember({"radarscenes"}));
-  Opt(cmd, "--sequence", &o->sequence, "Name of the sequence folder under data/")
+  Opt(cmd, "--format", &o->format, "Output format (radarscenes, nuscenes)")
+      ->check(CLI::IsMember({"radarscenes", "nuscenes"}));
+  Opt(cmd, "--sequence", &o->sequence, "RadarScenes: name of the sequence folder under data/")
       ->check(NonEmptyPath());
+  Opt(cmd, "--scene", &o->nuscenes.scene, "nuScenes: the scene's name")->check(NonEmptyPath());
+  Opt(cmd, "--version", &o->nuscenes.version, "nuScenes: the version folder")
+      ->check(NonEmptyPath());
+  cmd->add_flag("--pcd-float64", o->nuscenes.float64,
+                "nuScenes: positions and velocities as float64 in the PCD files (the published "
+                "files have float32, which round the run's values)");
   cmd->add_flag("--quiet,-q", o->quiet, "No summary output");
   return {cmd, [o] { return RunExport(*o); }};
 }

@@ -140,7 +140,8 @@ void Validate(const std::vector<GridPanel>& panels, const GridFigureOptions& opt
     throw std::invalid_argument("RenderGridPanels: options.arrow_seconds must be positive");
 }
 
-std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
+std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels,
+                                    const GridFigureOptions& options) {
   std::vector<LegendItem> items = {
       {"free", colors::kWhite},
       {"static", colors::kBlack},
@@ -151,7 +152,7 @@ std::vector<LegendItem> LegendItems(const std::vector<GridPanel>& panels) {
                        [&](const GridPanel& p) { return !(p.*member).empty(); });
   };
   if (any(&GridPanel::truth_boxes))
-    items.push_back({"ground truth", colors::kBlack, Marker::kOutline});
+    items.push_back({options.truth_label, colors::kBlack, Marker::kOutline});
   if (any(&GridPanel::ego_boxes)) items.push_back({"ego", kEgoOutline, Marker::kOutline});
   if (any(&GridPanel::particles)) items.push_back({"particle", colors::kBlack, Marker::kDot});
   if (any(&GridPanel::clusters)) {
@@ -245,7 +246,7 @@ Placement Place(cairo_t* m, const std::vector<GridPanel>& panels, const GridFigu
   p.x_label_y = y + k.u;
   if (!options.x_label.empty()) y += k.u + detail::LineHeight(k.fs);
   p.legend_top = y + 3.0 * k.u;
-  const LegendBand band = BandFor(m, k, LegendItems(panels), options);
+  const LegendBand band = BandFor(m, k, LegendItems(panels, options), options);
   y = p.legend_top + band.height;
   p.caption_top = y + 3.0 * k.u;
   const double caption_h = detail::DrawParagraph(
@@ -438,7 +439,7 @@ void DrawHueWheel(cairo_t* cr, double cx, double cy, double r, double png_scale,
 
 void DrawLegendBand(cairo_t* cr, const std::vector<GridPanel>& panels,
                     const GridFigureOptions& options, const Metrics& k, double top) {
-  const std::vector<LegendItem> items = LegendItems(panels);
+  const std::vector<LegendItem> items = LegendItems(panels, options);
   const LegendBand band = BandFor(cr, k, items, options);
   const double cx = k.pad + 0.5 * band.wheel_w, cy = top + 0.5 * band.wheel_h;
   DrawHueWheel(cr, cx, cy, k.wheel_r, options.png_scale, k.u);

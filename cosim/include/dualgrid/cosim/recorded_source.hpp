@@ -32,9 +32,10 @@ struct RecordedOptions {
 };
 
 /// Steps through a RecordedSequence: each step is a batch of scans (RecordedOptions), at the time
-/// of its first scan, with that scan's ego state. The labelled moving tracks become the frame's
-/// vehicles (box and velocity estimated from their points: docs/recorded-data.md), so that the
-/// tracking scores (D, D_v) apply to them; unlabelled data give no vehicles.
+/// of its first scan, with that scan's ego state. The frame's vehicles, to which the tracking
+/// scores (D, D_v) apply: an annotated sequence's references of that scan (nuScenes), else the
+/// labelled moving tracks (box and velocity estimated from their points: docs/recorded-data.md);
+/// unlabelled data give no vehicles. Steps count from 1, as the co-simulation's.
 class RecordedSource : public DetectionSource {
  public:
   /// `sequence` must outlive the source.

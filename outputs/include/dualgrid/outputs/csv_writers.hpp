@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -106,10 +107,12 @@ class ClusterWriter {
 void WriteParticles(const cosim::Pipeline& pipeline, std::size_t m,
                     const cosim::GridSnapshot& snapshot, const std::filesystem::path& path);
 
-/// objects.csv: one row per (mode, object ever in the grid).
+/// objects.csv: one row per (mode, object ever in the grid); with `categories` (object name ->
+/// category: annotated data) a last column `category`.
 void WriteObjects(const std::vector<std::string>& modes,
                   const std::vector<eval::ScenarioMetrics>& metrics, const cosim::IdRegistry& ids,
-                  const std::filesystem::path& path);
+                  const std::filesystem::path& path,
+                  const std::map<std::string, std::string>* categories = nullptr);
 
 /// weights.csv of one vehicle's trace.
 void WriteWeights(const WeightTrace& trace, const std::string& object,

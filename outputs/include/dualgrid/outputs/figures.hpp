@@ -29,6 +29,18 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
                 const std::function<void(const std::filesystem::path&)>& draw,
                 std::vector<std::string>* warnings);
 
+/// How captions and axes name the reference objects: SUMO's ground truth, a data set's
+/// annotated instances, or tracks estimated from their labelled points (never "SUMO" for
+/// recorded data).
+struct ReferenceWords {
+  std::string boxes = "ground-truth vehicle boxes (SUMO)";
+  std::string velocity = "a vehicle's velocity (SUMO)";
+  std::string object = "object (SUMO vehicle id)";
+  std::string legend = "ground truth";  ///< the grid figure's legend entry of the boxes
+};
+/// `references`: "sumo", "annotated" or "tracks" (RunFolderOptions::references).
+ReferenceWords WordsFor(const std::string& references);
+
 /// Bird's-eye picture of the current step: lanes, guard rails, parked boxes, vehicles, radar
 /// fields of view and the step's detections with their radial-velocity arrows, drawn in the grid
 /// frame (pipeline.grid_frame(): the world turned so that the grid's axes are the picture's). The
@@ -36,7 +48,8 @@ bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::st
 /// Every Render* below writes its caption under the figure unless `captions` is false
 /// (`--figure-captions off`, for a paper that sets its own).
 void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
-                 double ahead, double half_width, bool captions = true);
+                 double ahead, double half_width, bool captions = true,
+                 const ReferenceWords& words = {});
 
 /// The paper's Fig. 7: one grid panel per mode at one time, ground-truth boxes outlined; in the
 /// grid frame, whose axes are the grid's.
@@ -46,7 +59,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
                       const std::vector<cosim::GridSnapshot>& snapshots,
                       const std::vector<cosim::ModeScorer>& scorers, const GridFrame& grid_frame,
                       const sim::Frame& frame, double time, const std::filesystem::path& path,
-                      bool captions = true);
+                      bool captions = true, const ReferenceWords& words = {});
 
 /// D per object (name) and mode; NaN where a mode did not score the object.
 using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
@@ -57,7 +70,7 @@ using TrackedShares = std::vector<std::pair<std::string, std::vector<double>>>;
 void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
                          const std::string& title, const std::string& y_label,
                          const std::filesystem::path& path, const TrackedShares& errors = {},
-                         bool captions = true);
+                         bool captions = true, const ReferenceWords& words = {});
 
 /// The scored objects' D (or D_v, `velocity_aware`) of one run, per mode (object ids named
 /// through `ids`).

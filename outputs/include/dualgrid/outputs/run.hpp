@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct RunFolderOptions {
   /// Formats every figure is written in: "png", "svg", "pdf".
   std::vector<std::string> figure_formats = {"png", "svg", "pdf"};
   bool figure_captions = true;  ///< captions under the figures
+  /// What the figures call the reference objects (figures.hpp, WordsFor): "sumo", "annotated"
+  /// (a data set's annotated boxes: nuScenes) or "tracks" (estimated from labelled points).
+  std::string references = "sumo";
   /// detections.csv: "none", "csv", "csv.gz" (gzip, about 3.5x smaller) or "exact" (17
   /// significant digits, with scans.csv: readable back by dualgrid::recorded).
   std::string detections = "none";
@@ -55,9 +59,13 @@ struct RunFolderOptions {
 
 /// What `dualgrid filter` adds to a run folder: where its detections came from.
 struct RecordedRun {
-  nlohmann::json input;  ///< summary.json's `input`: the files, scans, cycles, skips, labels
-  bool labels = false;   ///< the data carry labels (point scores and tracks)
+  nlohmann::json input;    ///< summary.json's `input`: the files, scans, cycles, skips, labels
+  bool labels = false;     ///< the data carry labels (point scores and tracks)
+  bool annotated = false;  ///< the references are the data set's annotated boxes (nuScenes)
   std::size_t skipped_points = 0;
+  std::vector<std::string> notes;  ///< the reader's notes for the table
+  /// Annotated data: each reference object's category (objects.csv's last column).
+  std::map<std::string, std::string> categories;
 };
 
 /// How a run went, once its folder is written.

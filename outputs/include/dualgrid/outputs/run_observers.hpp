@@ -14,6 +14,7 @@
 #include "dualgrid/cosim/cosimulation.hpp"
 #include "dualgrid/outputs/capture.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/figures.hpp"
 #include "dualgrid/outputs/recording.hpp"
 #include "dualgrid/outputs/run.hpp"
 #include "dualgrid/outputs/weight_traces.hpp"
@@ -105,6 +106,7 @@ class PictureObserver : public cosim::StepObserver {
   bool figures_, particles_;
   std::vector<std::string> formats_;
   bool captions_;
+  ReferenceWords words_;
   std::vector<std::string>* warnings_;
 };
 

@@ -25,6 +25,11 @@ inline constexpr double kDefaultRearAxleToCentre = 1.45;
 inline constexpr double kDefaultEgoLength = 4.9;
 inline constexpr double kDefaultEgoWidth = 1.9;
 
+/// The file name of the run's scenario that an export carries (RadarScenes: in the dataset
+/// root; nuScenes: beside the tables, named in dualgrid.json), so that `filter` on the export
+/// needs no --scenario.
+inline constexpr const char* kTravellingScenario = "dualgrid_scenario.yaml";
+
 /// Reads a RadarScenes sequence folder. `sensors_json`: sensors.json, default
 /// sequence_dir/../../sensors.json. Throws std::invalid_argument (bad or missing input).
 RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,

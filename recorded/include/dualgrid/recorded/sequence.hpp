@@ -34,6 +34,17 @@ struct RecordedScan {
   Velocity ego_velocity = Velocity::Zero();  ///< of the box centre [m/s]
   double ego_yaw_rate = 0.0;                 ///< [rad/s]
   double lane_yaw = 0.0;  ///< the road's direction [rad]: the heading unless the data say
+  /// Its reference objects (annotated data): RecordedSequence::references[ref_begin, ref_end).
+  std::size_t ref_begin = 0, ref_end = 0;
+};
+
+/// A reference object given by the data set (nuScenes' annotated box, interpolated by the
+/// reader to a scan's time), world frame.
+struct ReferenceObject {
+  std::string id;                        ///< instance token
+  std::string type;                      ///< category (vehicle.car, ...)
+  OrientedBox box;                       ///< centre [m], yaw [rad], length and width [m]
+  Velocity velocity = Velocity::Zero();  ///< over ground [m/s]
 };
 
 /// A recorded sequence, validated by its reader: scans in non-decreasing time, every point index
@@ -53,6 +64,10 @@ struct RecordedSequence {
   std::int64_t time_origin_us = 0;
   /// Detections dropped by the reader (NaN position or velocity), for the run's notes.
   std::size_t skipped_points = 0;
+  /// The data set's own reference objects (per scan, sorted by id). When `annotated`, a cycle's
+  /// vehicles are its first scan's references, not boxes estimated from track points.
+  bool annotated = false;
+  std::vector<ReferenceObject> references;
 
   double Time(std::int64_t timestamp_us) const {
     return static_cast<double>(timestamp_us - time_origin_us) / 1e6;

@@ -81,6 +81,8 @@ struct GridFigureOptions {
   double font_size = 0.0;
   /// Axis labels (the frame and origin of the rasters' coordinates, e.g. relative to the ego).
   std::string x_label = "x [m]", y_label = "y [m]";
+  /// The legend's name for the reference boxes (e.g. "annotated" for a data set's boxes).
+  std::string truth_label = "ground truth";
   /// Panels per row: 0 = automatic (side by side when a panel is at most 2.5 times as wide as
   /// high, e.g. a square grid; stacked for the paper's 8:1 road grid), else 1..panels.
   int columns = 0;
