@@ -19,6 +19,13 @@ from +x. See docs/python.md for the API, frames and a worked example.
 import numpy as _np
 
 from ._dualgrid import (
+    CELL_CLASSES,
+    ROLE_NAMES,
+    CoSimulation,
+    RecordedSimulation,
+    Simulation,
+    Step,
+    StepGrid,
     DynamicGrid,
     EgoMotion,
     FilterParams,
@@ -121,6 +128,13 @@ def detections_to_measurements(detections, ego_box=None, include_clutter=True):
 
 
 __all__ = [
+    "CELL_CLASSES",
+    "CoSimulation",
+    "ROLE_NAMES",
+    "RecordedSimulation",
+    "Simulation",
+    "Step",
+    "StepGrid",
     "COVERAGE_COLUMNS",
     "DynamicGrid",
     "EgoMotion",

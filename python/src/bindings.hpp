@@ -16,6 +16,8 @@ void BindRadar(py::module_& m);
 void BindCosim(py::module_& m);
 /// run_recorded (recorded_bindings.cpp): the filters on a recorded sequence.
 void BindRecorded(py::module_& m);
+/// CoSimulation, RecordedSimulation, Step, StepGrid (stepping_bindings.cpp, step_bindings.cpp).
+void BindStepping(py::module_& m);
 
 /// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
 /// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel

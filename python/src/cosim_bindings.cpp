@@ -5,8 +5,6 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <optional>
@@ -19,6 +17,7 @@
 #include "convert.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
 #include "run_results.hpp"
+#include "run_setup.hpp"
 
 namespace dualgrid::python {
 namespace {
@@ -29,50 +28,25 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
                      std::optional<double> duration, const std::vector<std::string>& modes,
                      const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
                      std::optional<fs::path> work_dir, int threads) {
-  std::vector<scenario::Override> sets;
-  for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
-  scenario::ScenarioConfig config = scenario::LoadScenario(path, sets);
-  if (seed) config.sim.seed = *seed;
-  if (duration) {
-    if (!(*duration > 0.0 && *duration <= 3600.0))
-      throw py::value_error("run_scenario: duration must be in (0, 3600] s, got " +
-                            std::to_string(*duration));
-    config.sim.duration = *duration;
-  }
-  cosim::CoSimOptions options;
-  options.modes.clear();
-  for (const std::string& name : modes) {
-    const auto m = filter::ParseWeightMode(name);
-    if (!m)
-      throw py::value_error("run_scenario: modes: unknown mode '" + name +
-                            "' (expected position, velocity, dual)");
-    options.modes.push_back(*m);
-  }
-  if (options.modes.empty()) throw py::value_error("run_scenario: modes must not be empty");
-  if (threads < 0) throw py::value_error("run_scenario: threads must be >= 0");
-  options.threads = threads;
+  const scenario::ScenarioConfig config =
+      LoadRunConfig(path, seed, duration, overrides, "run_scenario");
+  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_scenario");
+  SumoClaim sumo("run_scenario");
   // SUMO's route file and log: the caller's folder, or a temporary one removed afterwards.
-  const bool own_work = !work_dir;
-  const fs::path work =
-      work_dir ? *work_dir
-               : fs::temp_directory_path() /
-                     ("dualgrid_py_" + std::to_string(getpid()) + "_" + config.sim.name);
-  fs::create_directories(work);
+  WorkDir work = WorkDir::Make(work_dir, config.sim.name);
+  const std::filesystem::path networks = NetworkDir(network_dir);
 
   cosim::CoSimulation cs(config, options);
   ClusterColumns clusters;
   {
     py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
-    cs.Start(network_dir ? *network_dir : sim::DefaultNetworkDir(), work);
+    cs.Start(networks, work.path);
     cs.AddObserver(&clusters);
     while (cs.Step()) {
     }
     cs.Finish();
   }
-  if (own_work) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
-  }
+  work.Remove();
   py::dict r = Results(cs, config, clusters);
   return r;
 }

@@ -56,4 +56,5 @@ PYBIND11_MODULE(_dualgrid, m) {
 
   BindCosim(m);
   BindRecorded(m);
+  BindStepping(m);
 }

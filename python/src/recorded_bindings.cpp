@@ -13,6 +13,7 @@
 #include "bindings.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 #include "run_results.hpp"
+#include "run_setup.hpp"
 
 namespace dualgrid::python {
 namespace {
@@ -23,36 +24,13 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
                      std::optional<fs::path> scenario_file,
                      const std::vector<std::string>& overrides, std::optional<std::uint64_t> seed,
                      const std::vector<std::string>& modes, double batch_window, int threads) {
-  scenario::ScenarioConfig config;
-  if (scenario_file) {
-    std::vector<scenario::Override> sets;
-    for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
-    config = scenario::LoadScenario(*scenario_file, sets);
-    config.filter.cycle = config.sim.step_length;  // its factors are per its step
-  } else {
-    if (!overrides.empty()) throw py::value_error("run_recorded: overrides need a scenario file");
-    config = recorded::DefaultRecordedConfig();
-  }
-  if (seed) config.sim.seed = *seed;
-  if (!(batch_window >= 0.0 && batch_window <= 1.0))
-    throw py::value_error("run_recorded: batch_window must be in [0, 1] s");
-  cosim::CoSimOptions options;
-  options.modes.clear();
-  for (const std::string& name : modes) {
-    const auto m = filter::ParseWeightMode(name);
-    if (!m)
-      throw py::value_error("run_recorded: modes: unknown mode '" + name +
-                            "' (expected position, velocity, dual)");
-    options.modes.push_back(*m);
-  }
-  if (options.modes.empty()) throw py::value_error("run_recorded: modes must not be empty");
-  if (threads < 0) throw py::value_error("run_recorded: threads must be >= 0");
-  options.threads = threads;
-  const recorded::RecordedInput in = recorded::ReadRecordedInput(path, sensors);
-  const cosim::RecordedOptions ropts = recorded::FitConfig(in.sequence, batch_window, &config);
-  cosim::CoSimulation cs(config, options, [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
-    return std::make_unique<cosim::RecordedSource>(in.sequence, ropts);
-  });
+  const RecordedSetup setup =
+      LoadRecorded(path, sensors, scenario_file, overrides, seed, batch_window, "run_recorded");
+  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_recorded");
+  cosim::CoSimulation cs(
+      setup.config, options, [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
+        return std::make_unique<cosim::RecordedSource>(setup.input.sequence, setup.options);
+      });
   ClusterColumns clusters;
   {
     py::gil_scoped_release release;
@@ -62,16 +40,8 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
     }
     cs.Finish();
   }
-  py::dict r = Results(cs, config, clusters);
-  py::dict input;
-  input["kind"] = in.radarscenes ? "radarscenes" : "run";
-  input["sequence"] = in.sequence.name;
-  input["scans"] = in.sequence.scans.size();
-  input["detections"] = in.sequence.points.size();
-  input["skipped_detections"] = in.sequence.skipped_points;
-  input["labels"] = in.sequence.has_labels;
-  input["tracks"] = in.sequence.track_names.size();
-  r["input"] = input;
+  py::dict r = Results(cs, setup.config, clusters);
+  r["input"] = RecordedInputInfo(setup.input);
   return r;
 }
 
