@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -82,8 +83,15 @@ class StepCollector : public cosim::StepObserver {
   explicit StepCollector(bool velocities) : velocities_(velocities) {}
   bool WantsVelocities(int, double) override { return active_ && velocities_; }
   void OnStep(const cosim::StepView& v) override {
+    if (fail_next_) {
+      fail_next_ = false;
+      throw std::runtime_error("failure injected by _fail_next_step() (a test aid)");
+    }
     if (active_) last_ = CopyStep(v);
   }
+  /// Testing aid: the next OnStep throws, as an observer's error would (the error path of
+  /// CoSimulation::Step).
+  void FailNextStep() { fail_next_ = true; }
   /// Inactive: no copies (a run to the end that wants only the results).
   void set_active(bool active) { active_ = active; }
   std::shared_ptr<const StepData> Take() { return std::move(last_); }
@@ -91,6 +99,7 @@ class StepCollector : public cosim::StepObserver {
  private:
   bool velocities_;
   bool active_ = true;
+  bool fail_next_ = false;
   std::shared_ptr<const StepData> last_;
 };
 

@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -63,7 +64,7 @@ class Simulation {
       if (iterating) throw py::stop_iteration();
       throw std::runtime_error(std::string(name_) + ".step(): the run has " +
                                (state_ == State::kEnded ? "ended" : "been closed") + " after " +
-                               std::to_string(steps_) + " steps; results() has its results");
+                               std::to_string(steps_.load()) + " steps; results() has its results");
     }
     bool more = false;
     try {
@@ -111,7 +112,7 @@ class Simulation {
     if (state_ == State::kFailed) throw Failed("results");
     if (state_ == State::kRunning)
       throw std::runtime_error(std::string(name_) + ".results(): the run has not ended (" +
-                               std::to_string(steps_) +
+                               std::to_string(steps_.load()) +
                                " steps done): iterate to the end, or call run() or close() "
                                "first; metrics() gives the scores so far");
     return py::module_::import("copy").attr("deepcopy")(results_);
@@ -128,6 +129,10 @@ class Simulation {
     return FromJson(j);
   }
 
+  void FailNextStep() {
+    std::unique_lock<std::mutex> lock = Lock("_fail_next_step");
+    collector_.FailNextStep();
+  }
   int steps() const { return steps_; }
   std::string state() const {
     static const char* kNames[] = {"running", "ended", "closed", "failed"};
@@ -153,9 +158,9 @@ class Simulation {
     return lock;
   }
   std::runtime_error Failed(const char* what) const {
-    return std::runtime_error(std::string(name_) + "." + what +
-                              "(): unusable after an error in step " + std::to_string(steps_) +
-                              ": " + error_ + " (make a new simulation)");
+    return std::runtime_error(
+        std::string(name_) + "." + what + "(): unusable after an error in step " +
+        std::to_string(steps_.load()) + ": " + error_ + " (make a new simulation)");
   }
   // Releases SUMO and the filters after an error; the work folder stays (sumo.log).
   void Fail(const std::string& what) {
@@ -189,7 +194,7 @@ class Simulation {
   std::mutex mutex_;
   State state_ = State::kRunning;
   std::string error_;
-  int steps_ = 0;
+  std::atomic<int> steps_{0};  // read by `steps` without the lock
   py::dict results_;
 };
 
@@ -229,6 +234,8 @@ void BindSimulationMethods(py::module_& m) {
   cls.def("metrics", &Simulation::Metrics,
           "{mode: metrics.json's entry} over the steps done so far.");
   cls.def_property_readonly("steps", &Simulation::steps, "Steps done.");
+  cls.def("_fail_next_step", &Simulation::FailNextStep,
+          "Testing aid: the next step raises RuntimeError as an error inside a step would.");
   cls.def_property_readonly("state", &Simulation::state,
                             "'running', 'ended', 'closed' or 'failed'.");
   cls.def_property_readonly("modes", &Simulation::modes, "The weight modes, in order.");

@@ -12,6 +12,8 @@ import sys
 import tempfile
 import unittest
 
+import numpy as np
+
 import dualgrid
 
 SOURCE = os.environ.get("DUALGRID_SOURCE_DIR", ".")
@@ -63,6 +65,22 @@ class RunRecordedTest(unittest.TestCase):
             self.assertEqual(f"{c['time'][i]:.3f}", row["time"])
             self.assertEqual(f"{c['x'][i]:.3f}", row["x"])
             self.assertEqual(f"{c['vy'][i]:.3f}", row["vy"])
+
+    def test_stepped_equals_run_recorded(self):
+        sim = dualgrid.RecordedSimulation(self.seq, seed=5, modes=["velocity", "dual"])
+        steps = list(sim)
+        r = sim.results()
+        self.assertEqual(len(steps), self.cli["steps"])
+        for mode in ("velocity", "dual"):
+            self.assertEqual(r["metrics"][mode], self.cli["modes"][mode], mode)
+            clusters = [c for s in steps for c in s.clusters[mode]]
+            cli = [row for row in self.cli_clusters if row["mode"] == mode]
+            self.assertEqual([f"{c['x']:.3f}" for c in clusters], [row["x"] for row in cli])
+        self.assertEqual(r["input"], self.py["input"])
+        # Labelled points come with the detections; the scans' times increase.
+        labels = np.concatenate([s.detections["label"] for s in steps])
+        self.assertGreater(np.count_nonzero(labels >= 0), 0)
+        self.assertTrue(np.all(np.diff([s.time for s in steps]) > 0))
 
     def test_bad_input_is_value_error(self):
         with self.assertRaisesRegex(ValueError, "scenes.json"):
