@@ -16,6 +16,9 @@ void BindRadar(py::module_& m);
 void BindCosim(py::module_& m);
 /// run_recorded (recorded_bindings.cpp): the filters on a recorded sequence.
 void BindRecorded(py::module_& m);
+/// classify_cells, score_cells, dynamic_particles, cluster_particles, associate
+/// (eval_bindings.cpp).
+void BindEval(py::module_& m);
 /// CoSimulation, RecordedSimulation, Step, StepGrid (stepping_bindings.cpp, step_bindings.cpp).
 void BindStepping(py::module_& m);
 

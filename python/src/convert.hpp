@@ -67,3 +67,54 @@ py::array_t<T> ToArray(const std::vector<T>& v) {
 std::string ShortRepr(py::handle obj);
 
 }  // namespace dualgrid::python
+
+namespace dualgrid::python {
+
+/// An argument a function converts itself (a table, a pose, ...), shown in signatures under
+/// Tag::name instead of pybind11's "handle" / "object"; the names are the type aliases of the
+/// stub (python/dualgrid/_dualgrid.pyi).
+template <typename Tag>
+struct Arg {
+  py::object obj;
+  operator py::handle() const { return obj; }
+};
+struct TableTag {
+  static constexpr auto name = py::detail::const_name("TableLike");
+};
+struct PoseTag {
+  static constexpr auto name = py::detail::const_name("PoseLike");
+};
+struct Vector2Tag {
+  static constexpr auto name = py::detail::const_name("Vector2Like");
+};
+struct ArrayTag {
+  static constexpr auto name = py::detail::const_name("ArrayLike");
+};
+struct EgoTag {
+  static constexpr auto name = py::detail::const_name("EgoLike");
+};
+struct SceneTag {
+  static constexpr auto name = py::detail::const_name("SceneLike");
+};
+using TableArg = Arg<TableTag>;
+using PoseArg = Arg<PoseTag>;
+using Vector2Arg = Arg<Vector2Tag>;
+using ArrayArg = Arg<ArrayTag>;
+using EgoArg = Arg<EgoTag>;
+using SceneArg = Arg<SceneTag>;
+
+}  // namespace dualgrid::python
+
+namespace pybind11::detail {
+template <typename Tag>
+struct type_caster<dualgrid::python::Arg<Tag>> {
+  PYBIND11_TYPE_CASTER(dualgrid::python::Arg<Tag>, Tag::name);
+  bool load(handle src, bool) {
+    value.obj = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const dualgrid::python::Arg<Tag>& v, return_value_policy, handle) {
+    return v.obj.inc_ref();
+  }
+};
+}  // namespace pybind11::detail

@@ -16,6 +16,7 @@
 #include "convert.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/filter/params.hpp"
+#include "grid_holder.hpp"
 #include "value_class.hpp"
 
 namespace dualgrid::python {
@@ -193,23 +194,6 @@ uniform, zero_likelihood literal, velocity_likelihood vector, normalisation lite
         return out;
       },
       "Names preset() accepts.");
-}
-
-// DynamicGrid with the lock that serialises calls from different Python threads: update() runs
-// without the GIL, so another thread could otherwise read the grid while it changes.
-struct Grid {
-  Grid(const FilterParams& params, std::uint64_t seed) : grid(params, seed) {}
-  DynamicGrid grid;
-  std::mutex mutex;
-};
-
-// Runs f(grid) without the GIL under the grid's lock. f must not touch Python objects (it may
-// write into numpy buffers allocated before, which no other thread can see yet).
-template <typename F>
-auto Locked(Grid& g, F&& f) {
-  py::gil_scoped_release nogil;
-  std::lock_guard<std::mutex> lock(g.mutex);
-  return f(g.grid);
 }
 
 void Update(Grid& g, py::handle ego_pose, py::handle ego_velocity, py::handle detections,

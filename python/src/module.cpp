@@ -57,4 +57,5 @@ PYBIND11_MODULE(_dualgrid, m) {
   BindCosim(m);
   BindRecorded(m);
   BindStepping(m);
+  BindEval(m);
 }

@@ -150,7 +150,7 @@ EgoMotion ToEgo(py::handle obj, const FieldNames& names) {
 // Detections as a dict of equally long numpy columns (pandas.DataFrame(d) takes it as is).
 py::dict DetectionsDict(const std::vector<Detection>& dets) {
   const std::size_t n = dets.size();
-  std::vector<std::int32_t> sensor(n), source(n);
+  std::vector<std::int32_t> sensor(n), source(n), path(n), bounces(n), reflector(n), ghost_of(n);
   std::vector<bool> clutter(n);
   std::vector<double> range(n), azimuth(n), range_rate(n), snr(n), x(n), y(n), xe(n), ye(n), vr(n),
       vrx(n), vry(n), sx(n), sy(n);
@@ -172,6 +172,10 @@ py::dict DetectionsDict(const std::vector<Detection>& dets) {
     sy[i] = d.sensor_position_world.y();
     source[i] = d.source_id;
     clutter[i] = d.is_clutter;
+    path[i] = static_cast<std::int32_t>(d.path);
+    bounces[i] = d.bounces;
+    reflector[i] = d.reflector_id;
+    ghost_of[i] = d.ghost_of;
   }
   py::array_t<bool> is_clutter(static_cast<py::ssize_t>(n));
   for (std::size_t i = 0; i < n; ++i) is_clutter.mutable_data()[i] = clutter[i];
@@ -192,6 +196,10 @@ py::dict DetectionsDict(const std::vector<Detection>& dets) {
   out["sensor_y"] = ToArray(sy);
   out["source_id"] = ToArray(source);
   out["is_clutter"] = is_clutter;
+  out["path"] = ToArray(path);
+  out["bounces"] = ToArray(bounces);
+  out["reflector_id"] = ToArray(reflector);
+  out["ghost_of"] = ToArray(ghost_of);
   return out;
 }
 
@@ -309,15 +317,50 @@ ValueError on non-positive dimensions.)doc");
 }
 
 FieldNames BindEgoAndOptions(py::module_& m) {
+  using radar::MultipathParams;
+  py::class_<MultipathParams> mp(m, "MultipathParams", R"doc(
+The radar model's multipath ghosts (radar_model/.../multipath.hpp, docs/radar.md "Multipath"):
+guard rails and the long flanks of trucks as plane mirrors. Off by default (enabled=False).
+MultipathParams(enabled=True) for the defaults; ModelOptions(multipath=...).)doc");
+  auto mp_names = std::make_shared<std::vector<std::string>>();
+  Field(mp, mp_names, "enabled", &MultipathParams::enabled, "Ghosts on (False: none).");
+  Field(mp, mp_names, "rails", &MultipathParams::rails, "Guard-rail segments are mirrors.");
+  Field(mp, mp_names, "vehicles", &MultipathParams::vehicles,
+        "The long sides of boxes at least vehicle_min_length long are mirrors.");
+  Field(mp, mp_names, "rail_loss_db", &MultipathParams::rail_loss_db,
+        "Power lost per bounce off a rail [dB].");
+  Field(mp, mp_names, "vehicle_loss_db", &MultipathParams::vehicle_loss_db,
+        "Power lost per bounce off a vehicle [dB].");
+  Field(mp, mp_names, "vehicle_min_length", &MultipathParams::vehicle_min_length,
+        "Shortest box whose flanks are mirrors [m] (trucks and buses).");
+  Field(mp, mp_names, "max_bounces", &MultipathParams::max_bounces,
+        "2: the order-2 paths only; 3: also the order-3 mirror image.");
+  Field(mp, mp_names, "min_pd", &MultipathParams::min_pd,
+        "Ghost scatterers whose detection probability alone is below this are dropped [-].");
+  mp.def(
+      "is_valid", [](const MultipathParams& p) { return p.IsValid(nullptr); },
+      "True when every field is usable.");
+  mp.def(
+      "validate",
+      [](const MultipathParams& p) {
+        std::string error;
+        if (!p.IsValid(&error)) throw py::value_error("MultipathParams: " + error);
+      },
+      "Raises ValueError naming the first unusable field.");
+  AddValueProtocol(mp, mp_names, "MultipathParams");
+
   py::class_<ModelOptions> opt(m, "ModelOptions",
                                "Switches of the radar model's effects: ModelOptions(noise=True, "
-                               "false_alarms=True, occlusion=True).");
+                               "false_alarms=True, occlusion=True, multipath=MultipathParams()).");
   auto opt_names = std::make_shared<std::vector<std::string>>();
   Field(opt, opt_names, "noise", &ModelOptions::noise,
         "Measurement noise on range, azimuth, range rate.");
   Field(opt, opt_names, "false_alarms", &ModelOptions::false_alarms, "Clutter detections.");
   Field(opt, opt_names, "occlusion", &ModelOptions::occlusion,
         "Nearer boxes and rails hide scatterers behind them.");
+  Field(opt, opt_names, "multipath", &ModelOptions::multipath,
+        "Multipath ghosts (MultipathParams; off unless multipath.enabled): "
+        "options.multipath.enabled = True switches them on in place.");
   AddValueProtocol(opt, opt_names, "ModelOptions");
 
   py::class_<EgoMotion> ego(m, "EgoMotion", R"doc(
@@ -421,8 +464,10 @@ Detections come back as a dict of equally long numpy columns (pandas.DataFrame(d
   measured, relative to the moving sensor], snr_db [dB, noise-free SNR of the resolution cell],
   x, y [m, world], x_ego, y_ego [m, ego frame], radial_speed_compensated [m/s, over ground],
   v_rx, v_ry [m/s, radial_speed_compensated times the world line of sight: paper eq. (1)],
-  sensor_x, sensor_y [m, world], source_id (int32, target / polyline id, -1 for clutter),
-  is_clutter (bool).
+  sensor_x, sensor_y [m, world], source_id (int32, target / polyline id, -1 for clutter and
+  ghosts), is_clutter (bool), and the multipath labels (ModelOptions.multipath): path (int32, 0
+  direct, 1 type 1, 2 type 2), bounces (1 direct, 2 or 3), reflector_id (the mirror's id, -1
+  direct), ghost_of (the real object's id, -1 direct).
 detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)doc");
   cls.def(py::init([](std::vector<SensorParams> sensors, const ModelOptions& options,
                       std::uint64_t seed) {
