@@ -18,7 +18,7 @@ from +x. See docs/python.md for the API, frames and a worked example.
 
 import os as _os
 import sys as _sys
-from typing import Any, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Union
 
 from ._build_info import BUILT_FOR as _BUILT_FOR
 from ._build_info import BUILT_VERSION as _BUILT_VERSION
@@ -35,6 +35,7 @@ def _built_for() -> str:
 
 try:
     import numpy as _np
+    import numpy.typing as _npt
 except ImportError as _e:
     raise ImportError(
         f"dualgrid needs numpy, which this interpreter, {_this_interpreter()}, cannot import "
@@ -108,7 +109,7 @@ def run_scenario(path: Union[str, "_os.PathLike[str]"], seed: Optional[int] = No
                  overrides: Sequence[str] = (),
                  network_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
                  work_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
-                 threads: int = 0) -> dict:
+                 threads: int = 0) -> Dict[str, Any]:
     """Runs a scenario file as `dualgrid run` does and returns its results as a dict.
 
     The same scenario and seed give the command line's numbers (metrics, objects, clusters).
@@ -134,7 +135,7 @@ TARGET_COLUMNS = ("id", "x", "y", "yaw", "length", "width", "vx", "vy", "yaw_rat
 
 def detections_to_measurements(detections: Mapping[str, Any],
                                ego_box: Union["EgoMotion", Sequence[float], None] = None,
-                               include_clutter: bool = True) -> "_np.ndarray":
+                               include_clutter: bool = True) -> "_npt.NDArray[_np.float64]":
     """The (N, 6) float64 array DynamicGrid.update() takes, from RadarModel.scan()'s dict.
 
     detections: the dict of columns of RadarModel.scan()/scan_sensor() (or a pandas.DataFrame of
@@ -172,7 +173,9 @@ def detections_to_measurements(detections: Mapping[str, Any],
         dx, dy = cols[0] - bx, cols[1] - by
         along, across = c * dx + s * dy, -s * dx + c * dy
         keep &= ~((_np.abs(along) <= 0.5 * length) & (_np.abs(across) <= 0.5 * width))
-    return _np.column_stack(cols)[keep] if cols[0].size else _np.empty((0, 6))
+    out: "_npt.NDArray[_np.float64]" = (_np.column_stack(cols)[keep] if cols[0].size
+                                        else _np.empty((0, 6)))
+    return out
 
 
 __all__ = [

@@ -96,7 +96,15 @@ struct EgoTag {
 struct SceneTag {
   static constexpr auto name = py::detail::const_name("SceneLike");
 };
+struct PolylinesTag {
+  static constexpr auto name = py::detail::const_name("PolylinesLike");
+};
+struct MultipathTag {
+  static constexpr auto name = py::detail::const_name("MultipathParams | Mapping[str, Any]");
+};
+using MultipathArg = Arg<MultipathTag>;
 using TableArg = Arg<TableTag>;
+using PolylinesArg = Arg<PolylinesTag>;
 using PoseArg = Arg<PoseTag>;
 using Vector2Arg = Arg<Vector2Tag>;
 using ArrayArg = Arg<ArrayTag>;

@@ -91,7 +91,7 @@ py::array ClassifyCellsPy(ArrayArg masses, double threshold) {
   return out;
 }
 
-py::object ScoreCells(ArrayArg predicted, ArrayArg truth, std::optional<ArrayArg> observed) {
+py::dict ScoreCells(ArrayArg predicted, ArrayArg truth, std::optional<ArrayArg> observed) {
   const ByteArray p = ReadClasses(predicted, "predicted", eval::kNumPredictedClasses);
   const ByteArray t = ReadClasses(truth, "truth", eval::kNumTruthClasses);
   if (Shape(p) != Shape(t))
@@ -107,7 +107,7 @@ py::object ScoreCells(ArrayArg predicted, ArrayArg truth, std::optional<ArrayArg
   acc.AddFrame(
       {p.data(), n}, {t.data(), n},
       observed ? std::span<const std::uint8_t>(o.data(), n) : std::span<const std::uint8_t>());
-  return FromJson(nlohmann::json(acc.Result()));
+  return FromJson(nlohmann::json(acc.Result())).cast<py::dict>();
 }
 
 py::dict DynamicParticlesPy(Grid& g, std::optional<ArrayArg> classes, double threshold) {

@@ -237,7 +237,7 @@ List fields (off_boresight*) are returned as copies: assign a whole new list to 
       [](const SensorParams& p) {
         return py::make_tuple(p.mount.position.x(), p.mount.position.y(), p.mount.yaw);
       },
-      [](SensorParams& p, py::handle v) { p.mount = ReadPose(v, "mount"); },
+      [](SensorParams& p, PoseArg v) { p.mount = ReadPose(v, "mount"); },
       "Mounting pose in the ego frame (x forward, y left, origin at the ego box centre): "
       "(x, y, yaw) [m, m, rad].");
   names->push_back("mount");
@@ -358,9 +358,24 @@ MultipathParams(enabled=True) for the defaults; ModelOptions(multipath=...).)doc
   Field(opt, opt_names, "false_alarms", &ModelOptions::false_alarms, "Clutter detections.");
   Field(opt, opt_names, "occlusion", &ModelOptions::occlusion,
         "Nearer boxes and rails hide scatterers behind them.");
-  Field(opt, opt_names, "multipath", &ModelOptions::multipath,
-        "Multipath ghosts (MultipathParams; off unless multipath.enabled): "
-        "options.multipath.enabled = True switches them on in place.");
+  opt.def_property(
+      "multipath", [](ModelOptions& o) -> MultipathParams& { return o.multipath; },
+      [](ModelOptions& o, MultipathArg v) {
+        // A MultipathParams, or its to_dict() (what pickling and to_dict() give back).
+        py::object p = py::isinstance<py::dict>(v.obj)
+                           ? py::module_::import("dualgrid._dualgrid")
+                                 .attr("MultipathParams")(**v.obj.cast<py::dict>())
+                           : v.obj;
+        if (!py::isinstance<MultipathParams>(p))
+          throw py::type_error(
+              "multipath: expected a MultipathParams or a dict of its fields, got " +
+              ShortRepr(v.obj));
+        o.multipath = p.cast<MultipathParams>();
+      },
+      py::return_value_policy::reference_internal,
+      "Multipath ghosts (MultipathParams, or a dict of its fields; off unless "
+      "multipath.enabled): options.multipath.enabled = True switches them on in place.");
+  opt_names->push_back("multipath");
   AddValueProtocol(opt, opt_names, "ModelOptions");
 
   py::class_<EgoMotion> ego(m, "EgoMotion", R"doc(
@@ -373,12 +388,12 @@ width [m] is the ego's own body, hiding what lies behind it from its sensors (0:
       [](const EgoMotion& e) {
         return py::make_tuple(e.pose.position.x(), e.pose.position.y(), e.pose.yaw);
       },
-      [](EgoMotion& e, py::handle v) { e.pose = ReadPose(v, "pose"); },
+      [](EgoMotion& e, PoseArg v) { e.pose = ReadPose(v, "pose"); },
       "(x, y, yaw) [m, m, rad] of the ego box centre, world frame.");
   ego_names->push_back("pose");
   ego.def_property(
       "velocity", [](const EgoMotion& e) { return py::make_tuple(e.velocity.x(), e.velocity.y()); },
-      [](EgoMotion& e, py::handle v) { e.velocity = ReadVector2(v, "velocity", "[m/s]"); },
+      [](EgoMotion& e, Vector2Arg v) { e.velocity = ReadVector2(v, "velocity", "[m/s]"); },
       "(vx, vy) [m/s] of the box centre over ground, world frame.");
   ego_names->push_back("velocity");
   Field(ego, ego_names, "yaw_rate", &EgoMotion::yaw_rate, "[rad/s]");
@@ -402,7 +417,7 @@ polylines: guard rails, a list of dicts {"id": int, "points": (P, 2) array [m] w
   "rcs_dbsm_per_metre": float [dBsm/m], default -5}.
 Ids must be unique across targets and polylines (they become the detections' source_id). The ego
 must not be part of the scene. ValueError names the argument and row of bad input.)doc");
-  cls.def(py::init([](py::handle targets, py::handle polylines) {
+  cls.def(py::init([](TableArg targets, PolylinesArg polylines) {
             return ReadScene(targets, polylines);
           }),
           py::arg("targets") = py::none(), py::arg("polylines") = py::none());
@@ -483,7 +498,7 @@ detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)
   cls.def("__len__", [](const Radar& r) { return r.model.sensors().size(); });
   cls.def(
       "sensor_pose",
-      [](const Radar& r, int sensor, py::handle ego_pose) {
+      [](const Radar& r, int sensor, PoseArg ego_pose) {
         CheckSensorIndex(r, sensor);
         const Pose2 p = r.model.SensorPose(sensor, ReadPose(ego_pose, "ego_pose"));
         return py::make_tuple(p.position.x(), p.position.y(), p.yaw);
@@ -501,7 +516,7 @@ detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)
       "`step_length` [s] (each fires when a multiple of its update_period falls in the step).");
   cls.def(
       "coverage",
-      [](const Radar& r, py::handle ego_pose, std::optional<std::vector<int>> sensors) {
+      [](const Radar& r, PoseArg ego_pose, std::optional<std::vector<int>> sensors) {
         const Pose2 pose = ReadPose(ego_pose, "ego_pose");
         std::vector<int> which = sensors ? *sensors : std::vector<int>();
         if (!sensors)
@@ -528,7 +543,7 @@ streams. ego: an EgoMotion or a dict of its fields; scene: a Scene or a dict {ta
 Returns the dict of columns described in the class docstring.)doc";
   cls.def(
       "scan",
-      [ego_names](const Radar& r, py::handle ego, py::handle scene, std::uint64_t step, double time,
+      [ego_names](const Radar& r, EgoArg ego, SceneArg scene, std::uint64_t step, double time,
                   double step_length) {
         CheckTime(time, step_length);
         const EgoMotion e = ToEgo(ego, ego_names);
@@ -545,8 +560,7 @@ Returns the dict of columns described in the class docstring.)doc";
       py::arg("step_length") = 0.05, scan_doc);
   cls.def(
       "scan_sensor",
-      [ego_names](const Radar& r, int sensor, py::handle ego, py::handle scene,
-                  std::uint64_t step) {
+      [ego_names](const Radar& r, int sensor, EgoArg ego, SceneArg scene, std::uint64_t step) {
         CheckSensorIndex(r, sensor);
         const EgoMotion e = ToEgo(ego, ego_names);
         const Scene s = ToScene(scene);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "run_results.hpp"
 #include "run_setup.hpp"
 #include "step_data.hpp"
@@ -206,6 +207,26 @@ struct SequenceSimulation : Simulation {
   using Simulation::Simulation;
 };
 
+// Step results typed for signatures and the stub.
+struct StepTag {
+  static constexpr auto name = py::detail::const_name("Step");
+};
+struct OptionalStepTag {
+  static constexpr auto name = py::detail::const_name("Optional[Step]");
+};
+using StepResult = Arg<StepTag>;
+using OptionalStepResult = Arg<OptionalStepTag>;
+
+// __iter__ and __enter__ return the object itself: bound on the most derived class, so that
+// pybind11 finds the existing Python object (a base-class reference would get a new wrapper).
+template <typename S>
+void BindSelfReturns(py::class_<S, Simulation>& cls) {
+  cls.def(
+      "__iter__", [](S& self) -> S& { return self; }, py::return_value_policy::reference);
+  cls.def(
+      "__enter__", [](S& self) -> S& { return self; }, py::return_value_policy::reference);
+}
+
 const char* kCommonDoc = R"doc(
 Iterate (`for step in sim:`) or call step(): each step is a dualgrid.Step (time, ego pose,
 detections, truth, grids[mode], clusters, scores). results() after the end returns what
@@ -218,10 +239,9 @@ void BindSimulationMethods(py::module_& m) {
   py::class_<Simulation> cls(
       m, "Simulation",
       (std::string("Base of CoSimulation and RecordedSimulation.") + kCommonDoc).c_str());
-  cls.def("__iter__", [](py::object self) { return self; });
-  cls.def("__next__", [](Simulation& s) { return s.Next(true); });
+  cls.def("__next__", [](Simulation& s) { return StepResult{s.Next(true)}; });
   cls.def(
-      "step", [](Simulation& s) { return s.Next(false); },
+      "step", [](Simulation& s) { return OptionalStepResult{s.Next(false)}; },
       "The next Step; None when this call found the end of the run; RuntimeError after that.");
   cls.def("run", &Simulation::Run,
           "Runs the remaining steps (no Step objects) and returns results().");
@@ -247,7 +267,6 @@ void BindSimulationMethods(py::module_& m) {
   cls.def_property_readonly(
       "duration", [](const Simulation& s) { return s.config().sim.duration; },
       "The requested duration [s].");
-  cls.def("__enter__", [](py::object self) { return self; });
   cls.def("__exit__", [](Simulation& s, py::args) { s.Close(); });
 }
 
@@ -279,6 +298,7 @@ otherwise).)doc") + kCommonDoc)
       py::arg("seed") = py::none(), py::arg("duration") = py::none(),
       py::arg("overrides") = std::vector<std::string>{}, py::arg("network_dir") = py::none(),
       py::arg("work_dir") = py::none(), py::arg("threads") = 0, py::arg("velocities") = true);
+  BindSelfReturns(cls);
 
   py::class_<SequenceSimulation, Simulation> rec(m, "RecordedSimulation",
                                                  (std::string(R"doc(
@@ -299,6 +319,7 @@ run_recorded's.)doc") + kCommonDoc)
           py::arg("overrides") = std::vector<std::string>{}, py::arg("seed") = py::none(),
           py::arg("modes") = std::vector<std::string>{"position", "velocity", "dual"},
           py::arg("batch_window") = 0.001, py::arg("threads") = 0, py::arg("velocities") = true);
+  BindSelfReturns(rec);
 }
 
 }  // namespace dualgrid::python

@@ -82,6 +82,29 @@ class RunRecordedTest(unittest.TestCase):
         self.assertGreater(np.count_nonzero(labels >= 0), 0)
         self.assertTrue(np.all(np.diff([s.time for s in steps]) > 0))
 
+    def test_read_recorded_without_filtering(self):
+        r = dualgrid.read_recorded(self.seq)
+        pts, scans = r["points"], r["scans"]
+        self.assertEqual(r["kind"], "radarscenes")
+        self.assertEqual(len(pts["x"]), self.py["input"]["detections"])
+        self.assertEqual(len(scans["time"]), self.py["input"]["scans"])
+        self.assertEqual(int(scans["points"].sum()), len(pts["x"]))
+        self.assertEqual(len(r["track_names"]), self.py["input"]["tracks"])
+        # Every point carries its scan's time and sensor; scans in time order.
+        self.assertTrue(np.array_equal(pts["time"], scans["time"][pts["scan"]]))
+        self.assertTrue(np.array_equal(pts["sensor"], scans["sensor"][pts["scan"]]))
+        self.assertTrue(np.all(np.diff(scans["timestamp_us"]) >= 0))
+        self.assertTrue(np.all(np.isfinite(pts["x"])) and np.all(pts["range"] > 0))
+        # Labelled: moving points (labels 0..10) and their tracks; the sensors as SensorParams.
+        moving = (pts["label"] >= 0) & (pts["label"] < 11)
+        self.assertGreater(np.count_nonzero(moving), 0)
+        self.assertTrue(np.all(pts["track"][moving] >= 0))
+        self.assertTrue(all(isinstance(s, dualgrid.SensorParams) for s in r["sensors"]))
+        import pandas as pd
+        self.assertEqual(len(pd.DataFrame(pts)), len(pts["x"]))
+        with self.assertRaisesRegex(ValueError, "scenes.json"):
+            dualgrid.read_recorded(self.tmp.name)
+
     def test_bad_input_is_value_error(self):
         with self.assertRaisesRegex(ValueError, "scenes.json"):
             dualgrid.run_recorded(self.tmp.name)
