@@ -93,14 +93,18 @@ except ImportError as _e:
 def installed_network_dir() -> Optional[str]:
     """The built SUMO networks of the installation this package belongs to.
 
-    An installed package lives in PREFIX/lib/python3/dist-packages/dualgrid; its networks in
-    PREFIX/share/dualgrid/networks. None when that folder does not exist (a build-tree package:
-    run_scenario then uses the build tree's networks, or $DUALGRID_NETWORK_DIR).
+    A package installed by pip holds them in dualgrid/networks; one installed by cmake --install
+    lives in PREFIX/lib/python3/dist-packages/dualgrid, its networks in
+    PREFIX/share/dualgrid/networks. None when neither exists (a build-tree package: run_scenario
+    then uses the build tree's networks, or $DUALGRID_NETWORK_DIR).
     """
     here = _os.path.dirname(_os.path.abspath(__file__))
     prefix = _os.path.normpath(_os.path.join(here, "..", "..", "..", ".."))
-    candidate = _os.path.join(prefix, "share", "dualgrid", "networks")
-    return candidate if _os.path.isdir(candidate) else None
+    for candidate in (_os.path.join(here, "networks"),
+                      _os.path.join(prefix, "share", "dualgrid", "networks")):
+        if _os.path.isdir(candidate):
+            return candidate
+    return None
 
 
 def run_scenario(path: Union[str, "_os.PathLike[str]"], seed: Optional[int] = None,
