@@ -78,30 +78,19 @@ struct Arg {
   py::object obj;
   operator py::handle() const { return obj; }
 };
-struct TableTag {
-  static constexpr auto name = py::detail::const_name("TableLike");
-};
-struct PoseTag {
-  static constexpr auto name = py::detail::const_name("PoseLike");
-};
-struct Vector2Tag {
-  static constexpr auto name = py::detail::const_name("Vector2Like");
-};
-struct ArrayTag {
-  static constexpr auto name = py::detail::const_name("ArrayLike");
-};
-struct EgoTag {
-  static constexpr auto name = py::detail::const_name("EgoLike");
-};
-struct SceneTag {
-  static constexpr auto name = py::detail::const_name("SceneLike");
-};
-struct PolylinesTag {
-  static constexpr auto name = py::detail::const_name("PolylinesLike");
-};
-struct MultipathTag {
-  static constexpr auto name = py::detail::const_name("MultipathParams | Mapping[str, Any]");
-};
+// A tag naming an Arg in signatures.
+#define DUALGRID_ARG_TAG(Tag, text)                                  \
+  struct Tag {                                                       \
+    static constexpr auto name = pybind11::detail::const_name(text); \
+  }
+DUALGRID_ARG_TAG(TableTag, "TableLike");
+DUALGRID_ARG_TAG(PoseTag, "PoseLike");
+DUALGRID_ARG_TAG(Vector2Tag, "Vector2Like");
+DUALGRID_ARG_TAG(ArrayTag, "ArrayLike");
+DUALGRID_ARG_TAG(EgoTag, "EgoLike");
+DUALGRID_ARG_TAG(SceneTag, "SceneLike");
+DUALGRID_ARG_TAG(PolylinesTag, "PolylinesLike");
+DUALGRID_ARG_TAG(MultipathTag, "MultipathParams | Mapping[str, Any]");
 using MultipathArg = Arg<MultipathTag>;
 using TableArg = Arg<TableTag>;
 using PolylinesArg = Arg<PolylinesTag>;

@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,7 +14,9 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
+#include "dualgrid/recorded/run_folder.hpp"
 #include "run_results.hpp"
 #include "run_setup.hpp"
 
@@ -144,9 +147,38 @@ py::dict ReadRecorded(const fs::path& path, std::optional<fs::path> sensors) {
   return r;
 }
 
+// `dualgrid export`'s job: a run folder (recorded with --detections exact) as a RadarScenes
+// dataset root. Returns the sequence folder written.
+std::string ExportRadarScenes(const fs::path& run_dir, const fs::path& out,
+                              const std::string& sequence) {
+  if (sequence.empty() || sequence.find('/') != std::string::npos)
+    throw py::value_error("export_radarscenes: sequence must be a folder name, got '" + sequence +
+                          "'");
+  std::error_code ec;
+  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
+    throw py::value_error("export_radarscenes: out " + out.string() +
+                          " exists and is not an empty folder");
+  cosim::RecordedSequence seq = recorded::ReadRunFolder(run_dir);
+  seq.name = sequence;
+  // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end, as `dualgrid export`.
+  const double rear_axle = std::max(0.0, 0.5 * seq.ego_length - 1.0);
+  {
+    py::gil_scoped_release nogil;
+    recorded::WriteRadarScenes(seq, out, rear_axle);
+  }
+  return (out / "data" / sequence).string();
+}
+
 }  // namespace
 
 void BindRecorded(py::module_& m) {
+  m.def("export_radarscenes", &ExportRadarScenes, py::arg("run_dir"), py::arg("out"),
+        py::arg("sequence") = "sequence_1",
+        R"doc(Writes a run folder (of `dualgrid run` or `sim` with --detections exact) as a
+RadarScenes dataset root `out` (sensors.json, sequences.json, data/<sequence>/scenes.json and
+radar_data.h5), as `dualgrid export` does; read_recorded() and run_recorded() read it back.
+`out` must not exist or be empty. Returns the sequence folder. ValueError for bad input (the
+file and field), RuntimeError naming the file when a write fails.)doc");
   m.def("read_recorded", &ReadRecorded, py::arg("path"), py::arg("sensors") = py::none(),
         R"doc(Reads a recorded sequence without filtering it: a RadarScenes sequence folder
 (scenes.json, radar_data.h5; sensors: its sensors.json, default the dataset root's) or a run

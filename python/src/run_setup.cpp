@@ -10,6 +10,10 @@
 namespace dualgrid::python {
 
 namespace fs = std::filesystem;
+// DefaultRecordedConfig and FitConfig: in dualgrid::recorded, or in dualgrid::cosim once the
+// recorded library no longer needs the scenario (either is found).
+using namespace recorded;  // NOLINT(google-build-using-namespace)
+using namespace cosim;     // NOLINT(google-build-using-namespace)
 
 scenario::ScenarioConfig LoadRunConfig(const fs::path& path, std::optional<std::uint64_t> seed,
                                        std::optional<double> duration,
@@ -56,13 +60,13 @@ RecordedSetup LoadRecorded(const fs::path& path, const std::optional<fs::path>& 
   } else {
     if (!overrides.empty())
       throw py::value_error(std::string(fn) + ": overrides need a scenario file");
-    s.config = recorded::DefaultRecordedConfig();
+    s.config = DefaultRecordedConfig();
   }
   if (seed) s.config.sim.seed = *seed;
   if (!(batch_window >= 0.0 && batch_window <= 1.0))
     throw py::value_error(std::string(fn) + ": batch_window must be in [0, 1] s");
   s.input = recorded::ReadRecordedInput(path, sensors);
-  s.options = recorded::FitConfig(s.input.sequence, batch_window, &s.config);
+  s.options = FitConfig(s.input.sequence, batch_window, &s.config);
   return s;
 }
 

@@ -208,12 +208,8 @@ struct SequenceSimulation : Simulation {
 };
 
 // Step results typed for signatures and the stub.
-struct StepTag {
-  static constexpr auto name = py::detail::const_name("Step");
-};
-struct OptionalStepTag {
-  static constexpr auto name = py::detail::const_name("Optional[Step]");
-};
+DUALGRID_ARG_TAG(StepTag, "Step");
+DUALGRID_ARG_TAG(OptionalStepTag, "Optional[Step]");
 using StepResult = Arg<StepTag>;
 using OptionalStepResult = Arg<OptionalStepTag>;
 

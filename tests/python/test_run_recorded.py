@@ -112,5 +112,31 @@ class RunRecordedTest(unittest.TestCase):
             dualgrid.run_recorded(self.seq, modes=["fast"])
 
 
+class ExportTest(unittest.TestCase):
+    """export_radarscenes writes what `dualgrid export` writes: both read back the same."""
+
+    def test_export_equals_the_cli(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = os.path.join(tmp, "run")
+            subprocess.run([os.environ["DUALGRID_EXE"], "run",
+                            os.path.join(SOURCE, "scenarios", "simple_road.yaml"), "--out", run,
+                            "--duration", "2", "--modes", "dual", "--detections", "exact",
+                            "--no-figures", "--no-record", "-q"], check=True)
+            cli = os.path.join(tmp, "cli")
+            subprocess.run([os.environ["DUALGRID_EXE"], "export", run, "--out", cli, "-q"],
+                           check=True)
+            seq = dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
+            self.assertEqual(seq, os.path.join(tmp, "py", "data", "sequence_1"))
+            a = dualgrid.read_recorded(seq)
+            b = dualgrid.read_recorded(os.path.join(cli, "data", "sequence_1"))
+            self.assertGreater(len(a["points"]["x"]), 100)
+            for part in ("points", "scans"):
+                for k in a[part]:
+                    self.assertTrue(np.array_equal(a[part][k], b[part][k]), (part, k))
+            self.assertEqual(a["track_names"], b["track_names"])
+            with self.assertRaisesRegex(ValueError, "exists and is not an empty folder"):
+                dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
+
+
 if __name__ == "__main__":
     unittest.main()
