@@ -109,9 +109,9 @@ void BM_Recorded(benchmark::State& state) {
   int cycles = 0;
   for (auto _ : state) {
     const cosim::RecordedSequence seq = recorded::ReadRadarScenes(dir, std::nullopt);
-    scenario::ScenarioConfig config = recorded::DefaultRecordedConfig();
+    scenario::ScenarioConfig config = cosim::DefaultRecordedConfig();
     const cosim::RecordedOptions o =
-        recorded::FitConfig(seq, 1e-3 * static_cast<double>(state.range(1)), &config);
+        cosim::FitConfig(seq, 1e-3 * static_cast<double>(state.range(1)), &config);
     cosim::CoSimulation cs(config, {modes, 0},
                            [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                              return std::make_unique<cosim::RecordedSource>(seq, o);

@@ -1,8 +1,11 @@
 # dualgrid_install_library(TARGET EXPORT_NAME) makes one of dualgrid's libraries installable:
 # position-independent (the Python module links the static libraries), exported as
-# dualgrid::EXPORT_NAME, and its public headers (the folder's include/) installed.
+# dualgrid::EXPORT_NAME, and its public headers (the folder's include/) installed. The headers
+# need C++20 (std::span, designated initialisers): the requirement is part of the target, so a
+# consumer gets it without setting a standard.
 include(GNUInstallDirs)
 function(dualgrid_install_library target export_name)
+  target_compile_features(${target} PUBLIC cxx_std_20)
   set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON
                                              EXPORT_NAME ${export_name})
   install(TARGETS ${target} EXPORT dualgridTargets

@@ -221,4 +221,26 @@ void RecordedSource::Scan(IdRegistry& ids, std::vector<radar::Detection>* detect
   }
 }
 
+scenario::ScenarioConfig DefaultRecordedConfig() {
+  scenario::ScenarioConfig c;
+  c.filter.length_x = 100.0;
+  c.filter.width_y = 60.0;
+  return c;
+}
+
+RecordedOptions FitConfig(const RecordedSequence& seq, double batch_window,
+                          scenario::ScenarioConfig* config) {
+  RecordedOptions o;
+  o.batch_window = batch_window;
+  o.first_dt = config->filter.cycle;
+  const RecordedSource probe(seq, o);
+  config->sim.name = seq.name;
+  config->sim.duration = probe.last_time();
+  config->sim.step_length = probe.last_time() / probe.StepCount();
+  if (!(config->sim.step_length > 0.0))
+    throw std::invalid_argument(seq.name + ": the scans span no time (the last at t = 0)");
+  config->radar.sensors.clear();  // the sequence's radars
+  return o;
+}
+
 }  // namespace dualgrid::cosim

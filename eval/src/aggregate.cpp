@@ -177,8 +177,9 @@ std::string ComparisonTable::ToMarkdown() const {
       if (!s || s->n == 0) {
         os << " — |";
       } else {
-        os << ' ' << FormatFixed(s->mean * m.display_scale, m.decimals);
-        if (s->half_width) os << " ± " << FormatFixed(*s->half_width * m.display_scale, m.decimals);
+        const int decimals = m.count && s->n == 1 ? 0 : m.decimals;
+        os << ' ' << FormatFixed(s->mean * m.display_scale, decimals);
+        if (s->half_width) os << " ± " << FormatFixed(*s->half_width * m.display_scale, decimals);
         if (s->n < max_n) os << " (n=" << s->n << ')';
         os << " |";
       }
@@ -284,15 +285,15 @@ ComparisonTable MakeComparisonTable(std::string_view scenario, std::span<const M
        [](const ScenarioMetrics& m) {
          return std::optional<double>(m.duplicate_clusters_per_scan);
        }},
-      {{std::string(kScored), "objects scored", "", 1.0, 1},
+      {{std::string(kScored), "objects scored", "", 1.0, 1, true},
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_scored));
        }},
-      {{std::string(kNeverTracked), "objects never tracked", "", 1.0, 1},
+      {{std::string(kNeverTracked), "objects never tracked", "", 1.0, 1, true},
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_never_tracked));
        }},
-      {{std::string(kNeverObservable), "… of which never seen in the grid", "", 1.0, 1},
+      {{std::string(kNeverObservable), "… of which never seen in the grid", "", 1.0, 1, true},
        [](const ScenarioMetrics& m) {
          return std::optional<double>(static_cast<double>(m.objects_never_observable));
        }},

@@ -114,10 +114,12 @@ def run_scenario(path: Union[str, "_os.PathLike[str]"], seed: Optional[int] = No
                  overrides: Sequence[str] = (),
                  network_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
                  work_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
-                 threads: int = 0) -> Dict[str, Any]:
+                 threads: int = 0,
+                 out: Optional[Union[str, "_os.PathLike[str]"]] = None) -> Dict[str, Any]:
     """Runs a scenario file as `dualgrid run` does and returns its results as a dict.
 
     The same scenario and seed give the command line's numbers (metrics, objects, clusters).
+    out: a folder to write the run folder of `dualgrid run --out` to (the same files).
     network_dir defaults to $DUALGRID_NETWORK_DIR, else this installation's networks
     (installed_network_dir()), else the build tree's. Full description:
     help(dualgrid._dualgrid.run_scenario) and docs/python.md.
@@ -126,7 +128,7 @@ def run_scenario(path: Union[str, "_os.PathLike[str]"], seed: Optional[int] = No
         network_dir = installed_network_dir()
     return _run_scenario(str(path), seed=seed, duration=duration, modes=list(modes),
                          overrides=list(overrides), network_dir=network_dir, work_dir=work_dir,
-                         threads=threads)
+                         threads=threads, out=None if out is None else str(out))
 
 
 

@@ -16,6 +16,8 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/outputs/run.hpp"
+#include "dualgrid/outputs/run_config.hpp"
 #include "run_results.hpp"
 #include "run_setup.hpp"
 
@@ -24,31 +26,50 @@ namespace {
 
 namespace fs = std::filesystem;
 
-py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
-                     std::optional<double> duration, const std::vector<std::string>& modes,
-                     const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
-                     std::optional<fs::path> work_dir, int threads) {
-  const scenario::ScenarioConfig config =
-      LoadRunConfig(path, seed, duration, overrides, "run_scenario");
-  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_scenario");
-  SumoClaim sumo("run_scenario");
-  // SUMO's route file and log: the caller's folder, or a temporary one removed afterwards.
-  WorkDir work = WorkDir::Make(work_dir, config.sim.name);
-  const std::filesystem::path networks = NetworkDir(network_dir);
-
-  cosim::CoSimulation cs(config, options);
-  ClusterColumns clusters;
+// SUMO's route file and log go to `work_dir`, or a temporary folder removed afterwards.
+void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
+              const std::optional<fs::path>& work_dir) {
+  WorkDir work = WorkDir::Make(work_dir, cs.config().sim.name);
   {
     py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
-    cs.Start(networks, work.path);
-    cs.AddObserver(&clusters);
+    cs.Start(network_dir, work.path);
     while (cs.Step()) {
     }
     cs.Finish();
   }
   work.Remove();
-  py::dict r = Results(cs, config, clusters);
-  return r;
+}
+
+// The run folder `out`, as `dualgrid run` writes it with its default options.
+void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config,
+                 const fs::path& network_dir, const fs::path& out) {
+  outputs::RunFolderOptions folder;
+  folder.out = out;
+  folder.network_dir = network_dir;
+  folder.quiet = true;
+  py::gil_scoped_release release;
+  outputs::WriteRunFolder(cs, config, folder);
+}
+
+py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
+                     std::optional<double> duration, const std::vector<std::string>& modes,
+                     const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
+                     std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out) {
+  const scenario::ScenarioConfig config =
+      LoadRunConfig(path, seed, duration, overrides, "run_scenario");
+  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_scenario");
+  if (out && work_dir)
+    throw py::value_error("run_scenario: work_dir: not with out (SUMO's files go there)");
+  SumoClaim sumo("run_scenario");
+  cosim::CoSimulation cs(config, options);
+  ClusterColumns clusters;
+  cs.AddObserver(&clusters);
+  const fs::path networks = NetworkDir(network_dir);
+  if (out)
+    RunToFolder(cs, config, networks, *out);
+  else
+    RunToEnd(cs, networks, work_dir);
+  return Results(cs, config, clusters);
 }
 
 }  // namespace
@@ -66,7 +87,7 @@ void BindCosim(py::module_& m) {
         py::arg("duration") = py::none(),
         py::arg("modes") = std::vector<std::string>{"position", "velocity", "dual"},
         py::arg("overrides") = std::vector<std::string>{}, py::arg("network_dir") = py::none(),
-        py::arg("work_dir") = py::none(), py::arg("threads") = 0,
+        py::arg("work_dir") = py::none(), py::arg("threads") = 0, py::arg("out") = py::none(),
         R"doc(Runs a scenario file as `dualgrid run` does (SUMO, radar, one filter per mode, the
 paper's scoring) and returns its results; the same scenario and seed give the CLI's numbers.
 
@@ -75,7 +96,10 @@ by side on the same detections. overrides: "KEY=VALUE" texts as `--set` (e.g.
 "filter.preset=paper"). network_dir: folder of the built networks (default: the installed or
 build tree's, or $DUALGRID_NETWORK_DIR). work_dir: where SUMO's route file and sumo.log go
 (default: a temporary folder, removed). threads: OpenMP threads (0: default; results do not
-depend on it). One run at a time per process (libsumo).
+depend on it). out: a folder to write the run folder to, as `dualgrid run --out DIR` with its
+default options does (metrics, tables, CSV files, figures, the replay recording, summary.json
+last; the same bytes as the command line's except the wall-clock times of summary.json; SUMO's
+files go there too, so not with work_dir). One run at a time per process (libsumo).
 
 Returns a dict: scenario, seed, steps, simulated_s, requested_s, complete (False when the ego
 left the network early), detections_per_step, metrics ({mode: metrics.json's entry}),

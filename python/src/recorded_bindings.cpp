@@ -14,6 +14,7 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "dualgrid/cosim/recorded_source.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 #include "dualgrid/recorded/run_folder.hpp"

@@ -1,5 +1,7 @@
 #include "run_setup.hpp"
 
+#include "dualgrid/outputs/run_config.hpp"
+
 #include <unistd.h>
 
 #include <atomic>
@@ -18,17 +20,11 @@ using namespace cosim;     // NOLINT(google-build-using-namespace)
 scenario::ScenarioConfig LoadRunConfig(const fs::path& path, std::optional<std::uint64_t> seed,
                                        std::optional<double> duration,
                                        const std::vector<std::string>& overrides, const char* fn) {
-  std::vector<scenario::Override> sets;
-  for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
-  scenario::ScenarioConfig config = scenario::LoadScenario(path, sets);
-  if (seed) config.sim.seed = *seed;
-  if (duration) {
-    if (!(*duration > 0.0 && *duration <= 3600.0))
-      throw py::value_error(std::string(fn) + ": duration must be in (0, 3600] s, got " +
-                            std::to_string(*duration));
-    config.sim.duration = *duration;
-  }
-  return config;
+  if (duration && !(*duration > 0.0 && *duration <= 3600.0))
+    throw py::value_error(std::string(fn) + ": duration must be in (0, 3600] s, got " +
+                          std::to_string(*duration));
+  // The command line's loader: the same configuration as `dualgrid run` with these options.
+  return outputs::LoadRunConfig(path, overrides, seed, duration);
 }
 
 cosim::CoSimOptions RunOptions(const std::vector<std::string>& modes, int threads, const char* fn) {

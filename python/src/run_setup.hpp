@@ -12,6 +12,7 @@
 
 #include "bindings.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/cosim/recorded_source.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 
 namespace dualgrid::python {

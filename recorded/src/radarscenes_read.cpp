@@ -151,8 +151,8 @@ std::vector<SceneEntry> ReadScenes(const std::filesystem::path& file, std::strin
 
 }  // namespace
 
-cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
-                                        const std::optional<std::filesystem::path>& sensors_json) {
+RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
+                                 const std::optional<std::filesystem::path>& sensors_json) {
   h5::Silence();
   std::filesystem::path dir = sequence_dir.lexically_normal();
   if (dir.filename().empty()) dir = dir.parent_path();  // a trailing '/'
@@ -162,7 +162,7 @@ cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_di
       sensors_json ? *sensors_json
                    : std::filesystem::absolute(dir).parent_path().parent_path() / "sensors.json";
   const Rig rig = ReadSensors(sensors_file);
-  cosim::RecordedSequence seq;
+  RecordedSequence seq;
   const std::filesystem::path scenes_file = dir / "scenes.json";
   const std::vector<SceneEntry> scenes = ReadScenes(scenes_file, &seq.name, rig.sensors.size());
   seq.sensors = rig.sensors;
@@ -234,7 +234,7 @@ cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_di
       Bad(scenes_file, "key 'scenes." + std::to_string(s.timestamp) +
                            ".odometry_index': " + std::to_string(s.odometry_index) +
                            " is outside odometry's " + std::to_string(odo.size()) + " rows");
-    cosim::RecordedScan scan;
+    RecordedScan scan;
     scan.timestamp_us = s.timestamp;
     scan.sensor = s.sensor_id - 1;
     const auto k = static_cast<std::size_t>(s.odometry_index);
@@ -256,7 +256,7 @@ cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_di
                          " differs from its scene's sensor " + std::to_string(s.sensor_id));
       int label = -1;
       if (seq.has_labels) {
-        if (r_label[i] < 0 || r_label[i] > cosim::kStaticLabel)
+        if (r_label[i] < 0 || r_label[i] > kStaticLabel)
           Bad(h5_file, rd_where + "field 'label_id': " + std::to_string(r_label[i]) + row +
                            " is not a RadarScenes label (0-11)");
         label = static_cast<int>(r_label[i]);
@@ -267,7 +267,7 @@ cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_di
         ++seq.skipped_points;
         continue;
       }
-      cosim::RecordedPoint p;
+      RecordedPoint p;
       p.range = r_range[i];
       p.azimuth = r_az[i];
       p.range_rate = r_vr[i];

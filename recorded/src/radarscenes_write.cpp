@@ -53,8 +53,7 @@ int LabelOfVClass(const std::string& c) {
   return it == kLabels.end() ? 10 : it->second;  // 10: other
 }
 
-void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem::path& root,
-                      double a) {
+void WriteRadarScenes(const RecordedSequence& seq, const std::filesystem::path& root, double a) {
   h5::Silence();
   const std::filesystem::path dir = root / "data" / seq.name;
   std::filesystem::create_directories(dir);
@@ -93,7 +92,7 @@ void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem:
   Json scenes;
   std::map<int, std::int64_t> last_of_sensor;
   for (std::size_t i = 0; i < seq.scans.size(); ++i) {
-    const cosim::RecordedScan& s = seq.scans[i];
+    const RecordedScan& s = seq.scans[i];
     const auto prev = last_of_sensor.find(s.sensor);
     Json e = {{"sensor_id", s.sensor + 1},
               {"radar_indices", {s.begin, s.end}},
@@ -128,10 +127,10 @@ void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem:
   std::size_t track_len = 1;
   for (const std::string& name : seq.track_names) track_len = std::max(track_len, name.size());
   for (std::size_t k = 0; k < seq.scans.size(); ++k) {
-    const cosim::RecordedScan& s = seq.scans[k];
+    const RecordedScan& s = seq.scans[k];
     const Pose2 car{s.ego_pose.position - a * UnitVector(s.ego_pose.yaw), s.ego_pose.yaw};
     for (std::size_t i = s.begin; i < s.end; ++i) {
-      const cosim::RecordedPoint& p = seq.points[i];
+      const RecordedPoint& p = seq.points[i];
       t[i] = static_cast<std::uint64_t>(stamp[k]);
       sensor[i] = static_cast<std::uint8_t>(s.sensor + 1);
       range[i] = p.range;
@@ -146,7 +145,7 @@ void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem:
       ys[i] = p.position.y();
       uuid[i] = Uuid(seq.name, i);
       track[i] = p.track >= 0 ? seq.track_names[p.track] : "";
-      label[i] = static_cast<std::uint8_t>(p.label >= 0 ? p.label : cosim::kStaticLabel);
+      label[i] = static_cast<std::uint8_t>(p.label >= 0 ? p.label : kStaticLabel);
     }
   }
   h5::CompoundWriter r;
@@ -180,7 +179,7 @@ void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem:
   std::vector<std::uint64_t> ot(m);
   std::vector<double> ox(m), oy(m), oyaw(m), ovx(m), owz(m), olane(m);
   for (std::size_t k = 0; k < m; ++k) {
-    const cosim::RecordedScan& s = seq.scans[k];
+    const RecordedScan& s = seq.scans[k];
     const Vector2 heading = UnitVector(s.ego_pose.yaw);
     const Position rear = s.ego_pose.position - a * heading;
     ot[k] = static_cast<std::uint64_t>(stamp[k]);

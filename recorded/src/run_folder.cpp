@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "dualgrid/recorded/radarscenes.hpp"
+#include "dualgrid/recorded/run_folder_columns.hpp"
 
 namespace dualgrid::recorded {
 
@@ -102,10 +103,10 @@ class CsvReader {
 
 }  // namespace
 
-cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
+RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   std::filesystem::path dir = run_dir.lexically_normal();
   if (dir.filename().empty()) dir = dir.parent_path();
-  cosim::RecordedSequence seq;
+  RecordedSequence seq;
   seq.name = std::filesystem::absolute(dir).filename().string();
   seq.has_labels = true;
   const std::filesystem::path scans_file = dir / "scans.csv";
@@ -116,16 +117,15 @@ cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   std::map<std::pair<long, long>, std::size_t> scan_of;  // (step, sensor) -> scan
   {
     CsvReader in(scans_file);
-    const std::size_t c_step = in.Column("step"), c_time = in.Column("time"),
-                      c_sensor = in.Column("sensor"), c_name = in.Column("sensor_name"),
-                      c_x = in.Column("ego_x"), c_y = in.Column("ego_y"),
-                      c_yaw = in.Column("ego_yaw"), c_vx = in.Column("ego_vx"),
-                      c_vy = in.Column("ego_vy"), c_wz = in.Column("ego_yaw_rate"),
-                      c_len = in.Column("ego_length"), c_wid = in.Column("ego_width"),
-                      c_lane = in.Column("lane_yaw"), c_mx = in.Column("mount_x"),
-                      c_my = in.Column("mount_y"), c_myaw = in.Column("mount_yaw"),
-                      c_fov = in.Column("fov"), c_rmin = in.Column("min_range"),
-                      c_rmax = in.Column("max_range");
+    const auto col = [&in](ScanColumn c) { return in.Column(std::string(kScanColumns[c])); };
+    const std::size_t c_step = col(kScanStep), c_time = col(kScanTime), c_sensor = col(kScanSensor),
+                      c_name = col(kScanSensorName), c_x = col(kScanEgoX), c_y = col(kScanEgoY),
+                      c_yaw = col(kScanEgoYaw), c_vx = col(kScanEgoVx), c_vy = col(kScanEgoVy),
+                      c_wz = col(kScanEgoYawRate), c_len = col(kScanEgoLength),
+                      c_wid = col(kScanEgoWidth), c_lane = col(kScanLaneYaw),
+                      c_mx = col(kScanMountX), c_my = col(kScanMountY), c_myaw = col(kScanMountYaw),
+                      c_fov = col(kScanFov), c_rmin = col(kScanMinRange),
+                      c_rmax = col(kScanMaxRange);
     std::int64_t last_t = -1;
     while (in.Next()) {
       const long step = in.Int(c_step), sensor = in.Int(c_sensor);
@@ -138,7 +138,7 @@ cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
       s.fov = in.Number(c_fov);
       s.min_range = in.Number(c_rmin);
       s.max_range = in.Number(c_rmax);
-      cosim::RecordedScan scan;
+      RecordedScan scan;
       scan.timestamp_us = std::llround(in.Number(c_time) * 1e6);
       if (scan.timestamp_us < last_t)
         in.Fail("row " + std::to_string(in.line()) + ", column 'time': not increasing");
@@ -168,11 +168,13 @@ cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   std::filesystem::path det_file = dir / "detections.csv";
   if (!std::filesystem::exists(det_file)) det_file = dir / "detections.csv.gz";
   CsvReader in(det_file);
-  const std::size_t c_step = in.Column("step"), c_sensor = in.Column("sensor"),
-                    c_range = in.Column("range"), c_az = in.Column("azimuth"),
-                    c_rr = in.Column("range_rate"), c_x = in.Column("x"), c_y = in.Column("y"),
-                    c_vr = in.Column("radial_speed"), c_source = in.Column("source"),
-                    c_vclass = in.Column("vclass");
+  const auto col = [&in](DetectionColumn c) {
+    return in.Column(std::string(kDetectionColumns[c]));
+  };
+  const std::size_t c_step = col(kDetStep), c_sensor = col(kDetSensor), c_range = col(kDetRange),
+                    c_az = col(kDetAzimuth), c_rr = col(kDetRangeRate), c_x = col(kDetX),
+                    c_y = col(kDetY), c_vr = col(kDetRadialSpeed), c_source = col(kDetSource),
+                    c_vclass = in.Column(std::string(kVClassColumn));
   std::map<std::string, int> track_index;
   std::size_t current = 0;  // scans are filled in order
   for (auto& s : seq.scans) s.begin = s.end = 0;
@@ -187,7 +189,7 @@ cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
       seq.scans[k].begin = seq.scans[k].end = seq.points.size();
     current = it->second;
     any = true;
-    cosim::RecordedPoint p;
+    RecordedPoint p;
     p.range = in.Number(c_range);
     p.azimuth = in.Number(c_az);
     p.range_rate = in.Number(c_rr);
@@ -195,7 +197,7 @@ cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
     p.position = {in.Number(c_x), in.Number(c_y)};
     const std::string& vclass = in.Text(c_vclass);
     if (vclass.empty()) {
-      p.label = cosim::kStaticLabel;  // clutter, ghosts, guard rails and parked boxes
+      p.label = kStaticLabel;  // clutter, ghosts, guard rails and parked boxes
     } else {
       p.label = LabelOfVClass(vclass);
       const std::string& name = in.Text(c_source);

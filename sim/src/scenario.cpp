@@ -1,5 +1,6 @@
 #include "dualgrid/sim/scenario.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -36,7 +37,48 @@ void CheckVehicle(FieldCheck& c, const VehicleSpec& v, const std::string& field,
               Interval::kLeftOpen, "m/s");
 }
 
+// The ego of the user's files must depart within the run (SUMO skips vehicles that depart before
+// its begin; one departing after the end never enters).
+void CheckEgoDeparture(FieldCheck& c, const ScenarioSpec& s) {
+  if (!s.ego_departure) return;
+  const std::optional<double> t = s.ego_departure->At(s.begin);
+  const std::string window = "SUMO time [" + FormatShort(s.begin) + ", " +
+                             FormatShort(s.begin + s.duration) + "] s (begin + duration)";
+  if (!t) {
+    c.Expect(false, "ego.from_routes", Quoted(s.ego.id),
+             "a member its flow creates when SUMO begins at " + FormatShort(s.begin) +
+                 " s (SUMO time): the flow ends before it departs");
+    return;
+  }
+  c.Expect(*t >= s.begin && *t < s.begin + s.duration, "ego.from_routes", Quoted(s.ego.id),
+           "a vehicle departing in the run, " + window + ", but it departs at SUMO time " +
+               FormatShort(*t) + " s" +
+               (*t < s.begin ? " and SUMO skips vehicles that depart before the begin"
+                             : ": set begin (or --begin) or a longer duration"));
+}
+
+// The run's window on SUMO's clock: begin (its source named), duration, the configuration's end.
+void CheckTimes(FieldCheck& c, const ScenarioSpec& s) {
+  const std::string begin_key = s.begin_source == "command line"  ? "--begin"
+                                : s.begin_source == "sumo_config" ? "sumo_config <begin>"
+                                                                  : "begin";
+  c.InRange(begin_key, s.begin, 0.0, kMaxBegin, Interval::kClosed, "s (SUMO time)");
+  if (s.config_end)
+    c.Expect(s.begin < *s.config_end, begin_key, s.begin,
+             "< the configuration's end = " + FormatShort(*s.config_end) +
+                 " s (SUMO time): a run that begins after SUMO's end");
+  c.InRange("duration", s.duration, 0.0, kMaxDuration, Interval::kLeftOpen, "s (run time)");
+  CheckEgoDeparture(c, s);
+}
+
 }  // namespace
+
+std::optional<double> FileDeparture::At(double begin) const {
+  if (!period) return depart;
+  const double t = std::max(depart, begin) + static_cast<double>(member) * *period;
+  if (flow_end && !(t < *flow_end)) return std::nullopt;
+  return t;
+}
 
 int ScenarioSpec::StepCount() const {
   return static_cast<int>(std::floor(duration / step_length + 1e-9));
@@ -55,7 +97,7 @@ double VClassRcs(const std::string& vclass) {
 bool ScenarioSpec::IsValid(std::string* error) const {
   FieldCheck c;
   c.Expect(!network.empty(), "network", "''", "the name or path of a network");
-  c.InRange("duration", duration, 0.0, 3600.0, Interval::kLeftOpen, "s");
+  CheckTimes(c, *this);
   c.InRange("step_length", step_length, 0.001, 1.0, Interval::kClosed, "s");
   c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6, "step_length",
            step_length, "a whole number of milliseconds (SUMO's resolution)");
@@ -80,13 +122,14 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   c.Expect(duration >= step_length, "duration", duration,
            ">= step_length = " + FormatShort(step_length) + " s (at least one step)");
   if (ego_from_routes)
-    c.Expect(!route_files.empty() || !additional_files.empty(), "ego.from_routes", Quoted(ego.id),
-             "SUMO route or additional files to take it from (traffic.route_files or "
-             "sumo_config)");
+    c.Expect(!route_files.empty() || !additional_files.empty() || random_trips, "ego.from_routes",
+             Quoted(ego.id),
+             "SUMO route or additional files to take it from (traffic.route_files, sumo_config "
+             "or traffic.random_trips)");
   else
     CheckVehicle(c, ego, "ego", *this);
   c.Expect(ego.depart < duration, "ego.depart", ego.depart,
-           "< duration = " + FormatShort(duration) + " s (a departure within the run)");
+           "< duration = " + FormatShort(duration) + " s (run time: a departure within the run)");
   c.InRange("ego.speed_policy.speed", ego_speed.speed, 0.0, kMaxTrafficSpeed, Interval::kClosed,
             "m/s");
   // A parked ego (speed 0) is held by the fixed policy; cruising at 0 would be no policy at all.

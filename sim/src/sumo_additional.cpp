@@ -54,8 +54,11 @@ bool IsNullDevice(std::string_view v) { return v == "NUL" || v == "nul" || v == 
 
 class Preparer {
  public:
+  // Absolute: SUMO reads a relative output path relative to the additional file naming it (the
+  // copy inside work_dir), so a relative work_dir would be counted twice.
   explicit Preparer(const std::filesystem::path& work_dir)
-      : copies_(work_dir / "sumo_additional"), outputs_dir_(work_dir / "sumo_outputs") {}
+      : copies_(std::filesystem::absolute(work_dir) / "sumo_additional"),
+        outputs_dir_(std::filesystem::absolute(work_dir) / "sumo_outputs") {}
 
   // The file SUMO should load for `file`: `file` itself or a prepared copy.
   std::string Prepare(const std::filesystem::path& file, int depth) {

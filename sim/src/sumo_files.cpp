@@ -6,6 +6,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <stdlib.h>
+
+#include "dualgrid/sim/sumo_tools.hpp"
 #include "dualgrid/sim/xml_scan.hpp"
 
 namespace dualgrid::sim {
@@ -35,16 +38,23 @@ std::optional<double> Number(const char* text) {
   return v;
 }
 
+// A <flow>'s time between departures [s]: period, or 3600 / vehsPerHour; std::nullopt when
+// chance decides (probability) or it is not a plain number.
+std::optional<double> FlowPeriod(const XmlElement& e) {
+  std::optional<double> period = Number(e.Attribute("period"));
+  if (!period)
+    if (const auto vph = Number(e.Attribute("vehsPerHour")); vph && *vph > 0)
+      period = 3600.0 / *vph;
+  return period && *period > 0.0 ? period : std::nullopt;
+}
+
 // How many vehicles a <flow> creates (SUMO's rules: `number`; else departures from begin every
 // period, 3600 / vehsPerHour, before end); std::nullopt when chance or the run decides.
 std::optional<long> FlowMembers(const XmlElement& e, double begin) {
   if (const auto n = Number(e.Attribute("number"))) return std::max(0L, std::lround(*n));
   const auto end = Number(e.Attribute("end"));
-  std::optional<double> period = Number(e.Attribute("period"));
-  if (!period)
-    if (const auto vph = Number(e.Attribute("vehsPerHour")); vph && *vph > 0)
-      period = 3600.0 / *vph;
-  if (!end || !period || !(*period > 0.0)) return std::nullopt;
+  const std::optional<double> period = FlowPeriod(e);
+  if (!end || !period) return std::nullopt;
   if (!(*end > begin)) return 0L;
   return static_cast<long>(std::ceil((*end - begin) / *period - 1e-9));
 }
@@ -60,42 +70,100 @@ std::string Quote(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
-SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
-  const std::filesystem::path base = std::filesystem::absolute(cfg).parent_path();
-  SumoConfigInputs in;
-  std::optional<std::string> net, routes, additional, step;
-  // SUMO's option names and their synonyms (sumo --help); in a configuration each is an element
-  // <name value="..."/> or an attribute name="..." of a section element (<input net-file=.../>).
-  const std::pair<std::optional<std::string>*, std::vector<std::string_view>> kOptions[] = {
-      {&net, {"net-file", "net", "n"}},
-      {&routes, {"route-files", "routes", "r"}},
-      {&additional, {"additional-files", "additional", "a"}},
-      {&step, {"step-length"}}};
-  ScanXml(cfg, "SUMO configuration", [&](const XmlElement& e) {
-    for (const auto& [slot, names] : kOptions) {
-      if (*slot) continue;  // the first one, as SUMO reads its options
-      for (std::string_view name : names) {
-        if (e.tag() == name && e.Attribute("value")) *slot = e.Attribute("value");
-        if (e.depth() == 1 && e.Attribute(name)) *slot = e.Attribute(name);
-        if (*slot) break;
-      }
+namespace {
+
+// A SUMO time option's text in seconds: a number, or SUMO's clock form [[[D:]H:]M:]S
+// ("7:00:00"); std::nullopt for anything else.
+std::optional<double> SumoTime(const std::string& text) {
+  if (const auto plain = Number(text.c_str())) return plain;
+  std::vector<double> parts;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, ':')) {
+    const auto v = Number(part.c_str());
+    if (!v) return std::nullopt;
+    parts.push_back(*v);
+  }
+  if (parts.size() < 2 || parts.size() > 4) return std::nullopt;
+  static const double kUnit[] = {86400.0, 3600.0, 60.0, 1.0};  // D, H, M, S [s]
+  double total = 0.0;
+  for (std::size_t i = 0; i < parts.size(); ++i) total += parts[i] * kUnit[4 - parts.size() + i];
+  return total;
+}
+
+// SUMO's own reading of `cfg`: `sumo -c CFG --save-configuration OUT` writes every option it
+// took, under its canonical name, with paths resolved against the configuration's folder (and
+// exits without simulating). Returns option name -> value text.
+std::map<std::string, std::string> AskSumo(const std::filesystem::path& cfg) {
+  namespace fs = std::filesystem;
+  std::string folder = (fs::temp_directory_path() / "dualgrid_sumocfg.XXXXXX").string();
+  if (!mkdtemp(folder.data()))
+    throw std::runtime_error("cannot create a temporary folder in " +
+                             fs::temp_directory_path().string());
+  struct Remove {
+    fs::path dir;
+    ~Remove() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
     }
+  } remove{folder};
+  const fs::path saved = fs::path(folder) / "saved.sumocfg", log = fs::path(folder) / "sumo.log";
+  const int rc = RunSumoTool({"sumo", "-c", fs::absolute(cfg).string(), "--save-configuration",
+                              saved.string(), "--xml-validation", "never"},
+                             log);
+  if (rc != 0 || !fs::is_regular_file(saved))
+    throw std::invalid_argument(cfg.string() +
+                                ": SUMO cannot read this configuration: " + FirstErrorLine(log));
+  std::map<std::string, std::string> options;
+  ScanXml(saved, "SUMO's reading of " + cfg.string(), [&](const XmlElement& e) {
+    if (e.depth() == 2 && e.Attribute("value"))
+      options[std::string(e.tag())] = e.Attribute("value");
     return true;
   });
+  return options;
+}
+
+}  // namespace
+
+SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
+  // The file itself first: a regular file, bounded, well-formed XML (SUMO would block on a FIFO
+  // and name no file for a broken one).
+  ScanXml(cfg, "SUMO configuration", [](const XmlElement&) { return true; });
+  const std::map<std::string, std::string> options = AskSumo(cfg);
+  const auto option = [&](const char* name) -> std::optional<std::string> {
+    const auto it = options.find(name);
+    return it == options.end() ? std::nullopt : std::optional<std::string>(it->second);
+  };
+  const std::filesystem::path base = std::filesystem::absolute(cfg).parent_path();
+  SumoConfigInputs in;
+  const auto net = option("net-file");
   const auto nets = net ? PathList(*net, base) : std::vector<std::filesystem::path>{};
   if (nets.empty())
     throw std::invalid_argument(cfg.string() +
                                 ": element <net-file value=\"...\"/> (or <net value=...>) "
                                 "expected in <input>");
   in.net_file = nets.front();
-  if (routes) in.route_files = PathList(*routes, base);
-  if (additional) in.additional_files = PathList(*additional, base);
-  if (step) {
+  if (const auto routes = option("route-files")) in.route_files = PathList(*routes, base);
+  if (const auto additional = option("additional-files"))
+    in.additional_files = PathList(*additional, base);
+  if (const auto step = option("step-length")) {
     in.step_length = Number(step->c_str());
     if (!in.step_length || !(*in.step_length > 0.0))
       throw std::invalid_argument(cfg.string() + ": element <step-length value=\"" + *step +
                                   "\"/>: expected a positive number of seconds");
   }
+  const auto time = [&](const char* name) -> std::optional<double> {
+    const auto text = option(name);
+    if (!text) return std::nullopt;
+    const auto t = SumoTime(*text);
+    if (!t)
+      throw std::invalid_argument(cfg.string() + ": element <" + name + " value=\"" + *text +
+                                  "\"/>: expected a time in seconds (SUMO time)");
+    return t;
+  };
+  in.begin = time("begin").value_or(0.0);
+  in.end = time("end");
+  if (const auto port = option("remote-port")) in.remote_port = *port;
   return in;
 }
 
@@ -112,10 +180,12 @@ void IndexFile(const std::string& file, const std::string& what, RouteFileIndex*
     if (tag == "poly" || tag == "poi") ++unseen[std::string(tag)];
     if (id == nullptr) return true;
     if (tag == "vehicle" || tag == "trip") {
-      index->vehicles.push_back({id, Number(e.Attribute("depart")).value_or(0.0), file});
+      const auto depart = Number(e.Attribute("depart"));
+      index->vehicles.push_back({id, depart.value_or(0.0), depart.has_value(), file});
     } else if (tag == "flow") {
       const double begin = Number(e.Attribute("begin")).value_or(0.0);
-      index->flows.push_back({id, FlowMembers(e, begin), begin, file});
+      index->flows.push_back(
+          {id, FlowMembers(e, begin), begin, Number(e.Attribute("end")), FlowPeriod(e), file});
     } else if (NamesOther(tag)) {
       index->others.emplace(id, std::string(tag));
       if (tag == "vType" || tag == "vTypeDistribution") index->types.insert(id);
@@ -164,6 +234,8 @@ std::optional<std::string> VehicleIdProblem(const RouteFileIndex& index, const s
     for (const auto& f : index.flows) {
       if (f.id != flow) continue;
       const long k = std::strtol(id.c_str() + dot + 1, nullptr, 10);
+      if (f.members && *f.members == 0)
+        return "is no member of flow " + Quote(flow) + ", which creates no vehicle";
       if (f.members && k >= *f.members)
         return "is no member of flow " + Quote(flow) + ", which creates " +
                std::to_string(*f.members) + " vehicle(s): " + Quote(flow + ".0") + " to " +
@@ -174,6 +246,24 @@ std::optional<std::string> VehicleIdProblem(const RouteFileIndex& index, const s
   if (const auto it = index.others.find(id); it != index.others.end())
     return "is a <" + it->second + ">, not a vehicle";
   return "is no vehicle, trip or flow member of the route files";
+}
+
+std::optional<FileDeparture> DepartureOf(const RouteFileIndex& index, const std::string& id) {
+  for (const auto& v : index.vehicles)
+    if (v.id == id) {
+      if (!v.timed) return std::nullopt;
+      FileDeparture d;
+      d.depart = v.depart;
+      return d;
+    }
+  const auto dot = id.rfind('.');
+  if (dot == std::string::npos) return std::nullopt;
+  for (const auto& f : index.flows) {
+    if (f.id != id.substr(0, dot) || !f.period) continue;
+    const long k = std::strtol(id.c_str() + dot + 1, nullptr, 10);
+    return FileDeparture{f.begin, f.period, k, f.end};
+  }
+  return std::nullopt;
 }
 
 std::string ExampleVehicleIds(const RouteFileIndex& index, std::size_t n) {

@@ -11,9 +11,11 @@
 
 #include <libsumo/libsumo.h>
 
+#include "auto_ego_run.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/sim/conversions.hpp"
+#include "dualgrid/sim/random_trips.hpp"
 #include "dualgrid/sim/sumo_additional.hpp"
 #include "dualgrid/sim/xml_scan.hpp"
 
@@ -59,7 +61,8 @@ void CheckNetworkFile(const std::filesystem::path& path) {
 
 }  // namespace
 
-NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor,
+                                  const std::filesystem::path& package_dir) {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("DUALGRID_NETWORK_DIR"); env && *env)
     return {env, "DUALGRID_NETWORK_DIR"};
@@ -70,13 +73,12 @@ NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor) {
     const fs::path installed = self.parent_path().parent_path() / "share" / "dualgrid" / "networks";
     if (fs::is_directory(installed, ec)) return {installed, "installed"};
   }
+  if (!package_dir.empty()) return {package_dir, "package"};
 #ifdef DUALGRID_NETWORK_DIR
   if (fs::is_directory(DUALGRID_NETWORK_DIR, ec)) return {DUALGRID_NETWORK_DIR, "build tree"};
 #endif
   return {"networks", "none"};
 }
-
-std::filesystem::path DefaultNetworkDir() { return FindNetworkDir().dir; }
 
 bool IsNetworkPath(const std::string& network) {
   return network.ends_with(".xml") || network.ends_with(".xml.gz") ||
@@ -152,9 +154,11 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
     std::string xml;
   };
   std::vector<Entry> entries;
-  auto vehicle_xml = [](const VehicleSpec& v) {
+  // The scenario's times count from its begin (run time); SUMO's route file is on SUMO's clock.
+  const double t0 = spec.begin;
+  auto vehicle_xml = [t0](const VehicleSpec& v) {
     return "  <vehicle id=\"" + XmlEscape(v.id) + "\" type=\"" + XmlEscape(v.type) + "\" route=\"" +
-           XmlEscape(v.route) + "\" depart=\"" + Num(v.depart) + "\" departLane=\"" +
+           XmlEscape(v.route) + "\" depart=\"" + Num(t0 + v.depart) + "\" departLane=\"" +
            std::to_string(v.lane) + "\" departPos=\"" + Num(v.position) + "\" departSpeed=\"" +
            Num(v.speed) + "\"/>\n";
   };
@@ -163,8 +167,8 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
   for (const FlowSpec& f : spec.flows) {
     entries.push_back(
         {f.begin, "  <flow id=\"" + XmlEscape(f.id) + "\" type=\"" + XmlEscape(f.type) +
-                      "\" route=\"" + XmlEscape(f.route) + "\" begin=\"" + Num(f.begin) +
-                      "\" end=\"" + Num(f.end) + "\" period=\"" + Num(f.period) +
+                      "\" route=\"" + XmlEscape(f.route) + "\" begin=\"" + Num(t0 + f.begin) +
+                      "\" end=\"" + Num(t0 + f.end) + "\" period=\"" + Num(f.period) +
                       "\" departLane=\"" + XmlEscape(f.lane) + "\" departPos=\"" + Num(f.position) +
                       "\" departSpeed=\"" + Num(0.5 * (f.speed_min + f.speed_max)) + "\"/>\n"});
   }
@@ -194,8 +198,10 @@ std::vector<std::string> SumoArgs(const ScenarioSpec& spec,
                                    std::to_string(spec.seed % 2147483647),
                                    "--lanechange.duration",
                                    Num(spec.lane_change_duration),
+                                   "--begin",
+                                   Num(spec.begin),
                                    "--end",
-                                   Num(spec.duration + 1.0),
+                                   Num(spec.begin + spec.duration + 1.0),
                                    "--xml-validation",
                                    "never",
                                    "--no-step-log",
@@ -219,55 +225,22 @@ std::vector<std::string> SumoArgs(const ScenarioSpec& spec,
   return args;
 }
 
-// `ego: {from_routes: auto}` (docs/scenarios.md): a dry run of SUMO over the scenario's duration;
-// the ego is the road vehicle of the user's route files that stays in the run longest (a vehicle
-// that never arrives stays to the end), ties going to the earlier departure; std::nullopt when
-// none departed.
-std::optional<std::string> ChooseAutoEgo(const ScenarioSpec& spec,
-                                         const std::vector<std::string>& args) {
-  libsumo::Simulation::start(args);
-  struct Closer {
-    ~Closer() {
-      try {
-        libsumo::Simulation::close();
-      } catch (...) {  // after a SUMO error close may throw again; that error is reported
-      }
-    }
-  } closer;
-  // The scenario's own vehicles are not the user's: only vehicles of the route files qualify.
-  std::set<std::string> own;
-  for (const auto& v : spec.vehicles) own.insert(v.id);
-  const auto own_flow = [&](const std::string& id) {
-    const std::string flow = id.substr(0, id.rfind('.'));
-    return std::any_of(spec.flows.begin(), spec.flows.end(),
-                       [&](const FlowSpec& f) { return f.id == flow; });
-  };
-  static const std::set<std::string> kOffRoad = {
-      "pedestrian", "wheelchair", "tram",   "rail_urban", "rail",    "rail_electric",
-      "rail_fast",  "ship",       "subway", "cable_car",  "aircraft"};
-  struct Candidate {
-    double depart = 0.0, arrive = 0.0;
-    std::size_t order = 0;
-  };
-  std::map<std::string, Candidate> seen;
-  for (int step = 0; step < spec.StepCount(); ++step) {
-    libsumo::Simulation::step();
-    const double now = libsumo::Simulation::getTime();
-    for (const std::string& id : libsumo::Simulation::getDepartedIDList()) {
-      if (own.count(id) || own_flow(id) || kOffRoad.count(libsumo::Vehicle::getVehicleClass(id)))
-        continue;
-      seen[id] = {now, spec.duration, seen.size()};
-    }
-    for (const std::string& id : libsumo::Simulation::getArrivedIDList())
-      if (auto it = seen.find(id); it != seen.end()) it->second.arrive = now;
-  }
-  // Longest in the run; ties: the earlier departure (order of departure).
-  const auto best = std::max_element(seen.begin(), seen.end(), [](const auto& a, const auto& b) {
-    const double ta = a.second.arrive - a.second.depart, tb = b.second.arrive - b.second.depart;
-    return ta != tb ? ta < tb : a.second.order > b.second.order;
-  });
-  if (best == seen.end()) return std::nullopt;
-  return best->first;
+}  // namespace
+
+std::string RunWindow(const ScenarioSpec& spec) {
+  return "SUMO time [" + Num(spec.begin) + ", " + Num(spec.begin + spec.duration) +
+         "] s (run time [0, " + Num(spec.duration) + "] s)";
+}
+
+namespace {
+
+// Why `auto` found no ego: no road vehicle departed in the run.
+std::string NoAutoEgo(const ScenarioSpec& spec) {
+  return "scenario '" + spec.name +
+         "': ego.from_routes is auto, but no road vehicle of the route files departed within " +
+         RunWindow(spec) +
+         (spec.begin > 0.0 ? "" : "; a scenario that starts later needs `begin` or --begin") +
+         " (vehicles that depart before the begin are skipped, as SUMO skips them)";
 }
 
 }  // namespace
@@ -286,6 +259,9 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
     std::filesystem::create_directories(work_dir);
     const auto routes = work_dir / "routes.rou.xml";
     WriteRouteFile(spec_, routes);
+    // Random traffic (randomTrips.py) when the scenario asks for it, as a route file of its own.
+    if (spec_.random_trips)
+      spec_.route_files.push_back(WriteRandomTrips(network_file, spec_, work_dir).string());
     // The scenario's own vehicles first, then the user's SUMO route files as they are.
     route_files = routes.string();
     for (const std::string& f : spec_.route_files) route_files += "," + f;
@@ -301,12 +277,12 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
   }
   std::sort(spec_.actions.begin(), spec_.actions.end(),
             [](const ActionSpec& a, const ActionSpec& b) { return a.time < b.time; });
-  std::optional<std::string> auto_ego;
   try {
     if (spec_.ego_from_routes && spec_.ego.id == kAutoEgo) {
-      auto_ego = ChooseAutoEgo(spec_, SumoArgs(spec_, network_file, route_files, additional_list,
-                                               work_dir / "sumo_auto_ego.log"));
-      if (auto_ego) spec_.ego.id = *auto_ego;
+      auto_choice_ =
+          ChooseAutoEgo(spec_, SumoArgs(spec_, network_file, route_files, additional_list,
+                                        work_dir / "sumo_auto_ego.log"));
+      if (auto_choice_) spec_.ego.id = auto_choice_->id;
     }
     if (!spec_.ego_from_routes || spec_.ego.id != kAutoEgo)
       libsumo::Simulation::start(
@@ -320,10 +296,7 @@ SumoSimulation::SumoSimulation(const ScenarioSpec& spec, const std::filesystem::
   }
   if (spec_.ego.id == kAutoEgo && spec_.ego_from_routes) {
     g_simulation_alive = false;
-    throw std::invalid_argument("scenario '" + spec_.name +
-                                "': ego.from_routes is auto, but no road vehicle of the route "
-                                "files departed before t=" +
-                                Num(spec_.duration) + " s");
+    throw std::invalid_argument(NoAutoEgo(spec_));
   }
   try {
     CheckAgainstNetwork();
@@ -480,17 +453,21 @@ void SumoSimulation::ApplyDepartures() {
 }
 
 void SumoSimulation::ApplyActions() {
-  const double now = libsumo::Simulation::getTime();
+  const double now = libsumo::Simulation::getTime() - spec_.begin;  // run time
   while (next_action_ < spec_.actions.size() && spec_.actions[next_action_].time <= now + 1e-9) {
     const ActionSpec& a = spec_.actions[next_action_++];
     const std::vector<std::string> ids = libsumo::Vehicle::getIDList();
     if (std::find(ids.begin(), ids.end(), a.vehicle) == ids.end())
-      throw std::runtime_error("scenario '" + spec_.name + "': action at t=" + Num(a.time) +
+      throw std::runtime_error("scenario '" + spec_.name + "': action at run time " + Num(a.time) +
                                " s names vehicle '" + a.vehicle +
                                "', which is not on the road at that time");
     if (a.set_speed) libsumo::Vehicle::setMaxSpeed(a.vehicle, *a.set_speed);
     if (a.change_lane) libsumo::Vehicle::changeLane(a.vehicle, *a.change_lane, a.duration);
   }
+}
+
+std::string SumoSimulation::Clock(double sumo_time) const {
+  return "SUMO time " + Num(sumo_time) + " s (run time " + Num(sumo_time - spec_.begin) + " s)";
 }
 
 bool SumoSimulation::Step() {
@@ -502,19 +479,17 @@ bool SumoSimulation::Step() {
       if (step_ >= spec_.StepCount()) {
         if (frame_.step == 0 && spec_.ego_from_routes)
           throw std::runtime_error("ego '" + spec_.ego.id +
-                                   "' (ego.from_routes) never entered "
-                                   "the network before t=" +
-                                   Num(spec_.duration) +
-                                   " s: is it a vehicle of the route files, departing before "
-                                   "the end (duration counts from SUMO's start)? See " +
+                                   "' (ego.from_routes) never entered the network within " +
+                                   RunWindow(spec_) +
+                                   ": is it a vehicle of the route files that departs in "
+                                   "that window? See " +
                                    log_path_.string());
         if (frame_.step == 0)
-          throw std::runtime_error("ego '" + spec_.ego.id +
-                                   "' never entered the network before t=" + Num(spec_.duration) +
-                                   " s (lane " + std::to_string(spec_.ego.lane) + ", position " +
-                                   Num(spec_.ego.position) + " m of route '" + spec_.ego.route +
-                                   "' blocked or invalid, or departure too late; see " +
-                                   log_path_.string() + ")");
+          throw std::runtime_error(
+              "ego '" + spec_.ego.id + "' never entered the network within " + RunWindow(spec_) +
+              " (lane " + std::to_string(spec_.ego.lane) + ", position " + Num(spec_.ego.position) +
+              " m of route '" + spec_.ego.route +
+              "' blocked or invalid, or departure too late; see " + log_path_.string() + ")");
         return false;
       }
       libsumo::Simulation::step();
@@ -533,7 +508,7 @@ bool SumoSimulation::Step() {
       libsumo::Vehicle::setSpeed(spec_.ego.id, spec_.ego_speed.speed);
     Frame f;
     f.step = step_;
-    f.time = libsumo::Simulation::getTime();
+    f.time = libsumo::Simulation::getTime() - spec_.begin;  // run time
     f.vehicles.reserve(ids.size());
     std::map<std::string, double> yaws;
     for (const std::string& id : ids) {
@@ -548,11 +523,11 @@ bool SumoSimulation::Step() {
     frame_ = std::move(f);
     return true;
   } catch (const libsumo::TraCIException& e) {
-    throw std::runtime_error("SUMO error at t=" + Num(libsumo::Simulation::getTime()) +
-                             " s: " + OneLine(e.what()));
+    throw std::runtime_error("SUMO error at " + Clock(libsumo::Simulation::getTime()) + ": " +
+                             OneLine(e.what()));
   } catch (const libsumo::FatalTraCIError& e) {
-    throw std::runtime_error("SUMO failed at t=" + Num(libsumo::Simulation::getTime()) +
-                             " s: " + OneLine(e.what()));
+    throw std::runtime_error("SUMO failed at " + Clock(libsumo::Simulation::getTime()) + ": " +
+                             OneLine(e.what()));
   }
 }
 

@@ -135,11 +135,11 @@ struct Outcome {
 
 Outcome Run(const cosim::RecordedSequence& seq, const cosim::RecordedSequence& twin_data,
             bool read_ahead, double batch_window = 0.001) {
-  scenario::ScenarioConfig config = recorded::DefaultRecordedConfig();
+  scenario::ScenarioConfig config = cosim::DefaultRecordedConfig();
   config.filter.num_particles = 4000;
   config.filter.num_birth = 400;
   REQUIRE(config.grid.frame == scenario::GridPlacement::Frame::kFollow);
-  const cosim::RecordedOptions o = recorded::FitConfig(seq, batch_window, &config);
+  const cosim::RecordedOptions o = cosim::FitConfig(seq, batch_window, &config);
   cosim::CoSimulation cs(config, {.threads = 2, .read_ahead = read_ahead},
                          [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                            return std::make_unique<LyingSource>(seq, twin_data, o);

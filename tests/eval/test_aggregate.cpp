@@ -139,9 +139,17 @@ TEST_CASE("A single run claims no confidence interval; notes are printed", "[agg
   CHECK(md.find("One seed") != std::string::npos);
   CHECK(md.find("— : not defined") == std::string::npos);  // nothing is blank
   CHECK(md.find("Not scored: cross_1 (17 frames).") != std::string::npos);
-  CHECK(md.find("| objects never tracked | 1.0 |") != std::string::npos);
-  CHECK(md.find("| … of which never seen in the grid | 1.0 |") != std::string::npos);
+  // Counts of one run are whole numbers.
+  CHECK(md.find("| objects scored | 2 |") != std::string::npos);
+  CHECK(md.find("| objects never tracked | 1 |") != std::string::npos);
+  CHECK(md.find("| … of which never seen in the grid | 1 |") != std::string::npos);
   CHECK(t.ToJson().at("notes").size() == 1);
+  // A mean over seeds keeps its decimal.
+  ScenarioMetrics m3 = m;
+  m3.objects_scored = 3;
+  const std::vector<ModeRuns> two = {{"dual", {m, m3}}};
+  CHECK(MakeComparisonTable("x", two).ToMarkdown().find("| objects scored | 2.5 ±") !=
+        std::string::npos);
 }
 
 TEST_CASE("Comparison table misuse", "[aggregate]") {

@@ -1,5 +1,5 @@
-// libFuzzer target for the replay reader (tools/src/recording.cpp on the checked reader,
-// tools/src/read_back.cpp): the input is a recording, index.json and frames.bin separated by the
+// libFuzzer target for the replay reader (outputs/src/recording.cpp on the checked reader,
+// outputs/src/read_back.cpp): the input is a recording, index.json and frames.bin separated by the
 // line "@@frames.bin@@". Every input must either be read (header, then every frame decoded) or be
 // refused with a std::invalid_argument (one line naming the file and the key). Any other
 // exception, a crash, a hang, or a sanitizer report is a bug; each one found becomes a case in
@@ -15,7 +15,7 @@
 #include <string>
 #include <string_view>
 
-#include "recording.hpp"
+#include "dualgrid/outputs/recording.hpp"
 
 namespace {
 
@@ -46,7 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   Write(dir / "replay" / "frames.bin",
         at == std::string_view::npos ? std::string_view() : input.substr(at + kSeparator.size()));
   try {
-    const dualgrid::tools::replay::Reader reader(dir);
+    const dualgrid::outputs::replay::Reader reader(dir);
     const auto& h = reader.header();
     // The reader admits frames of up to 1 GiB (its documented bound); decoding such a frame is
     // allowed, but not useful to a fuzzer with a 2 GB memory limit.

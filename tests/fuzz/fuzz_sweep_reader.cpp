@@ -1,4 +1,4 @@
-// libFuzzer target for the files a sweep and collect read back (tools/src/read_results.cpp on
+// libFuzzer target for the files a sweep and collect read back (outputs/src/read_results.cpp on
 // the checked reader): the input is read as a sweep plan (plan.json), as a result table
 // (table.json) and as a run's summary.json. Each must either be read or be refused with a
 // std::invalid_argument (one line naming the file and the key). Any other exception, a crash, a
@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "read_results.hpp"
+#include "dualgrid/outputs/read_results.hpp"
 
 namespace {
 
@@ -30,7 +30,7 @@ std::filesystem::path RunDir() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  using namespace dualgrid::tools;
+  using namespace dualgrid::outputs;
   try {
     const SweepPlan plan = ParseSweepPlan(ParseJsonText(text, "plan.json"));
     (void)SweepPlanJson(plan);

@@ -258,3 +258,33 @@ check "experiment:bad_edge" 2 "The edge 'no_such_edge' within the route 'east' i
   "$dualgrid" experiment "$S" --set 'routes.east=[east_1, no_such_edge]' --seeds 2 --duration 0.5 \
   --no-figures -q --out "$rb/exp_bad_edge"
 check "cli:frobnicate" 2 "unknown command 'frobnicate'" "$dualgrid" frobnicate --out x
+
+# --- 11. Time of day and OpenDRIVE maps (docs/scenarios.md): a begin after the configuration's
+# end, negative begins, an OpenDRIVE map netconvert rejects (named, with netconvert's first error
+# line), one that is not XML, and one that does not exist. ---
+printf '<configuration>\n  <input>\n    <net-file value="%s"/>\n    <route-files value="ok.rou.xml"/>\n  </input>\n  <time>\n    <begin value="500"/>\n    <end value="100"/>\n  </time>\n</configuration>\n' \
+  "$network_dir/highway.net.xml" >"$work/sumo/late.sumocfg"
+printf 'sumo_config: late.sumocfg\nego: {from_routes: v0}\n' >"$work/sumo/late.yaml"
+check "time:begin_after_end" 2 "key 'sumo_config <begin>' expected < the configuration's end = 100 s (SUMO time)" \
+  "$dualgrid" run "$work/sumo/late.yaml" --no-figures -q --out "$rb/late"
+printf 'sumo_config: late.sumocfg\nbegin: -3\nego: {from_routes: v0}\n' >"$work/sumo/negative.yaml"
+check "time:negative_begin" 2 "key 'begin' expected in [0, 31536000] s (SUMO time), got -3" \
+  "$dualgrid" run "$work/sumo/negative.yaml" --no-figures -q --out "$rb/negative"
+check "time:negative_begin_cli" 2 "--begin" \
+  "$dualgrid" run "$S" --begin -3 --no-figures -q --out "$rb/negative_cli"
+check "time:begin_not_a_time" 2 "key 'begin' expected a number" \
+  "$dualgrid" run "$S" --set begin=noon --no-figures -q --out "$rb/noon"
+export DUALGRID_CACHE_DIR=$work/cache
+python3 "$repo/tests/sim/write_xodr.py" broken "$work/sumo/broken.xodr"
+printf 'network: broken.xodr\nego: {from_routes: auto}\n' >"$work/sumo/broken_map.yaml"
+check "opendrive:rejected" 2 "broken.xodr: netconvert cannot convert this OpenDRIVE map: Error: No nodes loaded." \
+  "$dualgrid" run "$work/sumo/broken_map.yaml" --no-figures -q --out "$rb/broken_map"
+head -c 3000 /dev/urandom >"$work/sumo/noise.xodr"
+printf 'network: noise.xodr\nego: {from_routes: auto}\n' >"$work/sumo/noise_map.yaml"
+check "opendrive:not_xml" 2 "noise.xodr: netconvert cannot convert this OpenDRIVE map: Error:" \
+  "$dualgrid" run "$work/sumo/noise_map.yaml" --no-figures -q --out "$rb/noise_map"
+printf 'network: nowhere.xodr\nego: {from_routes: auto}\n' >"$work/sumo/missing_map.yaml"
+check "opendrive:missing" 2 "nowhere.xodr: OpenDRIVE map not found" \
+  "$dualgrid" run "$work/sumo/missing_map.yaml" --no-figures -q --out "$rb/missing_map"
+[ -e "$work/sumo/broken.net.xml" ] && { failed=$((failed + 1)); echo "FAIL opendrive: a network was written beside the map"; }
+unset DUALGRID_CACHE_DIR

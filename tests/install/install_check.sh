@@ -23,10 +23,13 @@ cmake -S "$consumer" -B "$work/consumer-build" -DCMAKE_PREFIX_PATH="$moved" \
   { cat "$work/consumer-configure.log" >&2; fail "the consumer project did not configure"; }
 cmake --build "$work/consumer-build" -j 2 >"$work/consumer-build.log" 2>&1 ||
   { tail -30 "$work/consumer-build.log" >&2; fail "the consumer project did not build"; }
-out=$("$work/consumer-build/consumer") || fail "the consumer program failed: $out"
+out=$(env -u DUALGRID_NETWORK_DIR "$work/consumer-build/consumer") || fail "the consumer program failed: $out"
 echo "$out"
 grep -q "^filter ok$" <<<"$out" || fail "consumer: no 'filter ok'"
 grep -q "^recorded ok$" <<<"$out" || fail "consumer: no 'recorded ok'"
+grep -q "^networks=$moved/share/dualgrid/networks (package)$" <<<"$out" ||
+  fail "consumer: sim::DefaultNetworkDir() is not the moved package's networks"
+grep -q "^run folder ok$" <<<"$out" || fail "consumer: no 'run folder ok'"
 grep -Eq "^steps=([1-9][0-9]*) of \1$" <<<"$out" || fail "consumer: the run did not reach its duration"
 grep -Eq "^dual objects=[1-9][0-9]* matches=[1-9]" <<<"$out" || fail "consumer: dual scored nothing"
 grep -q "$moved/share/dualgrid/networks" "$work/consumer-build/CMakeCache.txt" "$work/consumer-build/CMakeFiles/consumer.dir/flags.make" ||

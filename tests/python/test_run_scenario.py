@@ -90,5 +90,43 @@ class RunScenarioTest(unittest.TestCase):
             dualgrid.run_scenario("no/such/scenario.yaml")
 
 
+class RunFolderTest(unittest.TestCase):
+    """run_scenario(..., out=DIR) writes the command line's run folder: every file the same bytes,
+    summary.json the same but for its wall-clock time."""
+
+    def test_run_folder_equals_the_cli(self):
+        networks = os.path.join(os.path.dirname(os.environ["DUALGRID_EXE"]), os.pardir, "share",
+                                "dualgrid", "networks")
+        with tempfile.TemporaryDirectory() as tmp:
+            cli, py = os.path.join(tmp, "cli"), os.path.join(tmp, "py")
+            subprocess.run([os.environ["DUALGRID_EXE"], "run", SCENARIO, "--out", cli, "--seed",
+                            str(SEED), "--duration", "4", "--network-dir", networks, "-q",
+                            "--set", "filter.num_particles=20000"], check=True)
+            r = dualgrid.run_scenario(SCENARIO, seed=SEED, duration=4.0, out=py,
+                                      network_dir=networks, threads=1,
+                                      overrides=["filter.num_particles=20000"])
+            self.assertTrue(r["complete"])
+            files = {}
+            for root in (cli, py):
+                files[root] = sorted(os.path.relpath(os.path.join(d, f), root)
+                                     for d, _, names in os.walk(root) for f in names)
+            self.assertEqual(files[cli], files[py])
+            # Not vacuous: the folder has its results, figures and replay.
+            for f in ("metrics.json", "objects.csv", "clusters.csv", "table.md", "config.json",
+                      "scenario.yaml", "figures/tracked_share.png", "replay/index.json"):
+                self.assertIn(f, files[cli])
+            for f in files[cli]:
+                with open(os.path.join(cli, f), "rb") as a, open(os.path.join(py, f), "rb") as b:
+                    ca, cb = a.read(), b.read()
+                if f == "summary.json":
+                    ja, jb = json.loads(ca), json.loads(cb)
+                    self.assertGreater(len(ja["digests"]), 10)
+                    ja.pop("wall_s")
+                    jb.pop("wall_s")
+                    self.assertEqual(ja, jb)
+                elif f != "sumo.log":  # SUMO's own log, dated
+                    self.assertEqual(ca, cb, f)
+
+
 if __name__ == "__main__":
     unittest.main()

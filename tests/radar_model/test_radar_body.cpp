@@ -40,7 +40,7 @@ TEST_CASE("the ego's body hides targets from the corner radars behind it", "[rad
   // A truck in the left lane ahead: front_right (at the front right wheel, looking -45 deg) sees
   // it only through the ego's front (its line of sight runs ~1 m inside the body).
   const auto rig = DefaultRig(kEgoLength, kEgoWidth);
-  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  const RadarModel model(rig, ModelOptions{false, false, true, {}}, 1);
   Scene scene;
   scene.targets.push_back({1, OrientedBox{{10.0, 3.5}, 0.0, 12.0, 2.5}, {25, 0}, 0.0, 20.0});
   EgoMotion ghost;  // no body: the old model
@@ -54,7 +54,7 @@ TEST_CASE("the ego's body hides targets from the corner radars behind it", "[rad
   // The front_left radar, on the truck's side, still sees it.
   CHECK(!model.VisibleScatterers(fl, ego, scene).empty());
   // Occlusion off: the body is transparent too (ModelOptions::occlusion switches every occluder).
-  const RadarModel open(rig, ModelOptions{false, false, false}, 1);
+  const RadarModel open(rig, ModelOptions{false, false, false, {}}, 1);
   CHECK(!open.VisibleScatterers(fr, ego, scene).empty());
 }
 
@@ -64,7 +64,7 @@ TEST_CASE("no visible scatterer's line of sight runs through the ego's body",
   // line of sight at most 5 cm (the model's margin) + 2 mm (the 1 mm walk) inside the body less
   // its 1 mm skin (a line along the surface grazes it).
   const auto rig = DefaultRig(kEgoLength, kEgoWidth);
-  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  const RadarModel model(rig, ModelOptions{false, false, true, {}}, 1);
   EgoMotion ego;
   ego.length = kEgoLength;
   ego.width = kEgoWidth;
@@ -103,7 +103,7 @@ TEST_CASE("a flank seen exactly edge-on hides its far corner", "[radar][body]") 
   // the visible face, simple road seed 1). No ego body here: it would hide this line of sight
   // (along its own flank) as well, and the test is of the edge-on rule alone.
   const auto rig = DefaultRig(kEgoLength, kEgoWidth);
-  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  const RadarModel model(rig, ModelOptions{false, false, true, {}}, 1);
   const EgoMotion ego;
   // The flank offset by +-1 um from the sensors' lines (as rounding puts it in a simulation):
   // edge-on in effect, with the sensor in front of it by a hair on one side.
@@ -134,7 +134,7 @@ namespace {
 // its centre at `range` along sensor `name`'s boresight; noise on, no clutter.
 double CarDetectionRate(const std::string& name, double range, int scans) {
   const auto rig = DefaultRig(kEgoLength, kEgoWidth);
-  const RadarModel model(rig, ModelOptions{true, false, true}, 3);
+  const RadarModel model(rig, ModelOptions{true, false, true, {}}, 3);
   const int s = SensorIndex(rig, name);
   EgoMotion ego;
   ego.length = kEgoLength;
@@ -182,7 +182,7 @@ TEST_CASE("the radar model is rotation invariant", "[radar][body][property]") {
   // it must for roads in any direction. Exact geometry (no noise, no clutter); the grazing cases
   // at the ego's surface used to depend on rounding: seen at 45 deg, not at 0 deg.
   const auto rig = DefaultRig(kEgoLength, kEgoWidth);
-  const RadarModel model(rig, ModelOptions{false, false, true}, 1);
+  const RadarModel model(rig, ModelOptions{false, false, true, {}}, 1);
   const Position ego_at(312.5, -41.0);
   auto build = [&](double deg, EgoMotion* ego, Scene* scene) {
     const Pose2 turn{Position::Zero(), DegToRad(deg)};

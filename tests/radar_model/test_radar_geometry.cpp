@@ -52,7 +52,7 @@ Scene OneTarget(const Position& at, const Velocity& v, double box_yaw) {
   return scene;
 }
 
-const ModelOptions kExact{false, false, true};
+const ModelOptions kExact{false, false, true, {}};
 
 // Checks shared by all geometry cases: frames and eq. (1) velocity are consistent.
 void CheckFrames(const Detection& d, const Sample& s) {
@@ -142,7 +142,7 @@ TEST_CASE("Field of view and range limits hold", "[radar][geometry][property]") 
   const int sensor = GENERATE(range(0, 5));
   const SensorParams& p = rig[sensor];
   const SensorModel window(p);
-  const RadarModel exact(rig, ModelOptions{false, false, false}, 5);
+  const RadarModel exact(rig, ModelOptions{false, false, false, {}}, 5);
   const EgoMotion ego{Pose2{Position(100, -20), 0.7}, Velocity::Zero(), 0.0};
   const Pose2 pose = exact.SensorPose(sensor, ego.pose);
   int inside = 0, outside = 0;
@@ -230,7 +230,7 @@ TEST_CASE("A car behind a truck is hidden; only faces facing the sensor scatter"
   const auto from_car =
       std::count_if(dets.begin(), dets.end(), [](const Detection& d) { return d.source_id == 2; });
   if (hidden) CHECK(from_car == 0);
-  const RadarModel see_through(rig, ModelOptions{false, false, false}, 8);
+  const RadarModel see_through(rig, ModelOptions{false, false, false, {}}, 8);
   const std::vector<Detection> all = see_through.ScanSensor(front, ego, scene, 0);
   CHECK(std::count_if(all.begin(), all.end(), [](const Detection& d) { return d.source_id == 2; }) >
         0);

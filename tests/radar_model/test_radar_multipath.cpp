@@ -177,7 +177,8 @@ TEST_CASE("A ghost vanishes without its reflector, off its extent, or with a leg
   // The sensor -> rail leg: a 6 m x 2 m box at (4, 2.5) crosses every ray to x in [6.4, 9.2] at
   // y = 5 (at x = 4 they are at y = 2.2 ... 3.1), and not the direct rays to the car (y < 0).
   Scene sensor_leg = CarAndRail();
-  sensor_leg.targets.push_back({kWall, OrientedBox{{4.0, 2.5}, 0.0, 6.0, 2.0}, {}, 0.0, 10.0});
+  sensor_leg.targets.push_back(
+      {kWall, OrientedBox{{4.0, 2.5}, 0.0, 6.0, 2.0}, Velocity::Zero(), 0.0, 10.0});
   CHECK(Ghosts(model.VisibleScatterers(0, ego, sensor_leg), kCar).empty());
 
   // The rail -> car leg: a 3 m x 4 m box at (13, 1.5) (y from -0.5 to 3.5) crosses every leg
@@ -185,7 +186,8 @@ TEST_CASE("A ghost vanishes without its reflector, off its extent, or with a leg
   // y = 0.9 ... 2.9; the direct rays to the car pass it at y < -1.9 and the sensor -> rail legs
   // end before x = 9.2.
   Scene object_leg = CarAndRail();
-  object_leg.targets.push_back({kWall, OrientedBox{{13.0, 1.5}, 0.0, 3.0, 4.0}, {}, 0.0, 10.0});
+  object_leg.targets.push_back(
+      {kWall, OrientedBox{{13.0, 1.5}, 0.0, 3.0, 4.0}, Velocity::Zero(), 0.0, 10.0});
   CHECK(Ghosts(model.VisibleScatterers(0, ego, object_leg), kCar).empty());
   // The car's direct returns are still there.
   int direct = 0;

@@ -133,7 +133,7 @@ TEST_CASE("A point-like target is detected at the ROC rate with the formula nois
   Scene scene;
   scene.targets.push_back(
       {7, OrientedBox{range * UnitVector(az), 0.3, 0.05, 0.05}, Velocity::Zero(), 0.0, rcs_dbsm});
-  const RadarModel model({p}, ModelOptions{true, false, true}, 2024);
+  const RadarModel model({p}, ModelOptions{true, false, true, {}}, 2024);
   const EgoMotion ego{};
   const double snr = DbToLinear(snr_db);
   const int n = 4000;
@@ -186,7 +186,7 @@ TEST_CASE("False-alarm count matches cells times rate", "[radar][statistics]") {
                        ((q.max_range_rate - q.min_range_rate) / q.range_rate_resolution);
   CHECK(sensor.ResolutionCellCount() == Approx(cells));
   const double lambda = cells * pfa;
-  const RadarModel model({q}, ModelOptions{true, true, true}, 99);
+  const RadarModel model({q}, ModelOptions{true, true, true, {}}, 99);
   const int scans = 3000;
   Moments count, range;
   for (int step = 0; step < scans; ++step) {
@@ -205,7 +205,7 @@ TEST_CASE("False-alarm count matches cells times rate", "[radar][statistics]") {
   CHECK(std::abs(range.Mean() - 0.5 * (q.min_range + q.max_range)) <
         5.0 * (q.max_range - q.min_range) / std::sqrt(12.0 * range.n));
   // Switched off: none.
-  const RadarModel quiet({q}, ModelOptions{true, false, true}, 99);
+  const RadarModel quiet({q}, ModelOptions{true, false, true, {}}, 99);
   CHECK(quiet.ScanSensor(0, EgoMotion{}, Scene{}, 1).empty());
 }
 

@@ -60,7 +60,7 @@ TEST_CASE("ScenarioSpec validation names the field", "[sim][config]") {
   s.vehicle_types["car"] = {};
   s.routes["r"] = {"e1"};
   s.ego.id = "ego";
-  s.ego.route = "r";
+  s.ego.route = std::string("r");
   std::string error;
   REQUIRE(s.IsValid(&error));
 
@@ -88,7 +88,11 @@ TEST_CASE("ScenarioSpec validation names the field", "[sim][config]") {
   b.flows.push_back({"f", "car", "r", 10.0, 5.0});
   expect(b, "traffic.flows[0].end");
   b = s;
-  b.actions.push_back({1.0, "ghost", 20.0});
+  ActionSpec ghost;
+  ghost.time = 1.0;
+  ghost.vehicle = "ghost";
+  ghost.set_speed = 20.0;
+  b.actions.push_back(ghost);
   expect(b, "actions[0].vehicle");
   b = s;
   b.guard_rails.push_back({"g", {Position(0, 0)}});

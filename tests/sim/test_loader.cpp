@@ -93,7 +93,12 @@ TEST_CASE("Malformed scenarios are rejected naming the key and the expectation",
   };
   const Case c = GENERATE(values<Case>({
       {"duration: 5.0", "duration: five", "'duration'", "expected a number"},
-      {"duration: 5.0", "duration: -5", "'duration'", "expected in (0, 3600] s, got -5"},
+      {"duration: 5.0", "duration: -5", "'duration'",
+       "expected in (0, 86400] s (run time), got -5"},
+      {"duration: 5.0", "duration: 86400.5", "'duration'", "expected in (0, 86400] s"},
+      {"duration: 5.0", "duration: 5.0\nbegin: -1", "'begin'",
+       "expected in [0, 31536000] s (SUMO time), got -1"},
+      {"duration: 5.0", "duration: 5.0\nbegin: noon", "'begin'", "expected a number"},
       {"duration: 5.0", "duraton: 5.0", "'duraton'", "not a known setting"},
       {"network: highway\n", "", "'network'", "required"},
       {"lane: 1,", "lane: one,", "'ego.lane'", "expected an integer"},
@@ -284,4 +289,29 @@ TEST_CASE("grid frame and placement keys", "[loader][frame]") {
       Write("frame2.yaml", std::string(kValid) + "filter: {ahead: 250, length_x: 300}\n")));
   CHECK_NOTHROW(LoadScenario(
       Write("frame3.yaml", std::string(kValid) + "filter: {length_x: 300, ahead: 250}\n")));
+}
+
+TEST_CASE("begin: the run's start on SUMO's clock, and a day-long duration", "[loader][begin]") {
+  auto c = LoadScenario(Write("day.yaml", Replace(kValid, "duration: 5.0", "duration: 86400")));
+  CHECK(c.sim.duration == 86400.0);  // a day of simulated traffic is accepted
+  CHECK(c.sim.begin == 0.0);
+  CHECK(c.sim.begin_source == "default");
+  c = LoadScenario(
+      Write("begin.yaml", Replace(kValid, "duration: 5.0", "duration: 5.0\nbegin: 25200")));
+  CHECK(c.sim.begin == 25200.0);
+  CHECK(c.sim.begin_source == "scenario");
+  // config.json records it beside the duration that counts from it.
+  const nlohmann::json j = scenario::ConfigToJson(c);
+  CHECK(j.at("begin_s") == 25200.0);
+  CHECK(j.at("begin_source") == "scenario");
+}
+
+TEST_CASE("the auto rule's view is the grid as the filter places it", "[loader][begin]") {
+  auto c = LoadScenario(
+      Write("view.yaml",
+            std::string(kValid) + "filter: {length_x: 120, width_y: 30, ahead: 90, left: 10}\n"));
+  CHECK(c.sim.auto_ego_view.ahead == Approx(90));
+  CHECK(c.sim.auto_ego_view.behind == Approx(30));
+  CHECK(c.sim.auto_ego_view.left == Approx(10));
+  CHECK(c.sim.auto_ego_view.right == Approx(20));
 }

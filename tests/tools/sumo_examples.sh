@@ -2,8 +2,9 @@
 # SUMO's own example configurations (Debian's sumo-tools: tools/game/*.sumocfg and the RealWorld
 # scenarios of sumolib), run as they are (docs/scenarios.md, "SUMO's own examples"): every one
 # that `sumo -c` itself runs for 30 s must also run in dualgrid for 30 s with
-# `ego: {from_routes: auto}`, exit 0 with a complete summary.json, and write nothing beside the
-# configuration's files. The examples are copied first: SUMO's own run writes its outputs
+# `ego: {from_routes: auto}` from the configuration's own begin, exit 0 with a complete
+# summary.json, score objects where two vehicles share the road (or say that nothing can be
+# scored), and write nothing beside the configuration's files. The examples are copied first: SUMO's own run writes its outputs
 # (tripinfos.xml, ...) beside them.
 # Usage: sumo_examples.sh DUALGRID [--table]   (--table: print D and D_v per mode as Markdown)
 # A configuration whose files define no vehicle at all (persons only: tools/game/hiking) has
@@ -58,6 +59,20 @@ while IFS= read -r cfg; do
     diff <(echo "$before") <(listing "$dir") | head -n 5
     continue
   fi
+  # Where two vehicles share the road (the auto ego had another in its grid for 5 s or more),
+  # objects are scored; a scene with no traffic near any vehicle says so in a warning.
+  share=$(python3 -c "import json,sys; c=json.load(open(sys.argv[1]))['ego_choice']; print(1 if c['seen_s'] >= 5 else 0)" "$out/summary.json")
+  scored=$(python3 -c "import json,sys; t=json.load(open(sys.argv[1])); print(int([m for m in t['metrics'] if m['key']=='objects_scored'][0]['values']['dual']['mean']))" "$out/table.json")
+  if [ "$share" -eq 1 ] && [ "$scored" -eq 0 ]; then
+    failed=$((failed + 1))
+    echo "FAIL $name: vehicles share the road, but nothing was scored"
+    continue
+  fi
+  if [ "$share" -eq 0 ] && [ "$scored" -eq 0 ] && ! grep -q "nothing can be scored" "$work/run.log"; then
+    failed=$((failed + 1))
+    echo "FAIL $name: nothing scored and nothing said"
+    continue
+  fi
   passed=$((passed + 1))
   echo "ok $name: ego $(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['ego'])" "$out/summary.json")"
   [ -n "$table" ] && rows+=("$(python3 - "$out" "$name" <<'PY'
@@ -70,13 +85,14 @@ def cell(key):
     return " / ".join("-" if vals[key][m]["mean"] is None else f'{vals[key][m]["mean"]:.0f}'
                       for m in ("position", "velocity", "dual"))
 scored = vals["objects_scored"]["dual"]["mean"]
-print(f'| `{name}` | `{s["ego"]}` | {s["ego_departed_s"]:.1f} | {scored:.0f} | {cell("D")} | {cell("D_v")} |')
+c = s["ego_choice"]
+print(f'| `{name}` | {s["begin_s"]:.0f} | `{s["ego"]}` | {s["ego_departed_s"]:.1f} | {c["seen_s"]:.1f} | {scored:.0f} | {cell("D")} | {cell("D_v")} |')
 PY
 )")
 done < <(find "$work/game" "$work/RealWorld" \( -name '*.sumocfg' -o -name '*.sumo.cfg' \) | sort)
 if [ -n "$table" ]; then
-  echo "| configuration | ego (auto) | departs [s] | objects scored | D [%] (position / velocity / dual) | D_v [%] |"
-  echo "|---|---|---:|---:|---|---|"
+  echo "| configuration | begin [s] | ego (auto) | departs [s] | traffic in its grid [s] | objects scored | D [%] (position / velocity / dual) | D_v [%] |"
+  echo "|---|---:|---|---:|---:|---:|---|---|"
   printf '%s\n' "${rows[@]}"
 fi
 echo "SUMO examples: $passed ran, $failed failed, $no_vehicle without a vehicle, $refused refused by sumo itself"

@@ -3,10 +3,10 @@
 
 #include <stdexcept>
 
-#include "../../tools/src/sweep_spec.hpp"
+#include "dualgrid/scenario/sweep_spec.hpp"
 
-using dualgrid::tools::ParseSweepAxis;
-using dualgrid::tools::SweepSettings;
+using dualgrid::scenario::ParseSweepAxis;
+using dualgrid::scenario::SweepSettings;
 
 TEST_CASE("sweep lists and ranges expand in order, exactly printed", "[sweep]") {
   auto a = ParseSweepAxis("tangential.angle=0:15:90");

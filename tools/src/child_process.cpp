@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "read_results.hpp"
+#include "dualgrid/outputs/read_results.hpp"
 #include "signals.hpp"
 
 namespace dualgrid::tools {
@@ -159,7 +159,7 @@ ChildPool::~ChildPool() {
   }
 }
 
-bool RunComplete(const std::filesystem::path& dir) { return ReadRunState(dir).complete; }
+bool RunComplete(const std::filesystem::path& dir) { return outputs::ReadRunState(dir).complete; }
 
 std::string LastLine(const std::filesystem::path& p) {
   std::ifstream in(p);

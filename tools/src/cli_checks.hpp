@@ -18,7 +18,7 @@ inline constexpr int kMaxSeeds = 10000;
 /// counts exhaust the stack space of the thread pool.
 inline constexpr int kMaxThreadsPerCore = 4;
 /// Longest simulated duration [s] accepted on the command line (as in a scenario file).
-inline constexpr double kMaxDuration = 3600.0;
+inline constexpr double kMaxDuration = 86400.0;
 
 /// The machine's cores (at least 1).
 int Cores();

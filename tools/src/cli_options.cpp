@@ -1,6 +1,21 @@
 #include "cli_options.hpp"
 
+#include "dualgrid/outputs/run_config.hpp"
+#include "dualgrid/sim/scenario.hpp"
+
 namespace dualgrid::tools {
+
+scenario::ScenarioConfig LoadConfig(const RunOptions& o) {
+  return outputs::LoadRunConfig(o.scenario, o.sets, o.seed, o.duration, o.begin);
+}
+
+outputs::RunFolderOptions FilterRunOptions::FolderOptions() const {
+  outputs::RunFolderOptions f = folder;
+  f.out = run.out;
+  f.network_dir = run.network_dir;
+  f.quiet = run.quiet;
+  return f;
+}
 
 void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bool with_seed) {
   cmd->add_option("scenario", o->scenario, "Scenario file (e.g. scenarios/highway.yaml)")
@@ -13,6 +28,10 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
   cmd->add_option("--duration", o->duration,
                   "Simulated time [s] (default: the scenario's `duration`)")
       ->check(Number(0.0, kMaxDuration, true));
+  cmd->add_option("--begin", o->begin,
+                  "SUMO time [s] at which the run begins (default: the scenario's `begin`, else "
+                  "its sumo_config's <begin>, else 0); --duration counts from it")
+      ->check(Number(0.0, sim::kMaxBegin, false));
   Opt(cmd, "--network-dir", &o->network_dir,
       "Folder of the built networks named in scenarios (`network: highway`)")
       ->check(CLI::ExistingDirectory);
@@ -38,28 +57,28 @@ void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures) {
                   "Weight modes to run side by side, comma-separated (default: all three)")
       ->delimiter(',')
       ->check(CLI::IsMember({"position", "velocity", "dual"}));
-  cmd->add_option("--snapshots", o->snapshots,
+  cmd->add_option("--snapshots", o->folder.snapshots,
                   "Times [s] of the grid pictures, comma-separated (default: the scenario's "
                   "`evaluation.snapshot_times`, else 1/4, 1/2, 3/4 of the run)")
       ->delimiter(',')
       ->check(Number(0.0, kMaxDuration, true));
   cmd->add_flag("--no-figures", *no_figures, "Skip the pictures (metrics and tables only)");
-  cmd->add_option("--figure-formats", o->figure_formats,
+  cmd->add_option("--figure-formats", o->folder.figure_formats,
                   "Formats of every figure, comma-separated: png (raster), svg, pdf (vectors) "
                   "(default: all three)")
       ->delimiter(',')
       ->check(CLI::IsMember({"png", "svg", "pdf"}));
-  AddCaptionOption(cmd, &o->figure_captions);
+  AddCaptionOption(cmd, &o->folder.figure_captions);
   cmd->add_flag_callback(
-      "--write-detections", [o] { o->detections = "csv"; }, "Same as --detections csv");
-  Opt(cmd, "--detections", &o->detections,
+      "--write-detections", [o] { o->folder.detections = "csv"; }, "Same as --detections csv");
+  Opt(cmd, "--detections", &o->folder.detections,
       "Write the radar detections: none, csv, csv.gz (gzip, about 3.5x smaller), or exact (17 "
       "digits and scans.csv: the input of `dualgrid filter` and `dualgrid export`)")
       ->check(DetectionFormat());
-  cmd->add_flag("--write-particles", o->write_particles,
+  cmd->add_flag("--write-particles", o->folder.write_particles,
                 "Write every particle beside each grid picture (figures/particles_*.csv, several "
                 "MB each)");
-  cmd->add_flag("--check-invariants", o->check_invariants,
+  cmd->add_flag("--check-invariants", o->folder.check_invariants,
                 "Check the filters' invariants every step and sample the resident memory (soak "
                 "tests; docs/reliability.md)");
   cmd->add_option("--threads", o->threads,

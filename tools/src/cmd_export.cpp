@@ -6,9 +6,11 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
-#include "output.hpp"
 
 namespace dualgrid::tools {
 
@@ -23,7 +25,7 @@ struct ExportOptions {
 };
 
 int RunExport(const ExportOptions& o) {
-  cosim::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
+  recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
   seq.name = o.sequence;
   PrepareOutputFolder(o.out);
   // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end.

@@ -6,9 +6,8 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/outputs/run.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
-#include "output.hpp"
-#include "run_loop.hpp"
 
 namespace dualgrid::tools {
 
@@ -27,7 +26,7 @@ scenario::ScenarioConfig RecordedConfig(const FilterRunOptions& o) {
   if (o.run.scenario.empty()) {
     if (!o.run.sets.empty())
       throw std::invalid_argument("--set: needs --scenario FILE (the keys it overrides)");
-    scenario::ScenarioConfig c = recorded::DefaultRecordedConfig();
+    scenario::ScenarioConfig c = cosim::DefaultRecordedConfig();
     if (o.run.seed) c.sim.seed = *o.run.seed;
     return c;
   }
@@ -38,44 +37,18 @@ scenario::ScenarioConfig RecordedConfig(const FilterRunOptions& o) {
 
 }  // namespace
 
-std::vector<std::string> RecordedNotes(const RecordedRun& r, const std::vector<std::string>& modes,
-                                       const std::vector<eval::ScenarioMetrics>& metrics) {
-  std::vector<std::string> notes;
-  if (!r.labels) {
-    notes.push_back(
-        "Recorded data without labels (label_id): no point-level scores and no tracks, so D, "
-        "D_v and the cell scores are empty; the grids, clusters and figures are complete.");
-  }
-  for (std::size_t m = 0; m < modes.size() && r.labels; ++m) {
-    const auto& p = metrics[m].points;
-    if (!p) continue;
-    auto f = [](const std::optional<double>& v) { return v ? FormatFixed(*v, 3) : "—"; };
-    notes.push_back("Point-level dynamic classification, " + modes[m] + ": precision " +
-                    f(p->precision) + ", recall " + f(p->recall) + ", F1 " + f(p->f1) + " (" +
-                    std::to_string(p->true_positives) + " TP, " +
-                    std::to_string(p->false_positives) + " FP, " +
-                    std::to_string(p->false_negatives) + " FN over " + std::to_string(p->frames) +
-                    " cycles; D and D_v per track_id against "
-                    "boxes estimated from the tracks' points).");
-  }
-  if (r.skipped_points > 0)
-    notes.push_back(std::to_string(r.skipped_points) +
-                    " detection(s) skipped: NaN position, azimuth, range or velocity.");
-  return notes;
-}
-
 int RunFilterCommand(const FilterInputOptions& o) {
   const std::vector<filter::WeightMode> modes = ParseModes(o.run.modes);
   scenario::ScenarioConfig config = RecordedConfig(o.run);
   const recorded::RecordedInput in = recorded::ReadRecordedInput(o.input, o.sensors);
   const cosim::RecordedSequence& seq = in.sequence;
-  const cosim::RecordedOptions ropts = recorded::FitConfig(seq, o.batch_window, &config);
+  const cosim::RecordedOptions ropts = cosim::FitConfig(seq, o.batch_window, &config);
   const cosim::RecordedSource probe(seq, ropts);
   cosim::CoSimulation cosim(config, {modes, o.run.threads},
                             [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
                               return std::make_unique<cosim::RecordedSource>(seq, ropts);
                             });
-  RecordedRun r;
+  outputs::RecordedRun r;
   r.labels = seq.has_labels;
   r.skipped_points = seq.skipped_points;
   std::vector<std::string> sensors;
@@ -94,7 +67,7 @@ int RunFilterCommand(const FilterInputOptions& o) {
              {"tracks", seq.track_names.size()},
              {"sensors", sensors},
              {"filter_cycle_s", config.filter.cycle}};
-  return RunLoop(cosim, config, o.run, &r);
+  return WriteRunFolderAndReport(cosim, config, o.run.FolderOptions(), &r);
 }
 
 Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
@@ -132,11 +105,12 @@ Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
   cmd->add_flag("--quiet,-q", o->run.run.quiet, "No progress or summary output");
   AddFilterOptions(cmd, &o->run, no_figures.get());
   cmd->add_flag("--no-record", *no_record, "Do not record the replay frames (RUN_DIR/replay/)");
-  cmd->add_flag("--viewer", o->run.viewer, "Also write the interactive viewer (replay.html)");
+  cmd->add_flag("--viewer", o->run.folder.viewer,
+                "Also write the interactive viewer (replay.html)");
   return {cmd, [o, no_figures, no_record] {
-            o->run.figures = !*no_figures;
-            o->run.record = o->run.figures && !*no_record;
-            if (o->run.viewer && !o->run.record)
+            o->run.folder.figures = !*no_figures;
+            o->run.folder.record = o->run.folder.figures && !*no_record;
+            if (o->run.folder.viewer && !o->run.folder.record)
               throw std::invalid_argument("--viewer needs the recording: drop --no-record");
             return RunFilterCommand(*o);
           }};

@@ -3,9 +3,12 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
-#include "figures.hpp"
-#include "output.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/figures.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 
 namespace dualgrid::tools {
 

@@ -20,17 +20,25 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/eval/aggregate.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/figures.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/read_results.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/scenario/sweep_spec.hpp"
 #include "dualgrid/viz/charts.hpp"
 #include "exit_codes.hpp"
-#include "figures.hpp"
-#include "output.hpp"
 #include "progress.hpp"
-#include "read_results.hpp"
 #include "signals.hpp"
-#include "sweep_spec.hpp"
 
 namespace dualgrid::tools {
+
+using scenario::ParseNumber;
+using scenario::ParseSweepAxis;
+using scenario::SweepAxis;
+using scenario::SweepSettings;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -173,8 +181,11 @@ std::string ShellQuote(const std::string& s) {
 
 }  // namespace
 
-int RunSweep(const SweepOptions& o) {
-  if (o.sets.empty()) throw std::invalid_argument("--set: give at least one KEY=LIST to sweep");
+namespace {
+
+// The axes of --set, checked: no key twice, generator keys only for the generator, and the
+// product of settings (and runs) within bounds, counted before anything is built.
+std::vector<SweepAxis> SweepAxes(const SweepOptions& o) {
   std::vector<SweepAxis> axes;
   for (const auto& s : o.sets) {
     SweepAxis a = ParseSweepAxis(s);
@@ -190,8 +201,8 @@ int RunSweep(const SweepOptions& o) {
     if (!generator && a.key.rfind("tangential.", 0) == 0)
       throw std::invalid_argument("--set " + a.key + ": generator keys need the scenario '" +
                                   std::string(kGenerator) + "'");
-  // Counted before anything is built: a product of a million settings is refused at once, not
-  // after minutes of validation (or an allocation failure).
+  // A product of a million settings is refused at once, not after minutes of validation (or an
+  // allocation failure).
   std::size_t count = 1;
   std::string shape;
   for (const auto& a : axes) {
@@ -207,145 +218,150 @@ int RunSweep(const SweepOptions& o) {
     throw std::invalid_argument("--set, --seeds: " + std::to_string(count) + " settings x " +
                                 std::to_string(o.seeds) + " seeds, expected at most " +
                                 std::to_string(kMaxSweepRuns) + " runs");
-  const auto settings = SweepSettings(axes);
-  const fs::path out = fs::absolute(o.out);
-  // Resumable: an earlier sweep folder is kept (its finished runs are skipped), but only if it
-  // was a sweep of the same plan.
+  return axes;
+}
+
+// The plan without settings and runs; the folder `out` made ready for it. Resumable: an earlier
+// sweep folder is kept (its finished runs are skipped), but only if it was a sweep of this plan.
+SweepPlan OpenSweep(const SweepOptions& o, const std::vector<SweepAxis>& axes,
+                    const fs::path& out) {
   SweepPlan plan;
-  plan.scenario = generator ? std::string(kGenerator) : fs::absolute(o.scenario).string();
+  plan.scenario =
+      o.scenario == kGenerator ? std::string(kGenerator) : fs::absolute(o.scenario).string();
   for (const auto& a : axes) plan.axes.push_back({a.key, a.values});
   plan.seeds = o.seeds;
   plan.first_seed = o.first_seed;
   plan.modes = o.modes;
   plan.duration = o.duration;
   const fs::path plan_file = out / "plan.json";
-  if (fs::exists(plan_file)) {
-    SweepPlan old;
-    try {
-      old = ReadSweepPlan(plan_file);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string(e.what()) +
-                                  " (an earlier sweep's plan; use a new --out or remove it)");
-    }
-    if (SweepPlanIdentity(old) != SweepPlanIdentity(plan))
-      throw std::invalid_argument(out.string() +
-                                  " holds a sweep of another plan (plan.json differs); use a new "
-                                  "--out or remove it");
-  } else {
+  if (!fs::exists(plan_file)) {
     PrepareOutputFolder(out);
+    return plan;
   }
+  SweepPlan old;
+  try {
+    old = ReadSweepPlan(plan_file);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(e.what()) +
+                                " (an earlier sweep's plan; use a new --out or remove it)");
+  }
+  if (SweepPlanIdentity(old) != SweepPlanIdentity(plan))
+    throw std::invalid_argument(out.string() +
+                                " holds a sweep of another plan (plan.json differs); use a new "
+                                "--out or remove it");
+  return plan;
+}
 
-  // Scenarios and run commands; every setting is validated before anything runs (a stop signal
-  // ends the validation at once: nothing has run).
-  std::ostringstream list;
-  std::vector<std::pair<std::vector<std::string>, fs::path>> runs;  // args, folder
-  Progress checking("sweep: checking settings", static_cast<int>(settings.size()), !o.quiet);
-  for (std::size_t si = 0; si < settings.size(); ++si) {
-    if (StopSignal()) return StopExitCode();
-    checking.Update(static_cast<int>(si));
-    const auto& values = settings[si];
-    char id[24];
-    std::snprintf(id, sizeof id, "s%03zu", si + 1);
-    const std::string label = SettingLabel(axes, values);
-    const fs::path generated = fs::path("scenarios") / (std::string(id) + ".yaml");
-    const fs::path scenario = generator ? out / generated : fs::absolute(o.scenario);
-    std::vector<std::string> sets;
-    TangentialOptions gen;
-    gen.kind = "aspect";
-    gen.quiet = true;
-    for (std::size_t k = 0; k < axes.size(); ++k) {
-      if (axes[k].key.rfind("tangential.", 0) == 0)
-        SetGeneratorOption(&gen, axes[k].key.substr(11), values[k]);
-      else
-        sets.push_back(axes[k].key + "=" + values[k]);
-    }
-    try {
-      if (generator) {
-        gen.out = scenario;
-        RunTangential(gen);
-      }
-      std::vector<scenario::Override> overrides;
-      for (const auto& s : sets) overrides.push_back(scenario::ParseOverride(s));
-      scenario::LoadScenario(scenario, overrides);
-    } catch (const std::exception& e) {
-      throw std::invalid_argument("setting " + std::string(id) + " (" + label + "): " + e.what());
-    }
-    // A generated scenario is named relative to the sweep folder: a copied folder uses its own.
-    plan.settings.push_back(
-        {id, values, label, generator ? generated.string() : scenario.string()});
-    for (int k = 0; k < o.seeds; ++k) {
-      const std::uint64_t seed = o.first_seed + k;
-      const fs::path folder = RunFolder(out, id, seed);
-      std::vector<std::string> args = {o.executable,
-                                       "run",
-                                       scenario.string(),
-                                       "--out",
-                                       folder.string(),
-                                       "--seed",
-                                       std::to_string(seed),
-                                       "-q",
-                                       "--no-figures",
-                                       "--threads",
-                                       "1",
-                                       "--network-dir",
-                                       o.network_dir.string()};
-      std::string modes;
-      for (const auto& m : o.modes) modes += (modes.empty() ? "" : ",") + m;
-      args.insert(args.end(), {"--modes", modes});
-      if (o.duration) args.insert(args.end(), {"--duration", Exact(*o.duration)});
-      for (const auto& s : sets) args.insert(args.end(), {"--set", s});
-      std::string line;
-      for (const auto& a : args) line += (line.empty() ? "" : " ") + ShellQuote(a);
-      list << line << " > " << ShellQuote(folder.string() + ".log") << " 2>&1\n";
-      plan.runs.push_back({id, seed});
-      runs.emplace_back(std::move(args), folder);
-    }
-  }
-  checking.Finish();
-  // Every setting is valid: now the run folders' parents (logs sit beside the folders, and
-  // runs.txt redirects into them).
-  for (const auto& run : runs) fs::create_directories(run.second.parent_path());
-  WriteTextFile(plan_file, SweepPlanJson(plan).dump(2) + "\n");
-  WriteTextFile(out / "runs.txt", list.str());
+// A run of the sweep: its command and its folder.
+using SweepRun = std::pair<std::vector<std::string>, fs::path>;
 
-  if (o.emit == "slurm") {
-    std::ostringstream sh;
-    sh << "#!/bin/bash\n# Slurm job array of the sweep in " << out.string()
-       << ": one task per line of runs.txt (docs/stress.md).\n"
-       << "#SBATCH --job-name=dualgrid-sweep\n#SBATCH --array=1-" << runs.size() << "\n"
-       << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n#SBATCH --mem=2G\n"
-       << "#SBATCH --time=02:00:00\n#SBATCH --output=" << (out / "slurm").string()
-       << "/task_%a.out\nexport OMP_NUM_THREADS=1\n"
-       << "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " << ShellQuote((out / "runs.txt").string())
-       << ")\n[ -n \"$line\" ] || { echo \"no run $SLURM_ARRAY_TASK_ID\" >&2; exit 2; }\n"
-       << "eval \"$line\"\n";
-    fs::create_directories(out / "slurm");
-    WriteTextFile(out / "slurm.sh", sh.str());
-    std::cout << "wrote " << (out / "slurm.sh").string() << " (" << runs.size()
-              << " tasks); submit: sbatch " << (out / "slurm.sh").string()
-              << "; then: dualgrid collect " << out.string() << "\n";
-    return kExitOk;
-  }
-  if (o.emit == "list") {
-    std::cout << "wrote " << (out / "runs.txt").string() << " (" << runs.size()
-              << " runs); e.g. parallel -j " << Cores() << " < " << (out / "runs.txt").string()
-              << "; then: dualgrid collect " << out.string() << "\n";
-    return kExitOk;
-  }
+// The `dualgrid run` command of one setting and seed.
+std::vector<std::string> SweepRunArgs(const SweepOptions& o, const fs::path& scenario,
+                                      const fs::path& folder, std::uint64_t seed,
+                                      const std::vector<std::string>& sets) {
+  std::vector<std::string> args = {o.executable,
+                                   "run",
+                                   scenario.string(),
+                                   "--out",
+                                   folder.string(),
+                                   "--seed",
+                                   std::to_string(seed),
+                                   "-q",
+                                   "--no-figures",
+                                   "--threads",
+                                   "1",
+                                   "--network-dir",
+                                   o.network_dir.string()};
+  std::string modes;
+  for (const auto& m : o.modes) modes += (modes.empty() ? "" : ",") + m;
+  args.insert(args.end(), {"--modes", modes});
+  if (o.duration) args.insert(args.end(), {"--duration", Exact(*o.duration)});
+  for (const auto& s : sets) args.insert(args.end(), {"--set", s});
+  return args;
+}
 
-  // Local: `jobs` runs at a time, one OpenMP thread each (processes x threads <= cores).
+// Setting `si` (id s001, ...): its scenario (generated or given, validated with its overrides),
+// its entry in the plan, and a run per seed (appended to `runs` and to runs.txt's `list`).
+void AddSetting(const SweepOptions& o, const std::vector<SweepAxis>& axes,
+                const std::vector<std::string>& values, std::size_t si, const fs::path& out,
+                SweepPlan* plan, std::vector<SweepRun>* runs, std::ostringstream* list) {
+  const bool generator = o.scenario == kGenerator;
+  char id[24];
+  std::snprintf(id, sizeof id, "s%03zu", si + 1);
+  const std::string label = SettingLabel(axes, values);
+  const fs::path generated = fs::path("scenarios") / (std::string(id) + ".yaml");
+  const fs::path scenario = generator ? out / generated : fs::absolute(o.scenario);
+  std::vector<std::string> sets;
+  TangentialOptions gen;
+  gen.kind = "aspect";
+  gen.quiet = true;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    if (axes[k].key.rfind("tangential.", 0) == 0)
+      SetGeneratorOption(&gen, axes[k].key.substr(11), values[k]);
+    else
+      sets.push_back(axes[k].key + "=" + values[k]);
+  }
+  try {
+    if (generator) {
+      gen.out = scenario;
+      RunTangential(gen);
+    }
+    std::vector<scenario::Override> overrides;
+    for (const auto& s : sets) overrides.push_back(scenario::ParseOverride(s));
+    scenario::LoadScenario(scenario, overrides);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument("setting " + std::string(id) + " (" + label + "): " + e.what());
+  }
+  // A generated scenario is named relative to the sweep folder: a copied folder uses its own.
+  plan->settings.push_back({id, values, label, generator ? generated.string() : scenario.string()});
+  for (int k = 0; k < o.seeds; ++k) {
+    const std::uint64_t seed = o.first_seed + k;
+    const fs::path folder = RunFolder(out, id, seed);
+    std::vector<std::string> args = SweepRunArgs(o, scenario, folder, seed, sets);
+    std::string line;
+    for (const auto& a : args) {
+      if (!line.empty()) line += ' ';
+      line += ShellQuote(a);
+    }
+    *list << line << " > " << ShellQuote(folder.string() + ".log") << " 2>&1\n";
+    plan->runs.push_back({id, seed});
+    runs->emplace_back(std::move(args), folder);
+  }
+}
+
+// slurm.sh: a Slurm job array, one task per line of runs.txt.
+void WriteSlurm(const fs::path& out, std::size_t tasks) {
+  std::ostringstream sh;
+  sh << "#!/bin/bash\n# Slurm job array of the sweep in " << out.string()
+     << ": one task per line of runs.txt (docs/stress.md).\n"
+     << "#SBATCH --job-name=dualgrid-sweep\n#SBATCH --array=1-" << tasks << "\n"
+     << "#SBATCH --ntasks=1\n#SBATCH --cpus-per-task=1\n#SBATCH --mem=2G\n"
+     << "#SBATCH --time=02:00:00\n#SBATCH --output=" << (out / "slurm").string()
+     << "/task_%a.out\nexport OMP_NUM_THREADS=1\n"
+     << "line=$(sed -n \"${SLURM_ARRAY_TASK_ID}p\" " << ShellQuote((out / "runs.txt").string())
+     << ")\n[ -n \"$line\" ] || { echo \"no run $SLURM_ARRAY_TASK_ID\" >&2; exit 2; }\n"
+     << "eval \"$line\"\n";
+  fs::create_directories(out / "slurm");
+  WriteTextFile(out / "slurm.sh", sh.str());
+  std::cout << "wrote " << (out / "slurm.sh").string() << " (" << tasks
+            << " tasks); submit: sbatch " << (out / "slurm.sh").string()
+            << "; then: dualgrid collect " << out.string() << "\n";
+}
+
+// The runs not finished earlier, `o.jobs` at a time with one OpenMP thread each (processes x
+// threads <= cores). Returns how many failed.
+int RunLocally(const SweepOptions& o, const std::vector<SweepRun>& runs, std::size_t settings) {
   const CoreSplit split = SplitCores(o.jobs, 1, static_cast<int>(runs.size()));
-  const int jobs = split.jobs;
   if (!o.quiet)
-    std::cerr << "sweep: " << settings.size() << " settings x " << o.seeds
-              << " seeds = " << runs.size() << " runs, " << split.Describe() << "\n";
+    std::cerr << "sweep: " << settings << " settings x " << o.seeds << " seeds = " << runs.size()
+              << " runs, " << split.Describe() << "\n";
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < runs.size(); ++i)
     if (!ReadRunState(runs[i].second).complete) todo.push_back(i);
   if (!o.quiet && todo.size() < runs.size())
     std::cerr << "sweep: " << runs.size() - todo.size() << " runs finished earlier, skipped\n";
   Progress progress("sweep", static_cast<int>(todo.size()), !o.quiet);
-  ChildPool pool(jobs, "the sweep's runs");
+  ChildPool pool(split.jobs, "the sweep's runs");
   std::size_t next = 0;
   int done = 0, failed = 0;
   while (true) {
@@ -367,185 +383,268 @@ int RunSweep(const SweepOptions& o) {
     progress.Update(done, std::to_string(done) + "/" + std::to_string(todo.size()) + " runs");
   }
   progress.Finish();
+  return failed;
+}
+
+}  // namespace
+
+int RunSweep(const SweepOptions& o) {
+  if (o.sets.empty()) throw std::invalid_argument("--set: give at least one KEY=LIST to sweep");
+  const std::vector<SweepAxis> axes = SweepAxes(o);
+  const auto settings = SweepSettings(axes);
+  const fs::path out = fs::absolute(o.out);
+  SweepPlan plan = OpenSweep(o, axes, out);
+
+  // Scenarios and run commands; every setting is validated before anything runs (a stop signal
+  // ends the validation at once: nothing has run).
+  std::ostringstream list;
+  std::vector<SweepRun> runs;
+  Progress checking("sweep: checking settings", static_cast<int>(settings.size()), !o.quiet);
+  for (std::size_t si = 0; si < settings.size(); ++si) {
+    if (StopSignal()) return StopExitCode();
+    checking.Update(static_cast<int>(si));
+    AddSetting(o, axes, settings[si], si, out, &plan, &runs, &list);
+  }
+  checking.Finish();
+  // Every setting is valid: now the run folders' parents (logs sit beside the folders, and
+  // runs.txt redirects into them).
+  for (const auto& run : runs) fs::create_directories(run.second.parent_path());
+  WriteTextFile(out / "plan.json", SweepPlanJson(plan).dump(2) + "\n");
+  WriteTextFile(out / "runs.txt", list.str());
+  if (o.emit == "slurm") {
+    WriteSlurm(out, runs.size());
+    return kExitOk;
+  }
+  if (o.emit == "list") {
+    std::cout << "wrote " << (out / "runs.txt").string() << " (" << runs.size()
+              << " runs); e.g. parallel -j " << Cores() << " < " << (out / "runs.txt").string()
+              << "; then: dualgrid collect " << out.string() << "\n";
+    return kExitOk;
+  }
+  const int failed = RunLocally(o, runs, settings.size());
   const int collected = RunCollect(CollectOptions{out, o.quiet, o.figure_captions});
   if (StopSignal()) return StopExitCode();
   return failed > 0 ? kExitSomeSeedsFailed : collected;
 }
+
+namespace {
+
+// What collect read from the sweep's run folders.
+struct Collected {
+  std::string tidy;  // tidy.csv: setting x seed x mode x metric
+  // (setting, mode, metric) -> one sample per seed
+  std::map<std::tuple<std::string, std::string, std::string>, std::vector<double>> samples;
+  std::map<std::string, std::string> unit_of;  // metric -> unit, as the tables say
+  std::vector<std::string> missing;
+  int complete = 0;
+};
+
+// A finished run's table.json with a value for every mode of the plan; throws
+// std::invalid_argument naming the file otherwise (a damaged table is a missing run).
+std::vector<TableMetric> ReadRunTable(const fs::path& folder, const SweepPlan& plan) {
+  std::vector<TableMetric> table = ReadTableJson(folder / "table.json");
+  for (const TableMetric& m : table)
+    for (const std::string& mode : plan.modes)
+      if (!m.modes.count(mode) && m.key != "t_d")
+        throw std::invalid_argument((folder / "table.json").string() + ": metric '" + m.key +
+                                    "' has no value for mode '" + mode +
+                                    "', expected one (the plan runs it)");
+  if (table.empty())
+    throw std::invalid_argument((folder / "table.json").string() +
+                                ": key 'metrics': expected at least one metric");
+  return table;
+}
+
+Collected CollectRuns(const SweepPlan& plan, const fs::path& out,
+                      const std::map<std::string, const SweepPlan::Setting*>& setting_of) {
+  Collected c;
+  std::ostringstream tidy;
+  tidy << "setting";
+  for (const auto& a : plan.axes) tidy << "," << CsvCell(a.key);
+  tidy << ",seed,mode,metric,unit,value\n";
+  for (const auto& r : plan.runs) {
+    const fs::path folder = RunFolder(out, r.setting, r.seed);
+    const RunState state = ReadRunState(folder);
+    if (!state.complete) {
+      const std::string log = LastLine(folder.string() + ".log");
+      c.missing.push_back(folder.string() + ": " +
+                          (state.why == "not run" && !log.empty() ? log : state.why));
+      continue;
+    }
+    // A run counts as complete only once its table is read.
+    std::vector<TableMetric> table;
+    try {
+      table = ReadRunTable(folder, plan);
+    } catch (const std::invalid_argument& e) {
+      c.missing.push_back(e.what());
+      continue;
+    }
+    ++c.complete;
+    const auto& values = setting_of.at(r.setting)->values;
+    for (const TableMetric& m : table) {
+      c.unit_of[m.key] = m.unit.empty() ? MetricUnit(m.key) : m.unit;
+      for (const auto& [mode, v] : m.modes) {
+        tidy << r.setting;
+        for (const auto& val : values) tidy << "," << CsvCell(val);
+        tidy << "," << r.seed << "," << CsvCell(mode) << "," << CsvCell(m.key) << ","
+             << CsvCell(c.unit_of[m.key]) << "," << Exact(v.mean) << "\n";
+        c.samples[{r.setting, mode, m.key}].push_back(v.mean);
+      }
+    }
+  }
+  c.tidy = tidy.str();
+  return c;
+}
+
+// aggregate.csv (mean and 95 % CI over the seeds per setting, mode and metric); returns the same
+// rows for sweep.json.
+nlohmann::json WriteAggregate(const SweepPlan& plan, const Collected& c, const fs::path& out,
+                              const std::map<std::string, const SweepPlan::Setting*>& setting_of) {
+  std::ostringstream agg;
+  agg << "setting";
+  for (const auto& a : plan.axes) agg << "," << CsvCell(a.key);
+  agg << ",mode,metric,unit,n,mean,ci95_half_width\n";
+  nlohmann::json aj = nlohmann::json::array();
+  for (const auto& [key, xs] : c.samples) {
+    const auto& [sid, mode, metric] = key;
+    const eval::Summary s = eval::Summarize(xs);
+    const auto& values = setting_of.at(sid)->values;
+    const std::string& unit = c.unit_of.at(metric);
+    agg << sid;
+    for (const auto& val : values) agg << "," << CsvCell(val);
+    agg << "," << CsvCell(mode) << "," << CsvCell(metric) << "," << CsvCell(unit) << "," << s.n
+        << "," << Exact(s.mean) << "," << (s.half_width ? Exact(*s.half_width) : "") << "\n";
+    aj.push_back({{"setting", sid},
+                  {"values", values},
+                  {"mode", mode},
+                  {"metric", metric},
+                  {"unit", unit},
+                  {"n", s.n},
+                  {"mean", s.mean},
+                  {"ci95_half_width", s.half_width ? nlohmann::json(*s.half_width) : nullptr}});
+  }
+  WriteTextFile(out / "aggregate.csv", agg.str());
+  return aj;
+}
+
+// The first axis with several values, all numbers: the figures' x axis; -1 when none is.
+int FirstNumericAxis(const std::vector<SweepPlan::Axis>& axes) {
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    bool numeric = axes[i].values.size() > 1;
+    for (const auto& v : axes[i].values) {
+      double d;
+      numeric = numeric && ParseNumber(v, &d);
+    }
+    if (numeric) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+// One chart of `metric` against axis `xaxis` over the settings `ids`, a line per mode (mean)
+// with 95 % CI error bars; no series when no setting has the metric.
+viz::LineChart SweepChart(const SweepPlan& plan, const Collected& c, const char* metric, int xaxis,
+                          const std::vector<std::string>& ids,
+                          const std::map<std::string, const SweepPlan::Setting*>& setting_of,
+                          int* most_seeds) {
+  viz::LineChart chart;
+  const std::string& key = plan.axes[xaxis].key;
+  const std::string x_unit = SweepKeyUnit(key);
+  chart.x_label = key + (x_unit.empty() ? "" : " [" + x_unit + "]");
+  chart.y_label = std::string(metric) + " [" + MetricUnit(metric) + "]";
+  for (const char* mode : {"position", "velocity", "dual"}) {
+    viz::LineSeries mean;
+    mean.name = mode;
+    for (const auto& sid : ids) {
+      const auto it = c.samples.find({sid, mode, metric});
+      if (it == c.samples.end()) continue;
+      const eval::Summary s = eval::Summarize(it->second);
+      *most_seeds = std::max(*most_seeds, static_cast<int>(s.n));
+      mean.x.push_back(std::stod(setting_of.at(sid)->values[xaxis]));
+      mean.y.push_back(s.mean);
+      mean.errors.push_back(s.half_width.value_or(std::nan("")));
+    }
+    if (!mean.x.empty()) chart.series.push_back(std::move(mean));
+  }
+  return chart;
+}
+
+// Figures: each metric against axis `xaxis`, one figure per combination of the other axes.
+void DrawSweepFigures(const CollectOptions& o, const SweepPlan& plan, const Collected& c, int xaxis,
+                      const fs::path& out,
+                      const std::map<std::string, const SweepPlan::Setting*>& setting_of,
+                      std::vector<std::string>* warnings) {
+  fs::create_directories(out / "figures");
+  const auto& axes = plan.axes;
+  // Group settings by the values of the other axes; the same label for a title: spaced, so that
+  // a long one wraps between the pairs.
+  std::map<std::string, std::vector<std::string>> groups;  // label of others -> setting ids
+  std::map<std::string, std::string> titles;
+  for (const auto& s : plan.settings) {
+    std::string others, title;
+    for (std::size_t i = 0; i < axes.size(); ++i)
+      if (static_cast<int>(i) != xaxis && axes[i].values.size() > 1) {
+        others += (others.empty() ? "" : "_") + axes[i].key + "=" + s.values[i];
+        title += (title.empty() ? "" : ", ") + axes[i].key + " = " + s.values[i];
+      }
+    groups[others].push_back(s.id);
+    titles[others] = title;
+  }
+  const std::string& xkey = axes[xaxis].key;
+  for (const char* metric : kMetrics) {
+    for (const auto& [others, ids] : groups) {
+      int most_seeds = 0;
+      viz::LineChart chart = SweepChart(plan, c, metric, xaxis, ids, setting_of, &most_seeds);
+      if (chart.series.empty()) continue;
+      chart.title = std::string(metric) + " vs " + xkey +
+                    (others.empty() ? "" : " (" + titles.at(others) + ")");
+      if (o.figure_captions) chart.caption = SweepCaption(most_seeds);
+      std::string name =
+          std::string(metric) + "_vs_" + xkey + (others.empty() ? "" : "__" + others);
+      for (char& ch : name)
+        if (ch == '/' || ch == ' ' || ch == ',' || ch == '=') ch = ch == '=' ? '-' : '_';
+      TryFigures(
+          out / "figures" / (name + ".png"), kFigureFormats,
+          [&](const auto& p) { viz::RenderLineChart(chart, p.string()); }, warnings);
+    }
+  }
+}
+
+}  // namespace
 
 int RunCollect(const CollectOptions& o) {
   const fs::path out = fs::absolute(o.dir);
   if (!fs::exists(out / "plan.json"))
     throw std::invalid_argument(out.string() + ": no plan.json (not a sweep folder)");
   const SweepPlan plan = ReadSweepPlan(out / "plan.json");
-  std::vector<std::string> keys;
-  for (const auto& a : plan.axes) keys.push_back(a.key);
   std::map<std::string, const SweepPlan::Setting*> setting_of;
   for (const auto& s : plan.settings) setting_of[s.id] = &s;
-  // Tidy rows: setting x seed x mode x metric.
-  std::ostringstream tidy;
-  tidy << "setting";
-  for (const auto& k : keys) tidy << "," << CsvCell(k);
-  tidy << ",seed,mode,metric,unit,value\n";
-  // (setting, mode, metric) -> samples
-  std::map<std::tuple<std::string, std::string, std::string>, std::vector<double>> samples;
-  std::map<std::string, std::string> unit_of;  // metric -> unit, as the tables say
-  std::vector<std::string> missing;
-  int complete = 0;
-  for (const auto& r : plan.runs) {
-    const fs::path folder = RunFolder(out, r.setting, r.seed);
-    const RunState state = ReadRunState(folder);
-    if (!state.complete) {
-      const std::string log = LastLine(folder.string() + ".log");
-      const std::string why = state.why == "not run" && !log.empty() ? log : state.why;
-      missing.push_back(folder.string() + ": " + why);
-      continue;
-    }
-    // A run counts as complete only once its table is read: a damaged table.json is a missing
-    // run, not a setting without rows.
-    std::vector<TableMetric> table;
-    try {
-      table = ReadTableJson(folder / "table.json");
-      for (const TableMetric& m : table)
-        for (const std::string& mode : plan.modes)
-          if (!m.modes.count(mode) && m.key != "t_d")
-            throw std::invalid_argument((folder / "table.json").string() + ": metric '" + m.key +
-                                        "' has no value for mode '" + mode +
-                                        "', expected one (the plan runs it)");
-      if (table.empty())
-        throw std::invalid_argument((folder / "table.json").string() +
-                                    ": key 'metrics': expected at least one metric");
-    } catch (const std::invalid_argument& e) {
-      missing.push_back(e.what());
-      continue;
-    }
-    ++complete;
-    const auto& values = setting_of.at(r.setting)->values;
-    for (const TableMetric& m : table) {
-      unit_of[m.key] = m.unit.empty() ? MetricUnit(m.key) : m.unit;
-      for (const auto& [mode, v] : m.modes) {
-        tidy << r.setting;
-        for (const auto& val : values) tidy << "," << CsvCell(val);
-        tidy << "," << r.seed << "," << CsvCell(mode) << "," << CsvCell(m.key) << ","
-             << CsvCell(unit_of[m.key]) << "," << Exact(v.mean) << "\n";
-        samples[{r.setting, mode, m.key}].push_back(v.mean);
-      }
-    }
-  }
-  WriteTextFile(out / "tidy.csv", tidy.str());
-  // Aggregate: mean and 95 % CI over the seeds per setting, mode and metric.
-  std::ostringstream agg;
-  agg << "setting";
-  for (const auto& k : keys) agg << "," << CsvCell(k);
-  agg << ",mode,metric,unit,n,mean,ci95_half_width\n";
-  nlohmann::json aj = nlohmann::json::array();
-  for (const auto& [key, xs] : samples) {
-    const auto& [sid, mode, metric] = key;
-    const eval::Summary s = eval::Summarize(xs);
-    const auto& values = setting_of.at(sid)->values;
-    agg << sid;
-    for (const auto& val : values) agg << "," << CsvCell(val);
-    agg << "," << CsvCell(mode) << "," << CsvCell(metric) << "," << CsvCell(unit_of[metric]) << ","
-        << s.n << "," << Exact(s.mean) << "," << (s.half_width ? Exact(*s.half_width) : "") << "\n";
-    aj.push_back({{"setting", sid},
-                  {"values", values},
-                  {"mode", mode},
-                  {"metric", metric},
-                  {"unit", unit_of[metric]},
-                  {"n", s.n},
-                  {"mean", s.mean},
-                  {"ci95_half_width", s.half_width ? nlohmann::json(*s.half_width) : nullptr}});
-  }
-  WriteTextFile(out / "aggregate.csv", agg.str());
+  const Collected c = CollectRuns(plan, out, setting_of);
+  WriteTextFile(out / "tidy.csv", c.tidy);
+  const nlohmann::json aj = WriteAggregate(plan, c, out, setting_of);
   const int total = static_cast<int>(plan.runs.size());
-  nlohmann::json summary = {{"complete", complete == total},
+  nlohmann::json summary = {{"complete", c.complete == total},
                             {"runs", total},
-                            {"runs_complete", complete},
-                            {"missing", missing},
+                            {"runs_complete", c.complete},
+                            {"missing", c.missing},
                             {"aggregate", aj}};
   WriteTextFile(out / "sweep.json", summary.dump(2) + "\n");
 
-  // Figures: each metric against the first numeric axis with several values, one line per mode
-  // (mean) with 95 % CI error bars; one figure per combination of the other axes.
-  std::vector<std::string> warnings;
-  const auto& axes = plan.axes;
-  int xaxis = -1;
-  for (std::size_t i = 0; i < axes.size() && xaxis < 0; ++i) {
-    bool numeric = axes[i].values.size() > 1;
-    for (const auto& v : axes[i].values) {
-      double d;
-      numeric = numeric && ParseNumber(v, &d);
-    }
-    if (numeric) xaxis = static_cast<int>(i);
-  }
   // Figures are redrawn from the tables each time: earlier ones (other groupings) go first.
+  std::vector<std::string> warnings;
+  const int xaxis = FirstNumericAxis(plan.axes);
   fs::remove_all(out / "figures");
-  if (xaxis >= 0) {
-    fs::create_directories(out / "figures");
-    // Group settings by the values of the other axes.
-    std::map<std::string, std::vector<std::string>> groups;  // label of others -> setting ids
-    // The same label for a title: spaced, so that a long one wraps between the pairs.
-    std::map<std::string, std::string> titles;
-    for (const auto& s : plan.settings) {
-      std::string others, title;
-      for (std::size_t i = 0; i < keys.size(); ++i)
-        if (static_cast<int>(i) != xaxis && axes[i].values.size() > 1) {
-          const std::string& value = s.values[i];
-          others += (others.empty() ? "" : "_") + keys[i] + "=" + value;
-          title += (title.empty() ? "" : ", ") + keys[i] + " = " + value;
-        }
-      groups[others].push_back(s.id);
-      titles[others] = title;
-    }
-    const std::string x_unit = SweepKeyUnit(keys[xaxis]);
-    for (const char* metric : kMetrics) {
-      for (const auto& [others, ids] : groups) {
-        viz::LineChart chart;
-        chart.title = std::string(metric) + " vs " + keys[xaxis] +
-                      (others.empty() ? "" : " (" + titles.at(others) + ")");
-        chart.x_label = keys[xaxis] + (x_unit.empty() ? "" : " [" + x_unit + "]");
-        chart.y_label = std::string(metric) + " [" + MetricUnit(metric) + "]";
-        int most_seeds = 0;
-        bool any = false;
-        for (const char* mode : {"position", "velocity", "dual"}) {
-          viz::LineSeries mean;
-          mean.name = mode;
-          for (const auto& sid : ids) {
-            const auto it = samples.find({sid, mode, metric});
-            if (it == samples.end()) continue;
-            const eval::Summary s = eval::Summarize(it->second);
-            most_seeds = std::max(most_seeds, static_cast<int>(s.n));
-            mean.x.push_back(std::stod(setting_of.at(sid)->values[xaxis]));
-            mean.y.push_back(s.mean);
-            mean.errors.push_back(s.half_width.value_or(std::nan("")));
-          }
-          if (mean.x.empty()) continue;
-          any = true;
-          chart.series.push_back(std::move(mean));
-        }
-        if (!any) continue;
-        if (o.figure_captions) chart.caption = SweepCaption(most_seeds);
-        std::string name =
-            std::string(metric) + "_vs_" + keys[xaxis] + (others.empty() ? "" : "__" + others);
-        for (char& ch : name)
-          if (ch == '/' || ch == ' ' || ch == ',' || ch == '=') ch = ch == '=' ? '-' : '_';
-        const fs::path png = out / "figures" / (name + ".png");
-        TryFigures(
-            png, kFigureFormats, [&](const auto& p) { viz::RenderLineChart(chart, p.string()); },
-            &warnings);
-      }
-    }
-  }
+  if (xaxis >= 0) DrawSweepFigures(o, plan, c, xaxis, out, setting_of, &warnings);
   if (!o.quiet) {
-    std::cerr << "collect: " << complete << " of " << total << " runs complete; tables in "
+    std::cerr << "collect: " << c.complete << " of " << total << " runs complete; tables in "
               << out.string() << " (tidy.csv, aggregate.csv, sweep.json)";
     if (xaxis >= 0) std::cerr << ", figures/";
     std::cerr << "\n";
-    for (const auto& m : missing) std::cerr << "collect: missing " << m << "\n";
+    for (const auto& m : c.missing) std::cerr << "collect: missing " << m << "\n";
   }
-  if (complete == total) return kExitOk;
+  if (c.complete == total) return kExitOk;
   // Said even under -q: a sweep with missing runs is not a result to use silently.
-  std::cerr << "dualgrid: error: collect: " << total - complete << " of " << total
-            << " runs missing or unreadable (the first: " << missing.front() << "); listed in "
+  std::cerr << "dualgrid: error: collect: " << total - c.complete << " of " << total
+            << " runs missing or unreadable (the first: " << c.missing.front() << "); listed in "
             << (out / "sweep.json").string() << "\n";
   return kExitSomeSeedsFailed;
 }

@@ -4,8 +4,8 @@
 //             angles, perpendicular to the front radar's boresight;
 //   parallel: on the `highway` network, vehicles drive alongside the ego in both adjacent lanes
 //             at nearly its speed, perpendicular to the corner radars' lines of sight;
-//   guardrail: (multipath, issue 27) the ego beside a guard rail, vehicles passing on its other
-//             side (guardrail_case.cpp); aspect: any aspect angle (aspect_case.cpp).
+//   guardrail: (multipath) the ego beside a guard rail, vehicles passing on its other side
+//             (scenario/guardrail_case.hpp); aspect: any aspect angle (scenario/aspect_case.hpp).
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -13,9 +13,12 @@
 #include "aspect_case.hpp"
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
+#include "dualgrid/scenario/guardrail_case.hpp"
 #include "dualgrid/scenario/loader.hpp"
-#include "guardrail_case.hpp"
-#include "output.hpp"
 
 namespace dualgrid::tools {
 namespace {
@@ -125,57 +128,58 @@ std::string Parallel(const TangentialOptions& o) {
 
 }  // namespace
 
-int RunTangential(const TangentialOptions& o) {
-  if (o.out.extension() != ".yaml" && o.out.extension() != ".yml")
-    throw std::invalid_argument("--out must name a .yaml file, got '" + o.out.string() + "'");
-  if (o.kind == "aspect") {
-    AspectCase c;
-    c.sensor = o.sensor;
-    c.angle_deg = o.angle;
-    c.range = o.range;
-    c.speed = o.speed.value_or(15.0);
-    c.ego_speed = o.ego_speed;
-    c.target = o.target;
-    c.count = o.count;
-    c.interval = o.interval;
-    c.grid_width = o.grid_width.value_or(25.0);
-    c.auto_grid_width = !o.grid_width;
-    c.seed = o.seed;
-    if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
-    const std::string what = WriteAspectCase(c, o.out);
-    scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
-    if (!o.quiet) {
-      // Its network is written beside it (the scenario names it relative to itself): say so.
-      const std::filesystem::path base = o.out.parent_path() / o.out.stem();
-      std::cout << "wrote " << o.out.string() << " (" << what
-                << ") and its network beside it: " << base.string() << ".net.xml (netconvert, from "
-                << base.filename().string() << ".nod.xml and " << base.filename().string()
-                << ".edg.xml; log " << base.filename().string()
-                << ".netconvert.log); run it with: dualgrid run " << o.out.string() << " --out run/"
-                << o.out.stem().string() << "\n";
-    }
-    return 0;
+namespace {
+
+void WriteAspect(const TangentialOptions& o) {
+  scenario::AspectCase c;
+  c.sensor = o.sensor;
+  c.angle_deg = o.angle;
+  c.range = o.range;
+  c.speed = o.speed.value_or(15.0);
+  c.ego_speed = o.ego_speed;
+  c.target = o.target;
+  c.count = o.count;
+  c.interval = o.interval;
+  c.grid_width = o.grid_width.value_or(25.0);
+  c.auto_grid_width = !o.grid_width;
+  c.seed = o.seed;
+  if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
+  const std::string what = WriteAspectCase(c, o.out);
+  scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
+  if (!o.quiet) {
+    // Its network is written beside it (the scenario names it relative to itself): say so.
+    const std::filesystem::path base = o.out.parent_path() / o.out.stem();
+    std::cout << "wrote " << o.out.string() << " (" << what
+              << ") and its network beside it: " << base.string() << ".net.xml (netconvert, from "
+              << base.filename().string() << ".nod.xml and " << base.filename().string()
+              << ".edg.xml; log " << base.filename().string()
+              << ".netconvert.log); run it with: dualgrid run " << o.out.string() << " --out run/"
+              << o.out.stem().string() << "\n";
   }
-  if (o.kind == "guardrail") {
-    const Resolved r = Resolve(o);
-    GuardRailCase c;
-    c.offset = o.offset;
-    c.rail_angle = o.rail_angle;
-    c.ego_speed = o.ego_speed;
-    c.speed = r.speed;
-    c.count = o.count;
-    c.spacing = r.spacing;
-    c.seed = o.seed;
-    const std::string text = GuardRailScenario(c);
-    if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
-    WriteTextFile(o.out, text);
-    scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
-    if (!o.quiet)
-      std::cout << "wrote " << o.out.string() << "; run it with: dualgrid run " << o.out.string()
-                << " --set sensors.multipath=on --out run/" << o.out.stem().string() << "\n";
-    return 0;
-  }
-  // Ranges of single options are checked by the command line; these depend on the kind.
+}
+
+void WriteGuardRail(const TangentialOptions& o) {
+  const Resolved r = Resolve(o);
+  scenario::GuardRailCase c;
+  c.offset = o.offset;
+  c.rail_angle = o.rail_angle;
+  c.ego_speed = o.ego_speed;
+  c.speed = r.speed;
+  c.count = o.count;
+  c.spacing = r.spacing;
+  c.seed = o.seed;
+  const std::string text = scenario::GuardRailScenario(c);
+  if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
+  WriteTextFile(o.out, text);
+  scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
+  if (!o.quiet)
+    std::cout << "wrote " << o.out.string() << "; run it with: dualgrid run " << o.out.string()
+              << " --set sensors.multipath=on --out run/" << o.out.stem().string() << "\n";
+}
+
+// The crossing and parallel kinds' checks that depend on the kind (single options' ranges are
+// checked by the command line).
+void CheckCrossingOrParallel(const TangentialOptions& o) {
   if (!(o.ego_speed > 0.0))
     throw std::invalid_argument("--ego-speed must be > 0 for " + o.kind +
                                 " traffic (a parked ego: --kind aspect)");
@@ -207,8 +211,22 @@ int RunTangential(const TangentialOptions& o) {
         "--first-distance + (--count - 1) x --spacing must be <= 600 m (the crossing road's "
         "approach), got " +
         FormatFixed(o.first_distance + (o.count - 1) * r.spacing, 1) + " m");
+}
+
+}  // namespace
+
+int RunTangential(const TangentialOptions& o) {
   if (o.out.extension() != ".yaml" && o.out.extension() != ".yml")
     throw std::invalid_argument("--out must name a .yaml file, got '" + o.out.string() + "'");
+  if (o.kind == "aspect") {
+    WriteAspect(o);
+    return 0;
+  }
+  if (o.kind == "guardrail") {
+    WriteGuardRail(o);
+    return 0;
+  }
+  CheckCrossingOrParallel(o);
   const std::string text = o.kind == "crossing" ? Crossing(o) : Parallel(o);
   if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
   WriteTextFile(o.out, text);

@@ -9,8 +9,15 @@
 #include <vector>
 
 #include "dualgrid/filter/params.hpp"
+#include "dualgrid/outputs/run.hpp"
+#include "dualgrid/outputs/video.hpp"
+#include "dualgrid/scenario/loader.hpp"
 
 namespace dualgrid::tools {
+
+// The command line wires the outputs library (run folders, files, figures, replay): its names are
+// used unqualified in the commands.
+using namespace outputs;
 
 /// Options shared by every command that runs a scenario.
 struct RunOptions {
@@ -18,6 +25,7 @@ struct RunOptions {
   std::filesystem::path out;
   std::optional<std::uint64_t> seed;
   std::optional<double> duration;
+  std::optional<double> begin;  ///< [s, SUMO time] --begin: where SUMO starts
   std::filesystem::path network_dir;
   bool quiet = false;
   /// `--set KEY=VALUE` overrides of scenario keys, in order (scenario::Override).
@@ -34,50 +42,21 @@ struct SimOptions {
 struct FilterRunOptions {
   RunOptions run;
   std::vector<std::string> modes = {"position", "velocity", "dual"};
-  std::vector<double> snapshots;  ///< grid picture times [s]; empty: from the scenario
-  bool figures = true;
-  /// Formats every figure is written in: "png", "svg", "pdf" (`--figure-formats`).
-  std::vector<std::string> figure_formats = {"png", "svg", "pdf"};
-  /// Captions under the figures (`--figure-captions on|off`; off for a paper that sets its own).
-  bool figure_captions = true;
-  /// detections.csv: "none", "csv" or "csv.gz" (gzip-compressed, about 3.5x smaller).
-  std::string detections = "none";
-  /// figures/particles_<mode>_t<time>.csv beside each grid picture (several MB each).
-  bool write_particles = false;
   int threads = 0;  ///< OpenMP threads; 0: the OpenMP default
-  /// Checks every filter's invariants after every step (DynamicGrid::CheckInvariants; a
-  /// violation ends the run with exit code 1) and samples the resident memory every 60 s
-  /// simulated into summary.json (`rss_mb`): the soak test's mode.
-  bool check_invariants = false;
-  /// The replay recording (RUN_DIR/replay/, docs/replay.md): one frame every `record_interval`
-  /// [s] (rounded to whole steps) with up to `record_particles` particles per mode. On with
-  /// figures unless `--no-record`.
-  bool record = true;
-  /// Two frames per simulated second and 500 particles: about 8 MB per simulated minute of the
-  /// highway (docs/replay.md, "Cost"); --record-interval 0.1 for every tenth of a second.
-  double record_interval = 0.5;
-  int record_particles = 500;
-  /// After the results: the replay video (`--video`) and the interactive viewer (`--viewer`),
-  /// as `dualgrid replay` would write them with its defaults.
-  bool video = false;
-  bool viewer = false;
+  /// What the run folder holds (figures, detections, recording, ...); its out, network_dir and
+  /// quiet are taken from `run` when the command runs (FolderOptions).
+  outputs::RunFolderOptions folder;
+  /// `folder` with run.out, run.network_dir and run.quiet.
+  outputs::RunFolderOptions FolderOptions() const;
 };
 
 /// `dualgrid replay`: the video and/or the interactive viewer of a recorded run, without SUMO.
-struct ReplayOptions {
+struct ReplayCommandOptions {
   std::filesystem::path run_dir;
-  bool video = false;              ///< MP4 (H.264) + preview; the default when neither is asked for
-  bool html = false;               ///< the self-contained interactive viewer
-  std::filesystem::path out;       ///< video file (.mp4); default RUN_DIR/replay.mp4
-  std::filesystem::path html_out;  ///< default RUN_DIR/replay.html
-  std::vector<std::string> modes;  ///< subset of the recorded modes; empty: all
-  bool particles = false;          ///< video: draw the recorded particles
-  bool detections = true;          ///< video: draw the detections, coloured per sensor
-  double from = 0.0, to = 0.0;     ///< time window [s]; to = 0: to the end
-  double speed = 1.0;              ///< video playback speed (1 = real time)
-  int width = 1920;                ///< video width [px]
-  std::string preview = "gif";     ///< "gif", "webm" or "none"
+  bool video = false;  ///< MP4 (H.264) + preview; the default when neither is asked for
+  bool html = false;   ///< the self-contained interactive viewer
   bool quiet = false;
+  outputs::ReplayOptions replay;
 };
 
 /// `dualgrid experiment`: `run` over seeds 1..N in separate processes, then aggregated.
@@ -167,15 +146,25 @@ struct CollectOptions {
 /// prefix) from its text; throws std::invalid_argument naming the key and what was expected.
 void SetGeneratorOption(TangentialOptions* o, const std::string& key, const std::string& value);
 
+/// Writes the run folder of `cosim` (outputs::WriteRunFolder) with the terminal's progress and
+/// stop signal, prints the table and the one-line result; returns the exit code. `recorded` is
+/// null for a SUMO run.
+int WriteRunFolderAndReport(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
+                            const outputs::RunFolderOptions& folder,
+                            const outputs::RecordedRun* recorded);
+
 int RunSim(const SimOptions& options);
 int RunSweep(const SweepOptions& options);
 int RunCollect(const CollectOptions& options);
 int RunRegress(const RegressOptions& options);
 int RunTangential(const TangentialOptions& options);
 int RunFilters(const FilterRunOptions& options);
-int RunReplay(const ReplayOptions& options);
+int RunReplay(const ReplayCommandOptions& options);
 int RunExperiment(const ExperimentOptions& options);
 int RunSnapshot(const SnapshotOptions& options);
+
+/// The scenario of `options` with its command-line overrides (outputs::LoadRunConfig).
+scenario::ScenarioConfig LoadConfig(const RunOptions& options);
 
 /// Parses mode names or throws naming the bad one.
 std::vector<filter::WeightMode> ParseModes(const std::vector<std::string>& names);

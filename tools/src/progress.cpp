@@ -1,7 +1,11 @@
 #include "progress.hpp"
 
 #include <unistd.h>
+
 #include <cstdio>
+#include <memory>
+
+#include "signals.hpp"
 
 namespace dualgrid::tools {
 
@@ -41,6 +45,23 @@ void Progress::Finish() {
   const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
   if (tty_) std::fprintf(stderr, "\r%*s\r", 100, "");
   std::fprintf(stderr, "%s: done in %.1f s\n", label_.c_str(), elapsed);
+}
+
+outputs::Callbacks TerminalCallbacks(bool quiet) {
+  auto progress = std::make_shared<std::unique_ptr<Progress>>();
+  outputs::Callbacks c;
+  c.stop = [] { return StopSignal(); };
+  c.begin = [progress, quiet](const std::string& task, int total) {
+    *progress = std::make_unique<Progress>(task, total, !quiet);
+  };
+  c.progress = [progress](int done, const std::string& detail) {
+    if (*progress) (*progress)->Update(done, detail);
+  };
+  c.end = [progress] {
+    if (*progress) (*progress)->Finish();
+    progress->reset();
+  };
+  return c;
 }
 
 }  // namespace dualgrid::tools

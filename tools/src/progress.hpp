@@ -5,6 +5,8 @@
 #include <chrono>
 #include <string>
 
+#include "dualgrid/outputs/callbacks.hpp"
+
 namespace dualgrid::tools {
 
 class Progress {
@@ -25,5 +27,9 @@ class Progress {
   Clock::time_point start_;
   Clock::time_point last_;
 };
+
+/// The command line's callbacks for the outputs library: stop at SIGINT/SIGTERM (signals.hpp),
+/// progress as a Progress bar on stderr (none when `quiet`).
+outputs::Callbacks TerminalCallbacks(bool quiet);
 
 }  // namespace dualgrid::tools

@@ -34,8 +34,8 @@ struct CoSimOptions {
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
   /// threads), it reads a recorded source one step ahead while the others filter, and builds
   /// the next step's measurement grid there (Pipeline::PrepareAhead: taken only for the same
-  /// inputs, so results do not depend on it; SUMO runs cannot be read ahead). -5.8 % wall time on a
-  /// three-mode recorded run on two threads (docs/performance.md, round 6).
+  /// inputs, so results do not depend on it; SUMO runs cannot be read ahead). Its gain is measured
+  /// in docs/performance.md.
   bool read_ahead = true;
 };
 

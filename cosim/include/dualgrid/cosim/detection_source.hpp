@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "dualgrid/radar_model/radar_model.hpp"
+#include "dualgrid/recorded/sequence.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
@@ -22,7 +23,7 @@ class IdRegistry;
 /// Per detection of a recorded step: its RadarScenes label (0-10 a moving road user's class,
 /// 11 static, -1 unlabelled). Empty when the source has no labels.
 using PointLabels = std::vector<int>;
-inline constexpr int kStaticLabel = 11;
+using recorded::kStaticLabel;
 
 /// One step's worth of detections and the ego's state. Lifetime: Start() once, then Advance()
 /// until it returns false; Finish() at the end. Not copyable.

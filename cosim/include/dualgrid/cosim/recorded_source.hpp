@@ -1,6 +1,6 @@
-// Recorded radar data as a detection source (docs/recorded-data.md): a sequence of scans, each of
-// one sensor at its own timestamp with the ego's pose from odometry, as read from a RadarScenes
-// sequence or a dualgrid run folder (dualgrid::recorded reads the files; this is data only).
+// Recorded radar data as a detection source (docs/recorded-data.md): steps through a
+// recorded::RecordedSequence (dualgrid::recorded reads the files), and fits a scenario
+// configuration to it.
 #pragma once
 
 #include <cstdint>
@@ -8,57 +8,17 @@
 #include <vector>
 
 #include "dualgrid/cosim/detection_source.hpp"
+#include "dualgrid/recorded/sequence.hpp"
+#include "dualgrid/scenario/loader.hpp"
 
 namespace dualgrid::cosim {
 
-/// One detection of a recorded scan. Positions in the sequence's (world) frame.
-struct RecordedPoint {
-  double range = 0.0;         ///< [m], sensor frame
-  double azimuth = 0.0;       ///< [rad], sensor frame
-  double range_rate = 0.0;    ///< vr: uncompensated [m/s]
-  double radial_speed = 0.0;  ///< vr_compensated: over ground, along the line of sight [m/s]
-  double rcs = 0.0;           ///< [dBsm]
-  Position position = Position::Zero();  ///< x_seq, y_seq [m]
-  int label = -1;                        ///< RadarScenes label_id (0-11), -1 unlabelled
-  int track = -1;                        ///< index into RecordedSequence::track_names, -1 none
-};
-
-/// One sensor's scan: its detections and the ego's state at its timestamp.
-struct RecordedScan {
-  std::int64_t timestamp_us = 0;   ///< sequence clock [us]
-  int sensor = 0;                  ///< index into RecordedSequence::sensors
-  std::size_t begin = 0, end = 0;  ///< its detections: RecordedSequence::points[begin, end)
-  Pose2 ego_pose;                  ///< the ego's box centre and heading, world frame [m, rad]
-  Velocity ego_velocity = Velocity::Zero();  ///< of the box centre [m/s]
-  double ego_yaw_rate = 0.0;                 ///< [rad/s]
-  double lane_yaw = 0.0;  ///< the road's direction [rad]: the heading unless the data say
-};
-
-/// A recorded sequence, validated by its reader: scans in non-decreasing time, every point index
-/// inside `points`, every point finite.
-struct RecordedSequence {
-  std::string name;
-  /// The radars, mounted relative to the ego's box centre (x forward, y left).
-  std::vector<radar::SensorParams> sensors;
-  double ego_length = 4.9;  ///< [m]
-  double ego_width = 1.9;   ///< [m]
-  std::vector<RecordedScan> scans;
-  std::vector<RecordedPoint> points;
-  std::vector<std::string> track_names;
-  /// The data carry labels (label_id): point-level scores are possible.
-  bool has_labels = false;
-  /// t = (timestamp_us - time_origin_us) / 1e6 [s]: a whole second at or before the first scan.
-  std::int64_t time_origin_us = 0;
-  /// Detections dropped by the reader (NaN position or velocity), for the run's notes.
-  std::size_t skipped_points = 0;
-
-  double Time(std::int64_t timestamp_us) const {
-    return static_cast<double>(timestamp_us - time_origin_us) / 1e6;
-  }
-};
-
-/// Labels 0-10 are road users that move (RadarScenes' dynamic classes); 11 is static.
-inline bool IsMovingLabel(int label) { return label >= 0 && label < kStaticLabel; }
+// The sequence types live in dualgrid::recorded (the readers' side, without SUMO); a
+// RecordedSource reads them under these names too.
+using recorded::IsMovingLabel;
+using recorded::RecordedPoint;
+using recorded::RecordedScan;
+using recorded::RecordedSequence;
 
 /// Options of a RecordedSource.
 struct RecordedOptions {
@@ -121,5 +81,16 @@ class RecordedSource : public DetectionSource {
   radar::EgoMotion ego_;
   PointLabels labels_;
 };
+
+/// The configuration of a recorded run without a scenario file: the defaults with a 100 m x 60 m
+/// grid (RadarScenes' radars look ahead and to both sides) and filter.cycle 0.05 s.
+scenario::ScenarioConfig DefaultRecordedConfig();
+
+/// Fits `config` to `seq`: name, duration (the last cycle's time), step length (the mean cycle,
+/// for step-based schedules), no simulated radars; returns the source options for its filter
+/// cycle (first_dt = filter.cycle) and `batch_window` [s]. Throws std::invalid_argument for a
+/// sequence that spans no time.
+RecordedOptions FitConfig(const RecordedSequence& seq, double batch_window,
+                          scenario::ScenarioConfig* config);
 
 }  // namespace dualgrid::cosim

@@ -63,6 +63,9 @@ struct MetricSpec {
   std::string unit;            ///< display unit
   double display_scale = 1.0;  ///< stored values are multiplied by this for display (D: 100 -> %)
   int decimals = 2;
+  /// A count (objects scored): Markdown shows one seed's value as a whole number, a mean over
+  /// seeds with `decimals`.
+  bool count = false;
 };
 
 /// Metric rows x mode columns; each cell holds our summary over seeds and optionally the paper's

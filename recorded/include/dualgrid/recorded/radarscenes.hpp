@@ -1,5 +1,5 @@
 // RadarScenes sequences (Schumann et al. 2021; docs/recorded-data.md) read into and written from
-// cosim::RecordedSequence, through Debian's libhdf5 (its C API).
+// RecordedSequence, through Debian's libhdf5 (its C API).
 //
 // Read: a sequence folder (data/sequence_N/) with scenes.json and radar_data.h5, and the
 // dataset root's sensors.json (two folders up unless given). Every problem of the files is a
@@ -14,7 +14,7 @@
 #include <optional>
 #include <string>
 
-#include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/recorded/sequence.hpp"
 
 namespace dualgrid::recorded {
 
@@ -27,14 +27,14 @@ inline constexpr double kDefaultEgoWidth = 1.9;
 
 /// Reads a RadarScenes sequence folder. `sensors_json`: sensors.json, default
 /// sequence_dir/../../sensors.json. Throws std::invalid_argument (bad or missing input).
-cosim::RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
-                                        const std::optional<std::filesystem::path>& sensors_json);
+RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
+                                 const std::optional<std::filesystem::path>& sensors_json);
 
 /// Writes `seq` as a RadarScenes dataset root `root` holding one sequence named seq.name, with
 /// the ego's rear axle `rear_axle_to_centre` [m] behind its box centre. Scans sharing a
 /// timestamp get 1 us apart in sensor order (scenes are keyed by timestamp). Sensors become
 /// radar_1.. in order. Throws std::runtime_error naming the file when a write fails.
-void WriteRadarScenes(const cosim::RecordedSequence& seq, const std::filesystem::path& root,
+void WriteRadarScenes(const RecordedSequence& seq, const std::filesystem::path& root,
                       double rear_axle_to_centre);
 
 /// RadarScenes' label_id of a SUMO vClass (docs/recorded-data.md, "Labels").

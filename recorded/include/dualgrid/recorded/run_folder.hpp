@@ -1,11 +1,11 @@
 // A dualgrid `sim` or `run` folder recorded with `--detections exact` (detections.csv and
-// scans.csv, every number with 17 significant digits) read as a cosim::RecordedSequence: the
+// scans.csv, every number with 17 significant digits) read as a RecordedSequence: the
 // input of `dualgrid filter RUN_DIR` and of `dualgrid export`.
 #pragma once
 
 #include <filesystem>
 
-#include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/recorded/sequence.hpp"
 
 namespace dualgrid::recorded {
 
@@ -13,6 +13,6 @@ namespace dualgrid::recorded {
 /// vehicle's vClass (LabelOfVClass), track ids = SUMO vehicle ids; clutter, ghosts and static
 /// obstacles are static (label 11) without a track. Throws std::invalid_argument naming the
 /// file, the row and the column of bad input, or the missing file.
-cosim::RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir);
+RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir);
 
 }  // namespace dualgrid::recorded

@@ -25,7 +25,7 @@ struct VehicleState {
 
 struct Frame {
   int step = 0;
-  double time = 0.0;  ///< [s] at the end of the step
+  double time = 0.0;  ///< [s] run time (since the scenario's begin) at the end of the step
   VehicleState ego;
   std::vector<VehicleState> vehicles;  ///< all others, sorted by id (deterministic order)
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/sim/auto_ego.hpp"
 
 namespace dualgrid::sim {
 
@@ -43,7 +44,7 @@ struct VehicleSpec {
   std::string id;
   std::string type = "car";
   std::string route;      ///< name of an entry of ScenarioSpec::routes
-  double depart = 0.0;    ///< [s]
+  double depart = 0.0;    ///< [s] run time (from ScenarioSpec::begin)
   int lane = 0;           ///< departure lane index (0 = rightmost)
   double position = 0.0;  ///< [m] departure position of the front bumper along the first edge
   double speed = 27.78;   ///< [m/s] departure speed
@@ -57,8 +58,8 @@ struct FlowSpec {
   std::string id;
   std::string type = "car";
   std::string route;
-  double begin = 0.0;         ///< [s]
-  double end = 60.0;          ///< [s]
+  double begin = 0.0;         ///< [s] run time (from ScenarioSpec::begin)
+  double end = 60.0;          ///< [s] run time
   double period = 5.0;        ///< [s] between departures
   std::string lane = "best";  ///< SUMO departLane: an index, "random", "free", "best"
   double position = 0.0;      ///< [m] departure position along the first edge
@@ -68,7 +69,7 @@ struct FlowSpec {
 
 /// A scripted event at a time: a speed change or a lane change of one vehicle.
 struct ActionSpec {
-  double time = 0.0;  ///< [s]
+  double time = 0.0;  ///< [s] run time (from ScenarioSpec::begin)
   std::string vehicle;
   std::optional<double> set_speed;  ///< [m/s] new desired speed
   std::optional<int> change_lane;   ///< target lane index
@@ -89,6 +90,25 @@ struct ParkedBox {
   double rcs_dbsm = 10.0;
 };
 
+/// When a vehicle of the user's files departs (sumo_files.hpp, DepartureOf): at `depart` [s, SUMO
+/// time]; the k-th member of a flow at max(depart, the run's begin) + k * period (SUMO starts a
+/// flow that began before the run at the run's begin, numbering from 0), if before `flow_end`.
+struct FileDeparture {
+  double depart = 0.0;
+  std::optional<double> period;  ///< set for a flow member: its flow's period [s]
+  long member = 0;
+  std::optional<double> flow_end;  ///< [s, SUMO time]
+  /// The departure [s, SUMO time] in a run beginning at `begin`; std::nullopt when SUMO creates
+  /// no such vehicle (a flow member past the flow's end).
+  std::optional<double> At(double begin) const;
+};
+
+/// Random traffic from SUMO's randomTrips.py (random_trips.hpp): `traffic.random_trips`, or by
+/// default for a scenario with `ego: {from_routes: auto}` and no traffic of its own.
+struct RandomTripsSpec {
+  double period = 2.0;  ///< [s] between departures
+};
+
 /// `ego: {from_routes: auto}`: the ego is chosen from the route files' vehicles by a dry run of
 /// SUMO (sumo_simulation.hpp, ChooseAutoEgo).
 inline constexpr const char* kAutoEgo = "auto";
@@ -99,7 +119,15 @@ struct ScenarioSpec {
   std::string description;
   /// A built network's name (<network dir>/<name>.net.xml) or a path to a .net.xml file.
   std::string network;
-  double duration = 60.0;     ///< [s]
+  /// The run's first instant on SUMO's clock [s, SUMO time]: SUMO starts there and the run
+  /// covers SUMO time [begin, begin + duration]. Its source: `begin_source`.
+  double begin = 0.0;
+  /// Where `begin` came from: "default" (0), "sumo_config" (the configuration's <begin>, as SUMO
+  /// read it), "scenario" (the key `begin`) or "command line" (--begin).
+  std::string begin_source = "default";
+  /// The configuration's <end> [s, SUMO time] when it gives one: begin must lie before it.
+  std::optional<double> config_end;
+  double duration = 60.0;     ///< [s] run time: counted from `begin`
   double step_length = 0.05;  ///< [s] SUMO step = radar cycle
   std::uint64_t seed = 1;
   double lane_change_duration = 3.0;  ///< [s] SUMO --lanechange.duration: continuous lane changes
@@ -126,6 +154,17 @@ struct ScenarioSpec {
   /// (`ego: {from_routes: ID}`), not one
   /// the scenario places. ID kAutoEgo ("auto"): SumoSimulation chooses it (ChooseAutoEgo).
   bool ego_from_routes = false;
+  /// `ego.from_routes` naming a vehicle of the files: when it departs (checked against the run's
+  /// window by IsValid, so a --begin or --duration given later is checked too).
+  std::optional<FileDeparture> ego_departure;
+  /// Random traffic generated when SUMO starts (into its work folder), added to route_files.
+  std::optional<RandomTripsSpec> random_trips;
+  /// The grid around a vehicle, for the `auto` rule (auto_ego.hpp; the loader sets it from the
+  /// filter's extent and placement).
+  ViewBox auto_ego_view;
+  /// The map the user named when `network` is made from it (an OpenDRIVE .xodr converted into
+  /// the cache, opendrive.hpp); "" otherwise.
+  std::string network_source;
   /// Radar cross-section [dBsm] per vType id of route_files (`traffic.rcs_dbsm`).
   std::map<std::string, double> type_rcs;
   /// Parts of the input that are not honoured, one line each naming the file and the element
@@ -143,6 +182,11 @@ struct ScenarioSpec {
 /// car 10, van (delivery) 14, truck / trailer / bus / coach 25, motorcycle 5, moped 3, bicycle 0
 /// (typical 77 GHz values of the literature, rounded); any other class 10.
 double VClassRcs(const std::string& vclass);
+
+/// The longest run [s]: a day of simulated traffic (docs/scenarios.md, "Time of day").
+inline constexpr double kMaxDuration = 86400.0;
+/// The latest begin [s, SUMO time]: a year.
+inline constexpr double kMaxBegin = 365.0 * 86400.0;
 
 /// Speed band of the paper's scenarios (70-130 km/h), used to validate traffic speeds.
 inline constexpr double kMinTrafficSpeed = 0.0;

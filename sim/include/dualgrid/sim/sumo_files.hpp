@@ -10,20 +10,28 @@
 #include <string>
 #include <vector>
 
+#include "dualgrid/sim/scenario.hpp"
+
 namespace dualgrid::sim {
 
-/// The inputs of a SUMO configuration file, paths made absolute relative to its folder (as SUMO
-/// resolves them).
+/// What SUMO took from a configuration file (its own reading: ReadSumoConfig), paths absolute.
 struct SumoConfigInputs {
-  std::filesystem::path net_file;                       ///< <input><net-file>
-  std::vector<std::filesystem::path> route_files;       ///< <input><route-files>, comma-separated
-  std::vector<std::filesystem::path> additional_files;  ///< <input><additional-files>
-  std::optional<double> step_length;                    ///< <time><step-length> [s]: not used
+  std::filesystem::path net_file;                       ///< net-file
+  std::vector<std::filesystem::path> route_files;       ///< route-files
+  std::vector<std::filesystem::path> additional_files;  ///< additional-files
+  std::optional<double> step_length;                    ///< step-length [s]: not used
+  double begin = 0.0;                                   ///< begin [s, SUMO time]; SUMO's default 0
+  std::optional<double> end;                            ///< end [s, SUMO time], when given
+  std::optional<std::string> remote_port;  ///< remote-port (TraCI): never opened (libsumo)
 };
 
-/// Reads `cfg`. Throws std::invalid_argument naming the file (and line) when it cannot be read,
-/// is not XML, or names no net-file. Only the elements above are read; everything else in it is
-/// left to SUMO's defaults or the scenario (docs/scenarios.md lists what is taken).
+/// Reads `cfg` as SUMO reads it: the file is checked first (a regular file, bounded, well-formed
+/// XML: xml_scan.hpp), then `sumo -c CFG --save-configuration` (a child process, which exits
+/// without simulating) writes SUMO's own reading of every option, synonyms and attribute forms
+/// resolved, into a temporary folder that is removed. Throws std::invalid_argument naming the
+/// file (and SUMO's first error line, or the option) when it cannot be read, SUMO refuses it,
+/// it names no net-file, or a time or step length is not a number; std::runtime_error when
+/// `sumo` cannot be started.
 SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg);
 
 /// What SUMO route and additional files define, in file order (SUMO reads vehicles, flows and
@@ -33,7 +41,8 @@ struct RouteFileIndex {
   /// a flow, "FLOW.k".
   struct Vehicle {
     std::string id;
-    double depart = 0.0;  ///< [s]; flows: their begin
+    double depart = 0.0;  ///< [s, SUMO time] (0 when not a number: "triggered", ...)
+    bool timed = false;   ///< `depart` is a number of seconds
     std::string file;
   };
   struct Flow {
@@ -41,7 +50,9 @@ struct RouteFileIndex {
     /// Members SUMO will create when the flow says (number, or end with period / vehsPerHour);
     /// std::nullopt when it depends on chance or on the run (probability, no end).
     std::optional<long> members;
-    double begin = 0.0;  ///< [s]
+    double begin = 0.0;            ///< [s, SUMO time]
+    std::optional<double> end;     ///< [s, SUMO time] when given
+    std::optional<double> period;  ///< [s] between members (period, or 3600 / vehsPerHour)
     std::string file;
   };
   std::vector<Vehicle> vehicles;  ///< <vehicle> and <trip>
@@ -70,6 +81,11 @@ RouteFileIndex IndexRouteFiles(const std::vector<std::string>& route_files,
 /// trip, or FLOW.k with k a member the flow creates); otherwise why not, in words that fit after
 /// "'ID' ", e.g. "is a vType, not a vehicle", "is a flow: its vehicles are 'f.0', 'f.1', ...".
 std::optional<std::string> VehicleIdProblem(const RouteFileIndex& index, const std::string& id);
+
+/// When SUMO departs the vehicle `id` of these files in a run that begins at `begin` [s, SUMO
+/// time], as ScenarioSpec::ego_departure records it; std::nullopt when the files do not say (a
+/// departure that is not a number, a flow without a period).
+std::optional<FileDeparture> DepartureOf(const RouteFileIndex& index, const std::string& id);
 
 /// Up to `n` ids that VehicleIdProblem accepts, in departure order, quoted and comma-separated
 /// ("'a', 'f.0', 'f.1'"), for error messages; "none" when the files define no vehicle.

@@ -11,6 +11,9 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
+#include "dualgrid/sim/auto_ego.hpp"
 #include "dualgrid/sim/ground_truth.hpp"
 #include "dualgrid/sim/scenario.hpp"
 #include "dualgrid/sim/sumo_additional.hpp"
@@ -21,18 +24,31 @@ namespace dualgrid::sim {
 struct NetworkDirLocation {
   std::filesystem::path dir;
   /// "DUALGRID_NETWORK_DIR" (the environment), "installed" (share/dualgrid/networks beside the
-  /// program or library), "build tree" (the build's networks/ folder, compiled in), or "none".
+  /// program), "package" (the installed package's, compiled into a find_package(dualgrid)
+  /// consumer), "build tree" (the build's networks/ folder, compiled in), or "none".
   std::string source;
 };
 /// The first of: the environment variable DUALGRID_NETWORK_DIR; `PREFIX/share/dualgrid/networks`
 /// where PREFIX is the parent of the folder holding `anchor` (the running program by default,
-/// /proc/self/exe: an installed bin/dualgrid finds its own tree wherever it was moved); the build
-/// tree's networks/ folder compiled into this library. Only folders that exist count (the
-/// environment variable excepted: it is the user's explicit choice); source "none" with the
-/// relative path "networks" when none does.
-NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {});
-/// FindNetworkDir().dir.
-std::filesystem::path DefaultNetworkDir();
+/// /proc/self/exe: an installed bin/dualgrid finds its own tree wherever it was moved);
+/// `package_dir` when given (then nothing else is looked at: a consumer of the installed package
+/// never uses a build tree); the build tree's networks/ folder compiled into this library. Only
+/// folders that exist count, except the environment variable and `package_dir` (explicit
+/// choices: a missing one is named by the error of the first network looked up in it); source
+/// "none" with the relative path "networks" when none does. Never throws.
+NetworkDirLocation FindNetworkDir(const std::filesystem::path& anchor = {},
+                                  const std::filesystem::path& package_dir = {});
+/// FindNetworkDir().dir; in a program built against the installed package (find_package(dualgrid)
+/// defines DUALGRID_PACKAGE_NETWORK_DIR for it), the package's networks. Never throws: a folder
+/// without the network asked for is an std::invalid_argument of CoSimulation::Start
+/// (ResolveNetwork) naming the folder and DUALGRID_NETWORK_DIR.
+inline std::filesystem::path DefaultNetworkDir() {
+#ifdef DUALGRID_PACKAGE_NETWORK_DIR
+  return FindNetworkDir({}, DUALGRID_PACKAGE_NETWORK_DIR).dir;
+#else
+  return FindNetworkDir().dir;
+#endif
+}
 
 /// True when a scenario's `network` is a file path (it ends in .xml or .xml.gz, or has a '/'),
 /// false for the name of a built network ("highway").
@@ -45,6 +61,9 @@ bool IsNetworkPath(const std::string& network);
 std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir);
 
+/// "SUMO time [B, E] s (run time [0, D] s)": the run's window on both clocks, for messages.
+std::string RunWindow(const ScenarioSpec& spec);
+
 /// Writes the SUMO route file (vTypes, routes, vehicles, flows) for a scenario.
 void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path);
 
@@ -52,16 +71,24 @@ class SumoSimulation {
  public:
   /// Starts SUMO. `work_dir` receives the generated route file, SUMO's message log, the copies of
   /// additional files that declare outputs (sumo_additional/) and those outputs (sumo_outputs/).
-  /// With `ego: {from_routes: auto}` a first run of SUMO over the duration chooses the ego
-  /// (docs/scenarios.md). Throws std::invalid_argument with a one-line message for input SUMO
-  /// refuses, std::runtime_error when a file cannot be written.
+  /// SUMO starts at spec.begin (SUMO time) and runs spec.duration. With `ego: {from_routes:
+  /// auto}` a first run of SUMO over that window chooses the ego (auto_ego.hpp,
+  /// docs/scenarios.md); it throws std::invalid_argument when no vehicle departs in the window.
+  /// Throws std::invalid_argument with a one-line message for input SUMO refuses,
+  /// std::runtime_error when a file cannot be written.
   SumoSimulation(const ScenarioSpec& spec, const std::filesystem::path& network_file,
                  const std::filesystem::path& work_dir);
   ~SumoSimulation();
   SumoSimulation(const SumoSimulation&) = delete;
   SumoSimulation& operator=(const SumoSimulation&) = delete;
 
-  /// Advances one step (spec.step_length) and refreshes frame(). Returns false once the scenario
+  /// With `ego: {from_routes: auto}`: the first run's choice and its reason (auto_ego.hpp).
+  const std::optional<AutoEgoChoice>& auto_ego_choice() const { return auto_choice_; }
+  /// "SUMO time T s (run time T - begin s)", for messages.
+  std::string Clock(double sumo_time) const;
+
+  /// Advances one step (spec.step_length) and refreshes frame(); frame().time is run time [s
+  /// since spec.begin]. Returns false once the scenario
   /// duration is reached or the ego has left the network.
   bool Step();
   /// Ends SUMO, which then writes out the outputs of the additional files; frame(), ego_id()
@@ -110,6 +137,7 @@ class SumoSimulation {
   bool ego_left_ = false;
   bool closed_ = false;
   std::vector<RedirectedOutput> redirected_outputs_;
+  std::optional<AutoEgoChoice> auto_choice_;
   std::size_t next_action_ = 0;
   std::map<std::string, LaneGeometry> lanes_;
   std::map<std::string, double> previous_yaw_;

@@ -1,0 +1,50 @@
+// The run folder as a whole (docs/output.md): made empty for a run, marked as dualgrid's, its
+// files' digests and the record of how the run ended (both in summary.json, written last).
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "dualgrid/cosim/cosimulation.hpp"
+
+namespace dualgrid::outputs {
+
+/// Marks a folder as dualgrid's own, written first into every output folder.
+inline constexpr const char* kRunMarker = ".dualgrid-run";
+
+/// Makes `out` an empty folder for a new run, so that no folder ever mixes two runs' files:
+/// creates it if missing; keeps it if empty; empties it if it holds an earlier dualgrid output
+/// (it has the marker kRunMarker, a summary.json or a config.json); otherwise throws
+/// std::invalid_argument (a folder of other files is never cleared). The earlier completion
+/// record goes first, so a run killed while clearing never looks finished. Then writes the
+/// marker.
+void PrepareOutputFolder(const std::filesystem::path& out);
+
+/// Test hook (docs/reliability.md): true when the environment variable DUALGRID_FAULT lists
+/// `what` (comma-separated), e.g. DUALGRID_FAULT=figure:tracked_share.png,run-seed:2. Lets the
+/// tests make one figure or one seed run fail on purpose; unset in normal use.
+bool FaultInjected(const std::string& what);
+
+/// Digests of every file under `dir` (relative path -> 16 hex digits, FNV-1a 64 over the bytes:
+/// a change detector, not a cryptographic hash), except summary.json, which holds them, SUMO's
+/// own sumo.log and the seed runs' logs (*.log). Everything else a run writes is a function of the
+/// scenario and the seed alone (wall-clock times live only in summary.json), so equal digests
+/// mean equal outputs, whatever the thread count.
+nlohmann::json OutputDigests(const std::filesystem::path& dir);
+
+/// After Start(): the note naming the vehicle that `ego: {from_routes: auto}` chose; "" when the
+/// ego was named.
+std::string AutoEgoNote(const cosim::Pipeline& pipeline);
+
+/// How a co-simulation ended, for summary.json and the one-line note: `complete` (no signal came
+/// and SUMO reached the duration or the ego left the network: the scenario's own end), `end`
+/// ("duration", "ego_left", "signal"), `ego` (its id: the scenario's, or the one `auto` chose),
+/// `ego_departed_s` and `ended_s` (SUMO's time at the first and last frame [s]), `sumo_outputs`
+/// (the outputs the additional files declare: file, element, attribute, original value, path
+/// written). `status` receives the note ("" for a run that reached the duration): why it ended
+/// otherwise, in one line.
+nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status);
+
+}  // namespace dualgrid::outputs

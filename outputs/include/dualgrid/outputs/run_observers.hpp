@@ -1,0 +1,114 @@
+// What a run does after each co-simulation step, as cosim::StepObserver hooks: the CSV files, the
+// weight traces, the replay recording, the invariant checks and the pictures. Each owns its
+// files; WriteRunFolder (run.hpp) wires them to the CoSimulation.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/outputs/capture.hpp"
+#include "dualgrid/outputs/csv_writers.hpp"
+#include "dualgrid/outputs/recording.hpp"
+#include "dualgrid/outputs/run.hpp"
+#include "dualgrid/outputs/weight_traces.hpp"
+
+namespace dualgrid::outputs {
+
+/// ground_truth.csv, grid.csv, detections (optional; with `exact` also scans.csv), clusters.csv,
+/// and the weight traces of one mode.
+class RunFilesObserver : public cosim::StepObserver {
+ public:
+  /// `detections`: the file for --detections, none if empty; `multipath`: the scenario's
+  /// sensors.multipath is on (the detections get their path columns). `trace_mode`: the mode
+  /// whose particles give the weight traces (paper Fig. 4); `focus`: the scenario's focus object.
+  RunFilesObserver(const std::filesystem::path& out,
+                   const std::optional<std::filesystem::path>& detections, bool multipath,
+                   std::size_t trace_mode, const std::string& focus, bool exact = false);
+  void OnStep(const cosim::StepView& v) override;
+  /// Checks every write (throws std::runtime_error naming the file).
+  void Close();
+  const WeightTraces& traces() const { return traces_; }
+
+ private:
+  GroundTruthWriter truth_;
+  GridPoseWriter grid_;
+  std::unique_ptr<DetectionWriter> detections_;
+  std::unique_ptr<ScanWriter> scans_;  // with --detections exact
+  ClusterWriter clusters_;
+  std::size_t trace_mode_;
+  WeightTraces traces_;
+};
+
+/// The replay recording (RUN_DIR/replay/, docs/replay.md): a frame every `interval` steps and at
+/// the last one. A failed write stops the recording with a warning, never the run.
+class RecordingObserver : public cosim::StepObserver {
+ public:
+  RecordingObserver(const std::filesystem::path& out, const scenario::ScenarioConfig& config,
+                    double interval_s, int max_particles, std::vector<std::string>* warnings);
+  bool WantsVelocities(int step, double time) override;
+  void OnStep(const cosim::StepView& v) override;
+  /// Writes the index (the recording is usable only then); a failure costs only the replay.
+  /// False when there is no recording to finish.
+  bool Finish(const nlohmann::json& metrics, const cosim::IdRegistry& ids, bool complete,
+              const std::string& status);
+
+ private:
+  bool Due(int step) const;
+
+  std::filesystem::path out_;
+  int every_ = 1;
+  int step_count_ = 0;
+  int max_particles_ = 0;
+  std::vector<std::string>* warnings_;
+  std::unique_ptr<replay::Writer> writer_;
+  bool failed_ = false;
+  replay::Header header_;
+  std::vector<replay::LiveCounter> counters_;
+  std::vector<replay::Live> live_;
+  std::set<int> ids_;
+};
+
+/// --check-invariants: every filter's invariants after every step (a violation throws
+/// std::logic_error: exit 1), and the resident memory every 60 s simulated.
+class InvariantObserver : public cosim::StepObserver {
+ public:
+  explicit InvariantObserver(double step_length) : step_length_(step_length) {}
+  void OnStep(const cosim::StepView& v) override;
+  /// [time s, resident MB] samples, the last at `end_time`.
+  nlohmann::json Samples(double end_time) const;
+
+ private:
+  double step_length_;
+  nlohmann::json rss_mb_ = nlohmann::json::array();
+};
+
+/// The grid and scene pictures (and with --write-particles the particle files) at the picture
+/// times. Figures never cost the run: a failure is a warning.
+class PictureObserver : public cosim::StepObserver {
+ public:
+  PictureObserver(const std::filesystem::path& out, std::vector<double> times,
+                  const RunFolderOptions& options, std::vector<std::string>* warnings);
+  bool WantsVelocities(int step, double time) override;
+  void OnStep(const cosim::StepView& v) override;
+
+ private:
+  std::filesystem::path out_;
+  std::vector<double> times_;
+  std::size_t next_ = 0;
+  bool picture_ = false;  // this step is a picture step (decided in WantsVelocities)
+  bool figures_, particles_;
+  std::vector<std::string> formats_;
+  bool captions_;
+  std::vector<std::string>* warnings_;
+};
+
+/// Resident memory of this process [MB] (/proc/self/statm), 0 if unreadable.
+double ResidentMegabytes();
+
+}  // namespace dualgrid::outputs

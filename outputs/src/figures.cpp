@@ -1,0 +1,305 @@
+#include "dualgrid/outputs/figures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/run_folder.hpp"
+#include "dualgrid/viz/birds_eye_view.hpp"
+#include "dualgrid/viz/charts.hpp"
+#include "dualgrid/viz/grid_panels.hpp"
+
+namespace dualgrid::outputs {
+
+bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
+               std::vector<std::string>* warnings) {
+  try {
+    if (FaultInjected("figure:" + path.filename().string()))
+      throw std::runtime_error("injected fault (DUALGRID_FAULT)");
+    draw();
+    return true;
+  } catch (const std::exception& e) {
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    const std::string warning = "figure " + path.string() + " not drawn: " + what;
+    std::cerr << "dualgrid: warning: " << warning << "\n";
+    if (warnings) warnings->push_back(warning);
+    return false;
+  }
+}
+
+namespace {
+
+// The caption's sentence on the axes of a picture in the grid frame, relative to the ego.
+std::string AxesNote(const GridFrame& g) {
+  return "Axes: metres from the ego along the grid frame's axes (" +
+         (g.identity()
+              ? std::string("here world east and north")
+              : "x axis at " + FormatFixed(RadToDeg(g.yaw()), 0) + " deg from world east") +
+         ").";
+}
+
+// One arrow length for vehicles and detections: the two kinds of arrow compare directly.
+constexpr double kArrowSeconds = 0.5;
+
+}  // namespace
+
+bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::string>& formats,
+                const std::function<void(const std::filesystem::path&)>& draw,
+                std::vector<std::string>* warnings) {
+  bool all = true;
+  for (const std::string& format : formats) {
+    std::filesystem::path path = png_path;
+    path.replace_extension("." + format);
+    all = TryFigure(
+              path, [&] { draw(path); }, warnings) &&
+          all;
+  }
+  return all;
+}
+
+void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
+                 double ahead, double half_width, bool captions) {
+  const sim::Frame& f = pipeline.frame();
+  const GridFrame& g = pipeline.grid_frame();
+  // Drawn relative to the ego in the grid frame, like the grid figures: the axes read as metres
+  // from the ego.
+  const Position ego = g.ToGrid(f.ego.box.center);
+  const auto rel = [&](const Position& p) { return Position(g.ToGrid(p) - ego); };
+  const auto rel_box = [&](OrientedBox b) {
+    b = g.ToGrid(b);
+    b.center -= ego;
+    return b;
+  };
+  viz::BirdsEyeOptions options;
+  options.title = pipeline.config().sim.name + ", t = " + FormatFixed(f.time, 2) +
+                  " s: radar view (" + std::to_string(pipeline.detections().size()) +
+                  " detections)";
+  options.x_label = "x from the ego [m]";
+  options.y_label = "y [m]";
+  options.caption =
+      AxesNote(g) + " Arrows: motion over ground in " + FormatFixed(kArrowSeconds, 1) +
+      " s; black: a vehicle's velocity (SUMO); coloured: a detection's radial velocity, ego "
+      "motion compensated (short where a vehicle moves across the line of sight). Colour: the "
+      "radar (field of view outline, its detections). A label that finds no free place is left "
+      "out; one set apart from its box has a leader line.";
+  if (!captions) options.caption.clear();
+  viz::BirdsEyeView view({Position(-behind, -half_width), Position(ahead, half_width)}, options);
+  auto to_rel = [&](std::vector<Position> points) {
+    for (Position& p : points) p = rel(p);
+    return points;
+  };
+  if (const sim::SumoSimulation* sumo = pipeline.sumo())  // recorded data have no lanes
+    for (const auto& lane : sumo->LaneShapes()) view.DrawLane(to_rel(lane.points), lane.width);
+  for (const auto& rail : pipeline.config().sim.guard_rails)
+    view.DrawGuardRail(to_rel(rail.points));
+  view.KeepLabelsOff(rel_box(f.ego.box));  // drawn last, on top; no label may cover it
+  for (const auto& p : pipeline.config().sim.parked) {
+    viz::VehicleStyle style;
+    style.fill = viz::colors::kGuardRail;
+    style.label = p.id;
+    style.legend = "parked";
+    view.DrawVehicle(rel_box(p.box), style);
+  }
+  const auto& radar = pipeline.radar();
+  const auto poses = radar.SensorPoses(pipeline.ego_motion().pose);
+  for (std::size_t s = 0; s < poses.size(); ++s) {
+    const auto& p = radar.sensors()[s];
+    view.DrawSensorFov({rel(poses[s].position), g.YawToGrid(poses[s].yaw), 0.5 * p.fov, p.max_range,
+                        static_cast<int>(s), p.name});
+  }
+  for (const auto& v : f.vehicles) {
+    viz::VehicleStyle style;
+    style.label = v.id;
+    style.velocity = g.VectorToGrid(v.velocity);  // over ground, as the detections' arrows
+    style.arrow_scale = kArrowSeconds;
+    view.DrawVehicle(rel_box(v.box), style);
+  }
+  viz::VehicleStyle ego_style;  // no label: the green box at the axes' origin
+  ego_style.ego = true;
+  ego_style.velocity = g.VectorToGrid(f.ego.velocity);
+  ego_style.arrow_scale = kArrowSeconds;
+  view.DrawVehicle(rel_box(f.ego.box), ego_style);
+  std::vector<viz::DetectionMark> marks;
+  for (const auto& d : pipeline.detections())
+    marks.push_back(
+        {rel(d.position_world), g.VectorToGrid(d.radial_velocity_world), d.sensor, d.is_clutter});
+  viz::DetectionStyle style;
+  style.coloring = viz::DetectionColoring::kBySensor;
+  style.arrow_scale = kArrowSeconds;
+  view.DrawDetections(marks, style);
+  view.Save(path.string());
+}
+
+namespace {
+
+viz::GridRaster ToRaster(const cosim::GridSnapshot& s) {
+  return {s.cells_x,    s.cells_y, s.resolution, s.origin, s.free,
+          s.static_occ, s.dynamic, s.mean_vx,    s.mean_vy};
+}
+
+}  // namespace
+
+void RenderGridFigure(const std::vector<std::string>& modes,
+                      const std::vector<cosim::GridSnapshot>& snapshots,
+                      const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
+                      const sim::Frame& frame, double time, const std::filesystem::path& path,
+                      bool captions) {
+  // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
+  // not with the network's (often UTM-sized) coordinates.
+  const Position ego = g.ToGrid(frame.ego.box.center);
+  const auto from_ego = [&](OrientedBox b) {
+    b.center -= ego;
+    return b;
+  };
+  std::vector<viz::GridPanel> panels;
+  for (std::size_t i = 0; i < modes.size(); ++i) {
+    viz::GridPanel panel;
+    panel.title = modes[i];
+    panel.raster = ToRaster(snapshots[i]);
+    panel.raster.origin -= ego;
+    for (const auto& v : frame.vehicles) {
+      panel.truth_boxes.push_back(from_ego(g.ToGrid(v.box)));
+      panel.truth_velocities.push_back(g.VectorToGrid(v.velocity));
+    }
+    panel.ego_boxes.push_back(from_ego(g.ToGrid(frame.ego.box)));
+    // The scorer's clusters of this step (grid frame) with their roles: what the mode tracks and
+    // at which estimated velocity.
+    const cosim::ModeScorer& sc = scorers[i];
+    for (std::size_t c = 0; c < sc.clusters().size(); ++c) {
+      const eval::Cluster& cl = sc.clusters()[c];
+      panel.clusters.push_back({cl.min - ego, cl.max - ego, cl.position - ego, cl.velocity,
+                                static_cast<int>(sc.association().role[c])});
+    }
+    panels.push_back(std::move(panel));
+  }
+  viz::GridFigureOptions options;
+  options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the caption)
+  options.y_label = "y [m]";
+  options.title = "Dynamic grids at t = " + FormatFixed(time, 2) + " s";
+  options.caption =
+      "Cells: white free, black static, grey unknown; dynamic mass in the hue of its direction "
+      "of motion over ground (the cell's mean particle velocity, grid frame: wheel), colours "
+      "blended by the cell's masses. Black outlines: ground-truth vehicle boxes (SUMO); green: "
+      "the ego. Coloured outlines: the mode's clusters of dynamic particles (blue-violet "
+      "matched to a vehicle, orange duplicate, magenta false) with their estimated velocity; "
+      "black arrows: true velocity. Arrows: motion over ground in " +
+      FormatFixed(options.arrow_seconds, 1) + " s. " + AxesNote(g);
+  if (!captions) options.caption.clear();
+  viz::RenderGridPanels(panels, path.string(), options);
+}
+
+TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,
+                               const cosim::IdRegistry& ids, bool velocity_aware) {
+  std::map<int, std::vector<double>> per_object;  // by id: order of first appearance
+  for (std::size_t m = 0; m < metrics.size(); ++m) {
+    for (const auto& o : metrics[m].objects) {
+      if (!o.scored) continue;
+      auto& row = per_object.try_emplace(o.id, metrics.size(), std::nan("")).first->second;
+      row[m] = (velocity_aware ? o.tracked_fraction_v : o.tracked_fraction).value_or(0.0);
+    }
+  }
+  TrackedShares out;
+  for (const auto& [id, row] : per_object) out.emplace_back(ids.Name(id), row);
+  return out;
+}
+
+void RenderTrackedShares(const std::vector<std::string>& modes, const TrackedShares& shares,
+                         const std::string& title, const std::string& y_label,
+                         const std::filesystem::path& path, const TrackedShares& errors,
+                         bool captions) {
+  viz::BarChart chart;  // with nothing scored (a very short run) the chart says "no data"
+  chart.title = title;
+  chart.x_label = "object (SUMO vehicle id)";
+  chart.y_label = y_label;
+  chart.percent = true;
+  // One column wide whatever the number of objects: a wider chart would need larger fonts
+  // (readability at one column) and show no more. Names turn, then thin out; value labels only
+  // where they fit their bars.
+  const bool velocity_aware = y_label.find("D_v") != std::string::npos;
+  chart.caption =
+      std::string("Bar colour: the filter's weight mode. ") +
+      (velocity_aware ? "D_v: share of an object's frames in the grid in which a cluster with the "
+                        "right velocity sits on it. "
+                      : "D: share of an object's frames in the grid in which a cluster sits on "
+                        "it. ") +
+      (errors.empty() ? "One run: no confidence interval."
+                      : "Bars: mean over the seeds; whiskers: 95 % confidence interval of the "
+                        "mean (Student t), none where fewer than two seeds scored the object.");
+  if (!captions) chart.caption.clear();
+  for (const auto& [name, row] : shares) chart.categories.push_back(name);
+  for (std::size_t m = 0; m < modes.size(); ++m) {
+    viz::BarSeries s;
+    s.name = modes[m];
+    for (const auto& [name, row] : shares) s.values.push_back(row[m]);
+    for (const auto& [name, row] : errors) s.errors.push_back(row[m]);
+    chart.series.push_back(std::move(s));
+  }
+  viz::RenderBarChart(chart, path.string());
+}
+
+void RenderWeightTrace(const WeightTrace& trace, const std::string& object, const std::string& mode,
+                       filter::VelocityLikelihood likelihood, const std::filesystem::path& path,
+                       bool captions) {
+  viz::LineChart chart;
+  // Not titled as the paper's Fig. 4: it plots another quantity (the caption compares them).
+  chart.title = "Weight shares on " + object + " (" + mode + " filter)";
+  chart.y_label =
+      "share within " + FormatFixed(WeightTrace::kGoodVelocity, 0) + " m/s [fraction of weight]";
+  chart.y_min = 0.0;
+  chart.y_max = 1.0;
+  // Not the paper's Fig. 4 quantity (one particle's weights): readers compare the two, so the
+  // caption says what is plotted and why w_velocity sits above w_position by default.
+  chart.caption =
+      "Share of each weight on " + object + " held by its particles within " +
+      FormatFixed(WeightTrace::kGoodVelocity, 0) +
+      " m/s of its true velocity. w_position scores positions only; w_velocity also scores the "
+      "Doppler. ";
+  // The explanation depends on the run's f_v (eq. (8)): say which one this run used.
+  if (likelihood == filter::VelocityLikelihood::kRadialFit)
+    chart.caption +=
+        "This run uses the radial likelihood with the Doppler fit's tangential term (the "
+        "dualgrid preset, the default): a particle with the true velocity matches the radial "
+        "speed and, where neighbouring Dopplers fix it, the tangential part, so w_velocity's "
+        "share sits at or above w_position's. The paper's Fig. 4 (w_velocity drops while the "
+        "Doppler is below the speed) is eq. (8) in its vector form (filter.preset=paper).";
+  else if (likelihood == filter::VelocityLikelihood::kRadial)
+    chart.caption +=
+        "This run uses the radial likelihood (velocity_likelihood=radial): a particle "
+        "with the true velocity always matches the radial speed, even across the line of "
+        "sight, so w_velocity's share sits at or above w_position's. The paper's Fig. 4 "
+        "(w_velocity drops while the Doppler is below the speed) is eq. (8) in its vector form "
+        "(filter.preset=paper), where that share falls near 0.";
+  else
+    chart.caption +=
+        "This run uses eq. (8) in its vector form (the paper preset): it compares the whole "
+        "velocity with the radial one, so where the Doppler is below the speed w_velocity "
+        "favours the wrong particles and its share falls, as in the paper's Fig. 4; the "
+        "default radial likelihood keeps it at or above w_position's.";
+  for (const bool v : {false, true}) {
+    viz::LineSeries s;
+    s.name = v ? "w_velocity" : "w_position";
+    s.x = trace.time;
+    s.y = v ? trace.velocity_share : trace.position_share;
+    s.color = viz::ModeColor(v ? viz::Mode::kVelocity : viz::Mode::kPosition);
+    chart.series.push_back(std::move(s));
+  }
+  // Shade where most detections see less than half of the object's speed (tangential motion).
+  std::optional<double> start;
+  for (std::size_t i = 0; i <= trace.time.size(); ++i) {
+    const bool low = i < trace.time.size() && trace.tangential_share[i] > 0.5;
+    if (low && !start) start = trace.time[i];
+    if (!low && start) {
+      chart.spans.push_back({*start, trace.time[i - 1], "Doppler < speed / 2"});
+      start.reset();
+    }
+  }
+  if (!chart.spans.empty())
+    chart.caption += " Shaded: most of the object's detections see less than half its speed.";
+  if (!captions) chart.caption.clear();
+  viz::RenderLineChart(chart, path.string());
+}
+
+}  // namespace dualgrid::outputs

@@ -1,0 +1,143 @@
+#include "dualgrid/outputs/run_folder.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <stdexcept>
+#include <vector>
+
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/outputs/output_file.hpp"
+
+namespace dualgrid::outputs {
+
+nlohmann::json OutputDigests(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files;
+  for (auto it = std::filesystem::recursive_directory_iterator(dir);
+       it != std::filesystem::recursive_directory_iterator(); ++it) {
+    // SUMO's own outputs (dated, and naming paths) and the additional files' copies (naming the
+    // run folder) are SUMO's business, not dualgrid's results.
+    const std::string name = it->path().filename().string();
+    if (it.depth() == 0 && it->is_directory() &&
+        (name == "sumo_outputs" || name == "sumo_additional")) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_regular_file()) files.push_back(it->path());
+  }
+  std::sort(files.begin(), files.end());
+  nlohmann::json digests = nlohmann::json::object();
+  std::vector<char> buf(1 << 16);
+  for (const auto& f : files) {
+    const std::string name = f.filename().string();
+    if (name == "summary.json" || name == kRunMarker || f.extension() == ".log") continue;
+    std::uint64_t h = 14695981039346656037ull;
+    std::ifstream in(f, std::ios::binary);
+    while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
+      for (std::streamsize i = 0; i < in.gcount(); ++i)
+        h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ull;
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    digests[std::filesystem::relative(f, dir).string()] = hex;
+  }
+  return digests;
+}
+
+void PrepareOutputFolder(const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out))
+    throw std::invalid_argument("--out: " + out.string() + " exists and is not a folder");
+  if (fs::exists(out, ec) && !fs::is_empty(out)) {
+    if (!fs::exists(out / kRunMarker) && !fs::exists(out / "summary.json") &&
+        !fs::exists(out / "config.json")) {
+      const std::string first = fs::directory_iterator(out)->path().filename().string();
+      throw std::invalid_argument("--out: " + out.string() +
+                                  " holds files that are not a dualgrid run (e.g. '" + first +
+                                  "'); give a new or empty folder");
+    }
+    fs::remove(out / "summary.json", ec);  // first: from here on the folder is not a finished run
+    if (ec)
+      throw std::runtime_error("cannot remove the earlier " + (out / "summary.json").string() +
+                               ": " + ec.message());
+    for (const auto& e : fs::directory_iterator(out)) {
+      fs::remove_all(e.path(), ec);
+      if (ec)
+        throw std::runtime_error("cannot clear the earlier run's " + e.path().string() + ": " +
+                                 ec.message());
+    }
+  }
+  fs::create_directories(out);
+  WriteTextFile(out / kRunMarker,
+                "This folder is written by dualgrid; a new run with this --out empties it.\n");
+}
+
+bool FaultInjected(const std::string& what) {
+  const char* env = std::getenv("DUALGRID_FAULT");
+  if (!env) return false;
+  const std::string list = std::string(",") + env + ",";
+  return list.find("," + what + ",") != std::string::npos;
+}
+
+std::string AutoEgoNote(const cosim::Pipeline& pipeline) {
+  const sim::ScenarioSpec& spec = pipeline.config().sim;
+  if (!spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return "";
+  const auto& choice = pipeline.simulation().auto_ego_choice();
+  return "ego: auto chose '" + pipeline.simulation().ego_id() + "' (" +
+         (choice ? choice->Reason() : std::string()) + "; docs/scenarios.md)";
+}
+
+nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status) {
+  const sim::ScenarioSpec& spec = cs.config().sim;
+  const bool started = cs.pipeline().started() && cs.steps() > 0;
+  const sim::SumoSimulation* sumo = started ? cs.pipeline().sumo() : nullptr;
+  const double last = started ? cs.pipeline().frame().time : 0.0;
+  const double first = started ? last - (cs.steps() - 1) * spec.step_length : 0.0;
+  // The ego leaving the network ends the scenario: the run is complete, `end` says how it ended.
+  const bool ended = cs.finished() || (sumo && sumo->ego_left());
+  nlohmann::json r = {{"complete", !stop_signal && ended},
+                      {"ego", sumo ? sumo->ego_id() : spec.ego.id},
+                      {"ego_departed_s", first},
+                      {"ended_s", last},
+                      {"begin_s", spec.begin},
+                      {"begin_source", spec.begin_source}};
+  if (!spec.network_source.empty()) r["network_source"] = spec.network_source;
+  if (const auto& choice = sumo ? sumo->auto_ego_choice() : std::nullopt)
+    r["ego_choice"] = {{"rule", "auto"},
+                       {"reason", choice->Reason()},
+                       {"seen_s", choice->seen_s},
+                       {"in_run_s", choice->in_run_s},
+                       {"depart_sumo_s", choice->depart_s},
+                       {"candidates", choice->candidates},
+                       {"with_traffic", choice->with_traffic}};
+  // Where SUMO wrote the outputs that the user's additional files declare.
+  r["sumo_outputs"] = nlohmann::json::array();
+  if (sumo)
+    for (const sim::RedirectedOutput& o : sumo->redirected_outputs())
+      r["sumo_outputs"].push_back({{"file", o.file},
+                                   {"element", o.element},
+                                   {"attribute", o.attribute},
+                                   {"original", o.original},
+                                   {"path", o.path}});
+  status->clear();
+  if (stop_signal) {
+    r["end"] = "signal";
+    *status = "Incomplete run: stopped by signal " + std::to_string(stop_signal) +
+              " at t = " + FormatFixed(last, 2) + " s of " + FormatFixed(spec.duration, 2) +
+              " s (run time; SUMO time " + FormatFixed(spec.begin + last, 2) + " s)";
+  } else if (sumo && sumo->ego_left()) {
+    r["end"] = "ego_left";
+    *status = "Shorter run than asked: the ego '" + sumo->ego_id() +
+              "' left the network at t = " + FormatFixed(last, 2) + " s of " +
+              FormatFixed(spec.duration, 2) + " s (run time; SUMO time " +
+              FormatFixed(spec.begin + last, 2) +
+              " s; its route ended there); the results cover its time in the network";
+  } else {
+    r["end"] = "duration";
+  }
+  return r;
+}
+
+}  // namespace dualgrid::outputs
