@@ -13,7 +13,11 @@ PACKAGES=(build-essential cmake pkg-config sumo sumo-tools libeigen3-dev libyaml
 # Python's standard library (tests/viz/viewer_check.py); the Python module's tests hand its
 # results to pandas (tests/python/test_run_scenario.py); the recorded-data tests write RadarScenes
 # files with h5py, independently of our own writer (tests/recorded).
-TEST_PACKAGES=(chromium python3 python3-pandas python3-h5py)
+# Python tests: mypy (the stubs), matplotlib, nbconvert and ipykernel (the notebook), venv, pip,
+# setuptools and wheel (pip install --no-build-isolation . into a venv).
+TEST_PACKAGES=(chromium python3 python3-pandas python3-h5py mypy python3-matplotlib
+               jupyter-nbconvert python3-ipykernel python3-venv python3-pip python3-setuptools
+               python3-wheel)
 BUILD_DIR=${DUALGRID_BUILD_DIR:-build}
 
 source scripts/lib/install_missing.sh

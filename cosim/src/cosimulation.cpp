@@ -48,8 +48,8 @@ bool CoSimulation::Step() {
   for (StepObserver* o : observers_)
     with_velocities = o->WantsVelocities(steps_, f.time) || with_velocities;
   FilterAndScore(with_velocities);
-  const StepView view{steps_,     f,        pipeline_, mode_names_,
-                      snapshots_, scorers_, objects_,  with_velocities};
+  const StepView view{steps_,   f,        pipeline_,      mode_names_,    snapshots_,
+                      scorers_, objects_, truth_classes_, with_velocities};
   ++steps_;
   for (StepObserver* o : observers_) o->OnStep(view);
   return true;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "dualgrid/cosim/recorded_source.hpp"
 
@@ -100,6 +102,31 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame
   return out;
 }
 
+void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint8_t> classes,
+                      const std::optional<OrientedBox>& exclude,
+                      std::vector<eval::WeightedParticle>* out) {
+  if (classes.size() != static_cast<std::size_t>(grid.cells_x()) * grid.cells_y())
+    throw std::invalid_argument("DynamicParticles: " + std::to_string(classes.size()) +
+                                " cell classes for a grid of " +
+                                std::to_string(grid.cells_x() * grid.cells_y()) + " cells");
+  const filter::ParticleSet& p = grid.weighted_particles();
+  out->clear();
+  const std::optional<BoxTest> ego = exclude ? std::optional<BoxTest>(*exclude) : std::nullopt;
+  // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
+  // visited, in the particles' order. kDynamic is ClassifyCell's first test, dynamic > threshold.
+  constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
+  grid.ForEachWeightedCellWhere(
+      classes, [](std::uint8_t c) { return c == kDynamic; },
+      [&](std::size_t, std::int64_t first, std::int64_t last) {
+        for (std::int64_t i = first; i < last; ++i) {
+          if (!(p.weight[i] > 0.0f)) continue;
+          const Position pos(p.x[i], p.y[i]);
+          if (ego && ego->Contains(pos)) continue;
+          out->push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+        }
+      });
+}
+
 ModeScorer::ModeScorer(const scenario::EvaluationConfig& config)
     : config_(config),
       clusterer_(config.dbscan, config.min_cluster_mass),
@@ -121,22 +148,7 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                         config_.dynamic_threshold, predicted_);
     classes = predicted_;
   }
-  const filter::ParticleSet& p = grid.weighted_particles();
-  dynamic_particles_.clear();
-  const BoxTest ego(ego_box);
-  // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
-  // visited, in the particles' order. kDynamic is ClassifyCell's first test, dynamic > threshold.
-  constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
-  grid.ForEachWeightedCellWhere(
-      classes, [](std::uint8_t c) { return c == kDynamic; },
-      [&](std::size_t, std::int64_t first, std::int64_t last) {
-        for (std::int64_t i = first; i < last; ++i) {
-          if (!(p.weight[i] > 0.0f)) continue;
-          const Position pos(p.x[i], p.y[i]);
-          if (ego.Contains(pos)) continue;
-          dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
-        }
-      });
+  DynamicParticles(grid, classes, ego_box, &dynamic_particles_);
   clusters_ = clusterer_.Run(dynamic_particles_);
   association_ = tracking_.AddFrame(time, clusters_, objects);
   cells_.AddFrame(classes, truth_classes, snapshot.observed);

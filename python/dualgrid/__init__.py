@@ -16,48 +16,108 @@ from +x. See docs/python.md for the API, frames and a worked example.
     grid.masses()["dynamic"]   # (cells_y, cells_x) float32
 """
 
-import numpy as _np
-
-from ._dualgrid import (
-    DynamicGrid,
-    EgoMotion,
-    FilterParams,
-    ModelOptions,
-    RadarModel,
-    Scene,
-    SensorParams,
-    __version__,
-    default_long_range_radar,
-    default_rig,
-    default_short_range_radar,
-    get_num_threads,
-    preset,
-    preset_names,
-    run_recorded,
-    read_nuscenes,
-    read_radarscenes,
-    set_num_threads,
-)
-from ._dualgrid import run_scenario as _run_scenario
-
 import os as _os
+import sys as _sys
+from typing import Any, Dict, Mapping, Optional, Sequence, Union
+
+from ._build_info import BUILT_FOR as _BUILT_FOR
+from ._build_info import BUILT_VERSION as _BUILT_VERSION
+from ._build_info import EXT_SUFFIX as _EXT_SUFFIX
 
 
-def installed_network_dir():
+def _this_interpreter() -> str:
+    return f"{_sys.executable} (Python {_sys.version.split()[0]})"
+
+
+def _built_for() -> str:
+    return f"{_BUILT_FOR} (Python {_BUILT_VERSION}, extension suffix {_EXT_SUFFIX})"
+
+
+try:
+    import numpy as _np
+    import numpy.typing as _npt
+except ImportError as _e:
+    raise ImportError(
+        f"dualgrid needs numpy, which this interpreter, {_this_interpreter()}, cannot import "
+        f"({_e}). The module was built for {_built_for()}: run that interpreter, or a virtual "
+        f"environment made from it with --system-site-packages (Debian's numpy), or rebuild for "
+        f"this one (docs/python.md, 'Installation')") from _e
+
+try:
+    from ._dualgrid import (
+        CELL_CLASSES,
+        ROLE_NAMES,
+        CoSimulation,
+        DynamicGrid,
+        EgoMotion,
+        FilterParams,
+        ModelOptions,
+        MultipathParams,
+        RadarModel,
+        RecordedSimulation,
+        Scene,
+        SensorParams,
+        Simulation,
+        Step,
+        StepGrid,
+        __version__,
+        associate,
+        classify_cells,
+        cluster_particles,
+        default_long_range_radar,
+        default_rig,
+        default_short_range_radar,
+        dynamic_particles,
+        export_radarscenes,
+        get_num_threads,
+        preset,
+        preset_names,
+        read_nuscenes,
+        read_radarscenes,
+        read_recorded,
+        run_recorded,
+        score_cells,
+        set_num_threads,
+    )
+    from ._dualgrid import run_scenario as _run_scenario
+except ImportError as _e:
+    _here = _os.path.dirname(_os.path.abspath(__file__))
+    _found = sorted(f for f in _os.listdir(_here) if f.startswith("_dualgrid"))
+    import sysconfig as _sysconfig
+    raise ImportError(
+        f"dualgrid's compiled module did not load in {_this_interpreter()}, which needs "
+        f"_dualgrid{_sysconfig.get_config_var('EXT_SUFFIX')} ({_e}). This package in {_here} "
+        f"holds {_found or 'no _dualgrid module'}, built for {_built_for()}: run that "
+        f"interpreter, or a virtual environment made from it with --system-site-packages, or "
+        f"rebuild for this one (cmake -DPython3_EXECUTABLE={_sys.executable}, or pip install "
+        f"--no-build-isolation . with it; docs/python.md, 'Installation')") from _e
+
+
+def installed_network_dir() -> Optional[str]:
     """The built SUMO networks of the installation this package belongs to.
 
-    An installed package lives in PREFIX/lib/python3/dist-packages/dualgrid; its networks in
-    PREFIX/share/dualgrid/networks. None when that folder does not exist (a build-tree package:
-    run_scenario then uses the build tree's networks, or $DUALGRID_NETWORK_DIR).
+    A package installed by pip holds them in dualgrid/networks; one installed by cmake --install
+    lives in PREFIX/lib/python3/dist-packages/dualgrid, its networks in
+    PREFIX/share/dualgrid/networks. None when neither exists (a build-tree package: run_scenario
+    then uses the build tree's networks, or $DUALGRID_NETWORK_DIR).
     """
     here = _os.path.dirname(_os.path.abspath(__file__))
     prefix = _os.path.normpath(_os.path.join(here, "..", "..", "..", ".."))
-    candidate = _os.path.join(prefix, "share", "dualgrid", "networks")
-    return candidate if _os.path.isdir(candidate) else None
+    for candidate in (_os.path.join(here, "networks"),
+                      _os.path.join(prefix, "share", "dualgrid", "networks")):
+        if _os.path.isdir(candidate):
+            return candidate
+    return None
 
 
-def run_scenario(path, seed=None, duration=None, modes=("position", "velocity", "dual"),
-                 overrides=(), network_dir=None, work_dir=None, threads=0, out=None):
+def run_scenario(path: Union[str, "_os.PathLike[str]"], seed: Optional[int] = None,
+                 duration: Optional[float] = None,
+                 modes: Sequence[str] = ("position", "velocity", "dual"),
+                 overrides: Sequence[str] = (),
+                 network_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
+                 work_dir: Optional[Union[str, "_os.PathLike[str]"]] = None,
+                 threads: int = 0,
+                 out: Optional[Union[str, "_os.PathLike[str]"]] = None) -> Dict[str, Any]:
     """Runs a scenario file as `dualgrid run` does and returns its results as a dict.
 
     The same scenario and seed give the command line's numbers (metrics, objects, clusters).
@@ -82,7 +142,9 @@ COVERAGE_COLUMNS = ("origin_x", "origin_y", "boresight", "half_fov", "min_range"
 TARGET_COLUMNS = ("id", "x", "y", "yaw", "length", "width", "vx", "vy", "yaw_rate", "rcs_dbsm")
 
 
-def detections_to_measurements(detections, ego_box=None, include_clutter=True):
+def detections_to_measurements(detections: Mapping[str, Any],
+                               ego_box: Union["EgoMotion", Sequence[float], None] = None,
+                               include_clutter: bool = True) -> "_npt.NDArray[_np.float64]":
     """The (N, 6) float64 array DynamicGrid.update() takes, from RadarModel.scan()'s dict.
 
     detections: the dict of columns of RadarModel.scan()/scan_sensor() (or a pandas.DataFrame of
@@ -120,10 +182,27 @@ def detections_to_measurements(detections, ego_box=None, include_clutter=True):
         dx, dy = cols[0] - bx, cols[1] - by
         along, across = c * dx + s * dy, -s * dx + c * dy
         keep &= ~((_np.abs(along) <= 0.5 * length) & (_np.abs(across) <= 0.5 * width))
-    return _np.column_stack(cols)[keep] if cols[0].size else _np.empty((0, 6))
+    out: "_npt.NDArray[_np.float64]" = (_np.column_stack(cols)[keep] if cols[0].size
+                                        else _np.empty((0, 6)))
+    return out
 
 
 __all__ = [
+    "MultipathParams",
+    "associate",
+    "classify_cells",
+    "cluster_particles",
+    "dynamic_particles",
+    "export_radarscenes",
+    "read_recorded",
+    "score_cells",
+    "CELL_CLASSES",
+    "CoSimulation",
+    "ROLE_NAMES",
+    "RecordedSimulation",
+    "Simulation",
+    "Step",
+    "StepGrid",
     "COVERAGE_COLUMNS",
     "DynamicGrid",
     "EgoMotion",

@@ -18,6 +18,11 @@ void BindCosim(py::module_& m);
 void BindRecorded(py::module_& m);
 /// read_nuscenes, read_radarscenes (nuscenes_bindings.cpp): recorded data as numpy columns.
 void BindNuScenes(py::module_& m);
+/// classify_cells, score_cells, dynamic_particles, cluster_particles, associate
+/// (eval_bindings.cpp).
+void BindEval(py::module_& m);
+/// CoSimulation, RecordedSimulation, Step, StepGrid (stepping_bindings.cpp, step_bindings.cpp).
+void BindStepping(py::module_& m);
 
 /// Applies the thread count chosen with dualgrid.set_num_threads (0: OpenMP's default) to the
 /// calling thread. OpenMP's thread count is per calling thread, so every call that runs a parallel

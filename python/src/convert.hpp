@@ -67,3 +67,51 @@ py::array_t<T> ToArray(const std::vector<T>& v) {
 std::string ShortRepr(py::handle obj);
 
 }  // namespace dualgrid::python
+
+namespace dualgrid::python {
+
+/// An argument a function converts itself (a table, a pose, ...), shown in signatures under
+/// Tag::name instead of pybind11's "handle" / "object"; the names are the type aliases of the
+/// stub (python/dualgrid/_dualgrid.pyi).
+template <typename Tag>
+struct Arg {
+  py::object obj;
+  operator py::handle() const { return obj; }
+};
+// A tag naming an Arg in signatures.
+#define DUALGRID_ARG_TAG(Tag, text)                                  \
+  struct Tag {                                                       \
+    static constexpr auto name = pybind11::detail::const_name(text); \
+  }
+DUALGRID_ARG_TAG(TableTag, "TableLike");
+DUALGRID_ARG_TAG(PoseTag, "PoseLike");
+DUALGRID_ARG_TAG(Vector2Tag, "Vector2Like");
+DUALGRID_ARG_TAG(ArrayTag, "ArrayLike");
+DUALGRID_ARG_TAG(EgoTag, "EgoLike");
+DUALGRID_ARG_TAG(SceneTag, "SceneLike");
+DUALGRID_ARG_TAG(PolylinesTag, "PolylinesLike");
+DUALGRID_ARG_TAG(MultipathTag, "MultipathParams | Mapping[str, Any]");
+using MultipathArg = Arg<MultipathTag>;
+using TableArg = Arg<TableTag>;
+using PolylinesArg = Arg<PolylinesTag>;
+using PoseArg = Arg<PoseTag>;
+using Vector2Arg = Arg<Vector2Tag>;
+using ArrayArg = Arg<ArrayTag>;
+using EgoArg = Arg<EgoTag>;
+using SceneArg = Arg<SceneTag>;
+
+}  // namespace dualgrid::python
+
+namespace pybind11::detail {
+template <typename Tag>
+struct type_caster<dualgrid::python::Arg<Tag>> {
+  PYBIND11_TYPE_CASTER(dualgrid::python::Arg<Tag>, Tag::name);
+  bool load(handle src, bool) {
+    value.obj = reinterpret_borrow<object>(src);
+    return true;
+  }
+  static handle cast(const dualgrid::python::Arg<Tag>& v, return_value_policy, handle) {
+    return v.obj.inc_ref();
+  }
+};
+}  // namespace pybind11::detail

@@ -5,8 +5,6 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <optional>
@@ -21,6 +19,7 @@
 #include "dualgrid/outputs/run.hpp"
 #include "dualgrid/outputs/run_config.hpp"
 #include "run_results.hpp"
+#include "run_setup.hpp"
 
 namespace dualgrid::python {
 namespace {
@@ -29,23 +28,16 @@ namespace fs = std::filesystem;
 
 // SUMO's route file and log go to `work_dir`, or a temporary folder removed afterwards.
 void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
-              std::optional<fs::path> work_dir) {
-  const fs::path work =
-      work_dir ? *work_dir
-               : fs::temp_directory_path() /
-                     ("dualgrid_py_" + std::to_string(getpid()) + "_" + cs.config().sim.name);
-  fs::create_directories(work);
+              const std::optional<fs::path>& work_dir) {
+  WorkDir work = WorkDir::Make(work_dir, cs.config().sim.name);
   {
     py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
-    cs.Start(network_dir, work);
+    cs.Start(network_dir, work.path);
     while (cs.Step()) {
     }
     cs.Finish();
   }
-  if (!work_dir) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
-  }
+  work.Remove();
 }
 
 // The run folder `out`, as `dualgrid run` writes it with its default options.
@@ -63,28 +55,16 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
                      std::optional<double> duration, const std::vector<std::string>& modes,
                      const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
                      std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out) {
-  if (duration && !(*duration > 0.0 && *duration <= 3600.0))
-    throw py::value_error("run_scenario: duration must be in (0, 3600] s, got " +
-                          std::to_string(*duration));
-  const scenario::ScenarioConfig config = outputs::LoadRunConfig(path, overrides, seed, duration);
-  cosim::CoSimOptions options;
-  options.modes.clear();
-  for (const std::string& name : modes) {
-    const auto m = filter::ParseWeightMode(name);
-    if (!m)
-      throw py::value_error("run_scenario: modes: unknown mode '" + name +
-                            "' (expected position, velocity, dual)");
-    options.modes.push_back(*m);
-  }
-  if (options.modes.empty()) throw py::value_error("run_scenario: modes must not be empty");
-  if (threads < 0) throw py::value_error("run_scenario: threads must be >= 0");
+  const scenario::ScenarioConfig config =
+      LoadRunConfig(path, seed, duration, overrides, "run_scenario");
+  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_scenario");
   if (out && work_dir)
     throw py::value_error("run_scenario: work_dir: not with out (SUMO's files go there)");
-  options.threads = threads;
+  SumoClaim sumo("run_scenario");
   cosim::CoSimulation cs(config, options);
   ClusterColumns clusters;
   cs.AddObserver(&clusters);
-  const fs::path networks = network_dir ? *network_dir : sim::DefaultNetworkDir();
+  const fs::path networks = NetworkDir(network_dir);
   if (out)
     RunToFolder(cs, config, networks, *out);
   else

@@ -16,6 +16,7 @@
 #include "convert.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/filter/params.hpp"
+#include "grid_holder.hpp"
 #include "value_class.hpp"
 
 namespace dualgrid::python {
@@ -195,25 +196,8 @@ uniform, zero_likelihood literal, velocity_likelihood vector, normalisation lite
       "Names preset() accepts.");
 }
 
-// DynamicGrid with the lock that serialises calls from different Python threads: update() runs
-// without the GIL, so another thread could otherwise read the grid while it changes.
-struct Grid {
-  Grid(const FilterParams& params, std::uint64_t seed) : grid(params, seed) {}
-  DynamicGrid grid;
-  std::mutex mutex;
-};
-
-// Runs f(grid) without the GIL under the grid's lock. f must not touch Python objects (it may
-// write into numpy buffers allocated before, which no other thread can see yet).
-template <typename F>
-auto Locked(Grid& g, F&& f) {
-  py::gil_scoped_release nogil;
-  std::lock_guard<std::mutex> lock(g.mutex);
-  return f(g.grid);
-}
-
-void Update(Grid& g, py::handle ego_pose, py::handle ego_velocity, py::handle detections,
-            py::handle coverage, double dt) {
+void Update(Grid& g, PoseArg ego_pose, Vector2Arg ego_velocity, TableArg detections,
+            TableArg coverage, double dt) {
   // All conversion (and its errors) with the GIL held, before the grid changes.
   if (!std::isfinite(dt) || dt < 0.0)
     throw py::value_error("dt: expected a finite cycle length >= 0 [s], got " + std::to_string(dt));
@@ -356,7 +340,7 @@ dt: time since the previous cycle [s], >= 0 (keyword only).
 ValueError (naming the argument) for a bad shape, a missing column or a non-finite value.)doc");
   cls.def(
       "reframe",
-      [](Grid& g, double angle, py::handle ego_position) {
+      [](Grid& g, double angle, Vector2Arg ego_position) {
         const Vector2 ego = ReadVector2(ego_position, "ego_position", "[m]");
         if (!std::isfinite(angle))
           throw py::value_error("angle: expected a finite angle [rad], got " +
@@ -424,15 +408,15 @@ normalised so that each cell's weights sum to its dynamic mass. The set the pape
       "Number of entries weighted_particles() returns.");
   cls.def(
       "cell_center",
-      [](Grid& g, int ix, int iy) -> py::object {
+      [](Grid& g, int ix, int iy) -> std::optional<std::pair<double, double>> {
         CheckIndex(g.grid, ix, iy);
         const std::optional<Position> c =
             Locked(g, [&](const DynamicGrid& grid) -> std::optional<Position> {
               if (!grid.initialized()) return std::nullopt;
               return grid.CellCenter({ix, iy});
             });
-        if (!c) return py::none();
-        return py::make_tuple(c->x(), c->y());
+        if (!c) return std::nullopt;
+        return std::make_pair(c->x(), c->y());
       },
       py::arg("ix"), py::arg("iy"),
       "Centre (x, y) [m] of cell (ix, iy); IndexError outside the grid, None before the first "

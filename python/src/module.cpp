@@ -57,4 +57,6 @@ PYBIND11_MODULE(_dualgrid, m) {
   BindCosim(m);
   BindRecorded(m);
   BindNuScenes(m);
+  BindStepping(m);
+  BindEval(m);
 }

@@ -150,7 +150,7 @@ EgoMotion ToEgo(py::handle obj, const FieldNames& names) {
 // Detections as a dict of equally long numpy columns (pandas.DataFrame(d) takes it as is).
 py::dict DetectionsDict(const std::vector<Detection>& dets) {
   const std::size_t n = dets.size();
-  std::vector<std::int32_t> sensor(n), source(n);
+  std::vector<std::int32_t> sensor(n), source(n), path(n), bounces(n), reflector(n), ghost_of(n);
   std::vector<bool> clutter(n);
   std::vector<double> range(n), azimuth(n), range_rate(n), snr(n), x(n), y(n), xe(n), ye(n), vr(n),
       vrx(n), vry(n), sx(n), sy(n);
@@ -172,6 +172,10 @@ py::dict DetectionsDict(const std::vector<Detection>& dets) {
     sy[i] = d.sensor_position_world.y();
     source[i] = d.source_id;
     clutter[i] = d.is_clutter;
+    path[i] = static_cast<std::int32_t>(d.path);
+    bounces[i] = d.bounces;
+    reflector[i] = d.reflector_id;
+    ghost_of[i] = d.ghost_of;
   }
   py::array_t<bool> is_clutter(static_cast<py::ssize_t>(n));
   for (std::size_t i = 0; i < n; ++i) is_clutter.mutable_data()[i] = clutter[i];
@@ -192,6 +196,10 @@ py::dict DetectionsDict(const std::vector<Detection>& dets) {
   out["sensor_y"] = ToArray(sy);
   out["source_id"] = ToArray(source);
   out["is_clutter"] = is_clutter;
+  out["path"] = ToArray(path);
+  out["bounces"] = ToArray(bounces);
+  out["reflector_id"] = ToArray(reflector);
+  out["ghost_of"] = ToArray(ghost_of);
   return out;
 }
 
@@ -229,7 +237,7 @@ List fields (off_boresight*) are returned as copies: assign a whole new list to 
       [](const SensorParams& p) {
         return py::make_tuple(p.mount.position.x(), p.mount.position.y(), p.mount.yaw);
       },
-      [](SensorParams& p, py::handle v) { p.mount = ReadPose(v, "mount"); },
+      [](SensorParams& p, PoseArg v) { p.mount = ReadPose(v, "mount"); },
       "Mounting pose in the ego frame (x forward, y left, origin at the ego box centre): "
       "(x, y, yaw) [m, m, rad].");
   names->push_back("mount");
@@ -309,15 +317,65 @@ ValueError on non-positive dimensions.)doc");
 }
 
 FieldNames BindEgoAndOptions(py::module_& m) {
+  using radar::MultipathParams;
+  py::class_<MultipathParams> mp(m, "MultipathParams", R"doc(
+The radar model's multipath ghosts (radar_model/.../multipath.hpp, docs/radar.md "Multipath"):
+guard rails and the long flanks of trucks as plane mirrors. Off by default (enabled=False).
+MultipathParams(enabled=True) for the defaults; ModelOptions(multipath=...).)doc");
+  auto mp_names = std::make_shared<std::vector<std::string>>();
+  Field(mp, mp_names, "enabled", &MultipathParams::enabled, "Ghosts on (False: none).");
+  Field(mp, mp_names, "rails", &MultipathParams::rails, "Guard-rail segments are mirrors.");
+  Field(mp, mp_names, "vehicles", &MultipathParams::vehicles,
+        "The long sides of boxes at least vehicle_min_length long are mirrors.");
+  Field(mp, mp_names, "rail_loss_db", &MultipathParams::rail_loss_db,
+        "Power lost per bounce off a rail [dB].");
+  Field(mp, mp_names, "vehicle_loss_db", &MultipathParams::vehicle_loss_db,
+        "Power lost per bounce off a vehicle [dB].");
+  Field(mp, mp_names, "vehicle_min_length", &MultipathParams::vehicle_min_length,
+        "Shortest box whose flanks are mirrors [m] (trucks and buses).");
+  Field(mp, mp_names, "max_bounces", &MultipathParams::max_bounces,
+        "2: the order-2 paths only; 3: also the order-3 mirror image.");
+  Field(mp, mp_names, "min_pd", &MultipathParams::min_pd,
+        "Ghost scatterers whose detection probability alone is below this are dropped [-].");
+  mp.def(
+      "is_valid", [](const MultipathParams& p) { return p.IsValid(nullptr); },
+      "True when every field is usable.");
+  mp.def(
+      "validate",
+      [](const MultipathParams& p) {
+        std::string error;
+        if (!p.IsValid(&error)) throw py::value_error("MultipathParams: " + error);
+      },
+      "Raises ValueError naming the first unusable field.");
+  AddValueProtocol(mp, mp_names, "MultipathParams");
+
   py::class_<ModelOptions> opt(m, "ModelOptions",
                                "Switches of the radar model's effects: ModelOptions(noise=True, "
-                               "false_alarms=True, occlusion=True).");
+                               "false_alarms=True, occlusion=True, multipath=MultipathParams()).");
   auto opt_names = std::make_shared<std::vector<std::string>>();
   Field(opt, opt_names, "noise", &ModelOptions::noise,
         "Measurement noise on range, azimuth, range rate.");
   Field(opt, opt_names, "false_alarms", &ModelOptions::false_alarms, "Clutter detections.");
   Field(opt, opt_names, "occlusion", &ModelOptions::occlusion,
         "Nearer boxes and rails hide scatterers behind them.");
+  opt.def_property(
+      "multipath", [](ModelOptions& o) -> MultipathParams& { return o.multipath; },
+      [](ModelOptions& o, MultipathArg v) {
+        // A MultipathParams, or its to_dict() (what pickling and to_dict() give back).
+        py::object p = py::isinstance<py::dict>(v.obj)
+                           ? py::module_::import("dualgrid._dualgrid")
+                                 .attr("MultipathParams")(**v.obj.cast<py::dict>())
+                           : v.obj;
+        if (!py::isinstance<MultipathParams>(p))
+          throw py::type_error(
+              "multipath: expected a MultipathParams or a dict of its fields, got " +
+              ShortRepr(v.obj));
+        o.multipath = p.cast<MultipathParams>();
+      },
+      py::return_value_policy::reference_internal,
+      "Multipath ghosts (MultipathParams, or a dict of its fields; off unless "
+      "multipath.enabled): options.multipath.enabled = True switches them on in place.");
+  opt_names->push_back("multipath");
   AddValueProtocol(opt, opt_names, "ModelOptions");
 
   py::class_<EgoMotion> ego(m, "EgoMotion", R"doc(
@@ -330,12 +388,12 @@ width [m] is the ego's own body, hiding what lies behind it from its sensors (0:
       [](const EgoMotion& e) {
         return py::make_tuple(e.pose.position.x(), e.pose.position.y(), e.pose.yaw);
       },
-      [](EgoMotion& e, py::handle v) { e.pose = ReadPose(v, "pose"); },
+      [](EgoMotion& e, PoseArg v) { e.pose = ReadPose(v, "pose"); },
       "(x, y, yaw) [m, m, rad] of the ego box centre, world frame.");
   ego_names->push_back("pose");
   ego.def_property(
       "velocity", [](const EgoMotion& e) { return py::make_tuple(e.velocity.x(), e.velocity.y()); },
-      [](EgoMotion& e, py::handle v) { e.velocity = ReadVector2(v, "velocity", "[m/s]"); },
+      [](EgoMotion& e, Vector2Arg v) { e.velocity = ReadVector2(v, "velocity", "[m/s]"); },
       "(vx, vy) [m/s] of the box centre over ground, world frame.");
   ego_names->push_back("velocity");
   Field(ego, ego_names, "yaw_rate", &EgoMotion::yaw_rate, "[rad/s]");
@@ -359,7 +417,7 @@ polylines: guard rails, a list of dicts {"id": int, "points": (P, 2) array [m] w
   "rcs_dbsm_per_metre": float [dBsm/m], default -5}.
 Ids must be unique across targets and polylines (they become the detections' source_id). The ego
 must not be part of the scene. ValueError names the argument and row of bad input.)doc");
-  cls.def(py::init([](py::handle targets, py::handle polylines) {
+  cls.def(py::init([](TableArg targets, PolylinesArg polylines) {
             return ReadScene(targets, polylines);
           }),
           py::arg("targets") = py::none(), py::arg("polylines") = py::none());
@@ -421,8 +479,10 @@ Detections come back as a dict of equally long numpy columns (pandas.DataFrame(d
   measured, relative to the moving sensor], snr_db [dB, noise-free SNR of the resolution cell],
   x, y [m, world], x_ego, y_ego [m, ego frame], radial_speed_compensated [m/s, over ground],
   v_rx, v_ry [m/s, radial_speed_compensated times the world line of sight: paper eq. (1)],
-  sensor_x, sensor_y [m, world], source_id (int32, target / polyline id, -1 for clutter),
-  is_clutter (bool).
+  sensor_x, sensor_y [m, world], source_id (int32, target / polyline id, -1 for clutter and
+  ghosts), is_clutter (bool), and the multipath labels (ModelOptions.multipath): path (int32, 0
+  direct, 1 type 1, 2 type 2), bounces (1 direct, 2 or 3), reflector_id (the mirror's id, -1
+  direct), ghost_of (the real object's id, -1 direct).
 detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)doc");
   cls.def(py::init([](std::vector<SensorParams> sensors, const ModelOptions& options,
                       std::uint64_t seed) {
@@ -438,7 +498,7 @@ detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)
   cls.def("__len__", [](const Radar& r) { return r.model.sensors().size(); });
   cls.def(
       "sensor_pose",
-      [](const Radar& r, int sensor, py::handle ego_pose) {
+      [](const Radar& r, int sensor, PoseArg ego_pose) {
         CheckSensorIndex(r, sensor);
         const Pose2 p = r.model.SensorPose(sensor, ReadPose(ego_pose, "ego_pose"));
         return py::make_tuple(p.position.x(), p.position.y(), p.yaw);
@@ -456,7 +516,7 @@ detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)
       "`step_length` [s] (each fires when a multiple of its update_period falls in the step).");
   cls.def(
       "coverage",
-      [](const Radar& r, py::handle ego_pose, std::optional<std::vector<int>> sensors) {
+      [](const Radar& r, PoseArg ego_pose, std::optional<std::vector<int>> sensors) {
         const Pose2 pose = ReadPose(ego_pose, "ego_pose");
         std::vector<int> which = sensors ? *sensors : std::vector<int>();
         if (!sensors)
@@ -483,7 +543,7 @@ streams. ego: an EgoMotion or a dict of its fields; scene: a Scene or a dict {ta
 Returns the dict of columns described in the class docstring.)doc";
   cls.def(
       "scan",
-      [ego_names](const Radar& r, py::handle ego, py::handle scene, std::uint64_t step, double time,
+      [ego_names](const Radar& r, EgoArg ego, SceneArg scene, std::uint64_t step, double time,
                   double step_length) {
         CheckTime(time, step_length);
         const EgoMotion e = ToEgo(ego, ego_names);
@@ -500,8 +560,7 @@ Returns the dict of columns described in the class docstring.)doc";
       py::arg("step_length") = 0.05, scan_doc);
   cls.def(
       "scan_sensor",
-      [ego_names](const Radar& r, int sensor, py::handle ego, py::handle scene,
-                  std::uint64_t step) {
+      [ego_names](const Radar& r, int sensor, EgoArg ego, SceneArg scene, std::uint64_t step) {
         CheckSensorIndex(r, sensor);
         const EgoMotion e = ToEgo(ego, ego_names);
         const Scene s = ToScene(scene);

@@ -1,9 +1,11 @@
 // run_recorded: the filters of each mode on a recorded sequence (a RadarScenes sequence folder
 // or a run folder recorded with --detections exact), as `dualgrid filter` runs them; the same
 // result dict as run_scenario.
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -11,9 +13,13 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
+#include "dualgrid/recorded/run_folder.hpp"
 #include "run_results.hpp"
+#include "run_setup.hpp"
 
 namespace dualgrid::python {
 namespace {
@@ -24,36 +30,13 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
                      std::optional<fs::path> scenario_file,
                      const std::vector<std::string>& overrides, std::optional<std::uint64_t> seed,
                      const std::vector<std::string>& modes, double batch_window, int threads) {
-  scenario::ScenarioConfig config;
-  if (scenario_file) {
-    std::vector<scenario::Override> sets;
-    for (const std::string& s : overrides) sets.push_back(scenario::ParseOverride(s));
-    config = scenario::LoadScenario(*scenario_file, sets);
-    config.filter.cycle = config.sim.step_length;  // its factors are per its step
-  } else {
-    if (!overrides.empty()) throw py::value_error("run_recorded: overrides need a scenario file");
-    config = cosim::DefaultRecordedConfig();
-  }
-  if (seed) config.sim.seed = *seed;
-  if (!(batch_window >= 0.0 && batch_window <= 1.0))
-    throw py::value_error("run_recorded: batch_window must be in [0, 1] s");
-  cosim::CoSimOptions options;
-  options.modes.clear();
-  for (const std::string& name : modes) {
-    const auto m = filter::ParseWeightMode(name);
-    if (!m)
-      throw py::value_error("run_recorded: modes: unknown mode '" + name +
-                            "' (expected position, velocity, dual)");
-    options.modes.push_back(*m);
-  }
-  if (options.modes.empty()) throw py::value_error("run_recorded: modes must not be empty");
-  if (threads < 0) throw py::value_error("run_recorded: threads must be >= 0");
-  options.threads = threads;
-  const recorded::RecordedInput in = recorded::ReadRecordedInput(path, sensors);
-  const cosim::RecordedOptions ropts = cosim::FitConfig(in.sequence, batch_window, &config);
-  cosim::CoSimulation cs(config, options, [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
-    return std::make_unique<cosim::RecordedSource>(in.sequence, ropts);
-  });
+  const RecordedSetup setup =
+      LoadRecorded(path, sensors, scenario_file, overrides, seed, batch_window, "run_recorded");
+  const cosim::CoSimOptions options = RunOptions(modes, threads, "run_recorded");
+  cosim::CoSimulation cs(
+      setup.config, options, [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
+        return std::make_unique<cosim::RecordedSource>(setup.input.sequence, setup.options);
+      });
   ClusterColumns clusters;
   {
     py::gil_scoped_release release;
@@ -63,22 +46,156 @@ py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
     }
     cs.Finish();
   }
-  py::dict r = Results(cs, config, clusters);
-  py::dict input;
-  input["kind"] = in.radarscenes ? "radarscenes" : "run";
-  input["sequence"] = in.sequence.name;
-  input["scans"] = in.sequence.scans.size();
-  input["detections"] = in.sequence.points.size();
-  input["skipped_detections"] = in.sequence.skipped_points;
-  input["labels"] = in.sequence.has_labels;
-  input["tracks"] = in.sequence.track_names.size();
-  r["input"] = input;
+  py::dict r = Results(cs, setup.config, clusters);
+  r["input"] = RecordedInputInfo(setup.input);
   return r;
+}
+
+// The points of a recorded sequence as numpy columns, one row per detection, with its scan's
+// time, sensor and ego state broadcast.
+py::dict PointColumns(const cosim::RecordedSequence& seq) {
+  const std::size_t n = seq.points.size();
+  std::vector<std::int64_t> ts(n);
+  std::vector<int> scan(n), sensor(n), label(n), track(n);
+  std::vector<double> time(n), range(n), azimuth(n), rr(n), vr(n), rcs(n), x(n), y(n);
+  for (std::size_t s = 0; s < seq.scans.size(); ++s) {
+    const cosim::RecordedScan& sc = seq.scans[s];
+    for (std::size_t i = sc.begin; i < sc.end; ++i) {
+      const cosim::RecordedPoint& p = seq.points[i];
+      ts[i] = sc.timestamp_us;
+      time[i] = seq.Time(sc.timestamp_us);
+      scan[i] = static_cast<int>(s);
+      sensor[i] = sc.sensor;
+      range[i] = p.range;
+      azimuth[i] = p.azimuth;
+      rr[i] = p.range_rate;
+      vr[i] = p.radial_speed;
+      rcs[i] = p.rcs;
+      x[i] = p.position.x();
+      y[i] = p.position.y();
+      label[i] = p.label;
+      track[i] = p.track;
+    }
+  }
+  py::dict d;
+  d["timestamp_us"] = ToArray(ts);
+  d["time"] = ToArray(time);
+  d["scan"] = ToArray(scan);
+  d["sensor"] = ToArray(sensor);
+  d["range"] = ToArray(range);
+  d["azimuth"] = ToArray(azimuth);
+  d["range_rate"] = ToArray(rr);
+  d["radial_speed"] = ToArray(vr);
+  d["rcs"] = ToArray(rcs);
+  d["x"] = ToArray(x);
+  d["y"] = ToArray(y);
+  d["label"] = ToArray(label);
+  d["track"] = ToArray(track);
+  return d;
+}
+
+py::dict ScanColumns(const cosim::RecordedSequence& seq) {
+  const std::size_t n = seq.scans.size();
+  std::vector<std::int64_t> ts(n);
+  std::vector<int> sensor(n), first(n), count(n);
+  std::vector<double> time(n), ex(n), ey(n), eyaw(n), evx(n), evy(n), erate(n), lane(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    const cosim::RecordedScan& sc = seq.scans[s];
+    ts[s] = sc.timestamp_us;
+    time[s] = seq.Time(sc.timestamp_us);
+    sensor[s] = sc.sensor;
+    first[s] = static_cast<int>(sc.begin);
+    count[s] = static_cast<int>(sc.end - sc.begin);
+    ex[s] = sc.ego_pose.position.x();
+    ey[s] = sc.ego_pose.position.y();
+    eyaw[s] = sc.ego_pose.yaw;
+    evx[s] = sc.ego_velocity.x();
+    evy[s] = sc.ego_velocity.y();
+    erate[s] = sc.ego_yaw_rate;
+    lane[s] = sc.lane_yaw;
+  }
+  py::dict d;
+  d["timestamp_us"] = ToArray(ts);
+  d["time"] = ToArray(time);
+  d["sensor"] = ToArray(sensor);
+  d["first_point"] = ToArray(first);
+  d["points"] = ToArray(count);
+  d["ego_x"] = ToArray(ex);
+  d["ego_y"] = ToArray(ey);
+  d["ego_yaw"] = ToArray(eyaw);
+  d["ego_vx"] = ToArray(evx);
+  d["ego_vy"] = ToArray(evy);
+  d["ego_yaw_rate"] = ToArray(erate);
+  d["lane_yaw"] = ToArray(lane);
+  return d;
+}
+
+py::dict ReadRecorded(const fs::path& path, std::optional<fs::path> sensors) {
+  const recorded::RecordedInput in = recorded::ReadRecordedInput(path, sensors);
+  const cosim::RecordedSequence& seq = in.sequence;
+  py::dict r;
+  r["kind"] = in.radarscenes ? "radarscenes" : "run";
+  r["name"] = seq.name;
+  r["points"] = PointColumns(seq);
+  r["scans"] = ScanColumns(seq);
+  r["sensors"] = py::cast(seq.sensors);
+  r["track_names"] = py::cast(seq.track_names);
+  r["labels"] = seq.has_labels;
+  r["ego_length"] = seq.ego_length;
+  r["ego_width"] = seq.ego_width;
+  r["time_origin_us"] = seq.time_origin_us;
+  r["skipped_points"] = seq.skipped_points;
+  return r;
+}
+
+// `dualgrid export`'s job: a run folder (recorded with --detections exact) as a RadarScenes
+// dataset root. Returns the sequence folder written.
+std::string ExportRadarScenes(const fs::path& run_dir, const fs::path& out,
+                              const std::string& sequence) {
+  if (sequence.empty() || sequence.find('/') != std::string::npos)
+    throw py::value_error("export_radarscenes: sequence must be a folder name, got '" + sequence +
+                          "'");
+  std::error_code ec;
+  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
+    throw py::value_error("export_radarscenes: out " + out.string() +
+                          " exists and is not an empty folder");
+  cosim::RecordedSequence seq = recorded::ReadRunFolder(run_dir);
+  seq.name = sequence;
+  // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end, as `dualgrid export`.
+  const double rear_axle = std::max(0.0, 0.5 * seq.ego_length - 1.0);
+  {
+    py::gil_scoped_release nogil;
+    recorded::WriteRadarScenes(seq, out, rear_axle);
+  }
+  return (out / "data" / sequence).string();
 }
 
 }  // namespace
 
 void BindRecorded(py::module_& m) {
+  m.def("export_radarscenes", &ExportRadarScenes, py::arg("run_dir"), py::arg("out"),
+        py::arg("sequence") = "sequence_1",
+        R"doc(Writes a run folder (of `dualgrid run` or `sim` with --detections exact) as a
+RadarScenes dataset root `out` (sensors.json, sequences.json, data/<sequence>/scenes.json and
+radar_data.h5), as `dualgrid export` does; read_recorded() and run_recorded() read it back.
+`out` must not exist or be empty. Returns the sequence folder. ValueError for bad input (the
+file and field), RuntimeError naming the file when a write fails.)doc");
+  m.def("read_recorded", &ReadRecorded, py::arg("path"), py::arg("sensors") = py::none(),
+        R"doc(Reads a recorded sequence without filtering it: a RadarScenes sequence folder
+(scenes.json, radar_data.h5; sensors: its sensors.json, default the dataset root's) or a run
+folder recorded with --detections exact, as `dualgrid filter` reads it (docs/recorded-data.md).
+
+Returns a dict: kind ("radarscenes" or "run"), name, points (numpy columns, one row per
+detection: timestamp_us, time [s since time_origin_us], scan (row of scans), sensor (index into
+sensors), range [m], azimuth [rad, sensor frame], range_rate [m/s, uncompensated],
+radial_speed [m/s, ego-motion compensated], rcs [dBsm], x, y [m, the sequence's world frame],
+label (RadarScenes label_id, -1 none), track (index into track_names, -1 none)), scans (one row
+per sensor scan: timestamp_us, time, sensor, first_point, points, ego_x, ego_y [m], ego_yaw
+[rad], ego_vx, ego_vy [m/s], ego_yaw_rate [rad/s], lane_yaw [rad]: the ego's box centre),
+sensors (SensorParams, mounted on the ego's box centre), track_names, labels (bool), ego_length,
+ego_width [m], time_origin_us, skipped_points (detections with a NaN position or velocity, which
+the reader drops). pandas.DataFrame(r["points"]) takes the columns. ValueError naming the file
+and field for bad input.)doc");
   m.def("run_recorded", &RunRecorded, py::arg("path"), py::arg("sensors") = py::none(),
         py::arg("scenario") = py::none(), py::arg("overrides") = std::vector<std::string>{},
         py::arg("seed") = py::none(),

@@ -55,13 +55,19 @@ void AddValueProtocol(py::class_<T>& cls, const FieldNames& names, const char* t
           }),
           "Defaults of the C++ struct, then every keyword set as a field (TypeError for an "
           "unknown name, ValueError for a bad value of a checked field).");
-  const auto to_dict = [names](py::object self) {
+  const auto to_dict = [names](const T& value) {
+    // Through the Python properties (so enum fields read as their names), on a view of `value`.
+    py::object self = py::cast(&value, py::return_value_policy::reference);
     py::dict d;
-    for (const std::string& n : *names) d[py::str(n)] = self.attr(py::str(n));
+    for (const std::string& n : *names) {
+      py::object v = self.attr(py::str(n));
+      // A nested parameter struct (ModelOptions.multipath) as its own dict: plain data.
+      d[py::str(n)] = py::hasattr(v, "to_dict") ? v.attr("to_dict")() : v;
+    }
     return d;
   };
   cls.def("to_dict", to_dict, "Every field as {name: value} (a copy).");
-  cls.def("__repr__", [to_dict, type](py::object self) {
+  cls.def("__repr__", [to_dict, type](const T& self) {
     std::string s = std::string(type) + "(";
     bool first = true;
     for (auto item : to_dict(self)) {
@@ -71,15 +77,18 @@ void AddValueProtocol(py::class_<T>& cls, const FieldNames& names, const char* t
     }
     return s + ")";
   });
-  cls.def("__eq__", [to_dict](py::object self, py::object other) -> py::object {
-    if (!py::isinstance<T>(other)) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
-    return py::bool_(to_dict(self).equal(to_dict(other)));
-  });
+  cls.def(
+      "__eq__",
+      [to_dict](const T& self, py::object other) -> py::object {
+        if (!py::isinstance<T>(other)) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+        return py::bool_(to_dict(self).equal(to_dict(other.cast<const T&>())));
+      },
+      py::arg("other"));
   cls.attr("__hash__") = py::none();  // mutable
   cls.def("__copy__", [](const T& v) { return T(v); });
   cls.def(
       "__deepcopy__", [](const T& v, py::dict) { return T(v); }, py::arg("memo"));
-  cls.def(py::pickle([to_dict](py::object self) { return to_dict(self); },
+  cls.def(py::pickle([to_dict](const T& self) { return to_dict(self); },
                      [names, type](py::dict d) {
                        T value;
                        SetFields(value, d, names, type);

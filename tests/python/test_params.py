@@ -179,7 +179,31 @@ class SensorParamsTest(unittest.TestCase):
 
     def test_model_options(self):
         o = dualgrid.ModelOptions(noise=False)
-        self.assertEqual(o.to_dict(), {"noise": False, "false_alarms": True, "occlusion": True})
+        d = o.to_dict()
+        self.assertEqual(d["multipath"], dualgrid.MultipathParams().to_dict())
+        del d["multipath"]
+        self.assertEqual(d, {"noise": False, "false_alarms": True, "occlusion": True})
+
+    def test_multipath_options(self):
+        o = dualgrid.ModelOptions()
+        self.assertFalse(o.multipath.enabled)
+        o.multipath.enabled = True  # in place
+        o.multipath.max_bounces = 2
+        self.assertTrue(o.to_dict()["multipath"]["enabled"])
+        back = pickle.loads(pickle.dumps(o))
+        self.assertEqual(back, o)
+        self.assertEqual(back.multipath.max_bounces, 2)
+        self.assertEqual(dualgrid.ModelOptions(multipath={"enabled": True}).multipath,
+                         dualgrid.MultipathParams(enabled=True))
+        with self.assertRaisesRegex(TypeError, "multipath: expected a MultipathParams"):
+            dualgrid.ModelOptions(multipath=3)
+        bad = dualgrid.MultipathParams(enabled=True, max_bounces=7)
+        self.assertFalse(bad.is_valid())
+        with self.assertRaisesRegex(ValueError, "MultipathParams: max_bounces"):
+            bad.validate()
+        with self.assertRaisesRegex(ValueError, "multipath.max_bounces"):
+            dualgrid.RadarModel(dualgrid.default_rig(4.5, 1.8),
+                                options=dualgrid.ModelOptions(multipath=bad))
 
 
 if __name__ == "__main__":

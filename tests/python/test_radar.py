@@ -10,7 +10,8 @@ import dualgrid
 
 COLUMNS = [
     "sensor", "range", "azimuth", "range_rate", "snr_db", "x", "y", "x_ego", "y_ego",
-    "radial_speed_compensated", "v_rx", "v_ry", "sensor_x", "sensor_y", "source_id", "is_clutter"
+    "radial_speed_compensated", "v_rx", "v_ry", "sensor_x", "sensor_y", "source_id", "is_clutter",
+    "path", "bounces", "reflector_id", "ghost_of"
 ]
 
 EGO = dualgrid.EgoMotion(pose=(5.0, 1.0, 0.1), velocity=(10.0, 1.0), length=4.5, width=1.8)

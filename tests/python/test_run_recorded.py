@@ -12,6 +12,8 @@ import sys
 import tempfile
 import unittest
 
+import numpy as np
+
 import dualgrid
 
 SOURCE = os.environ.get("DUALGRID_SOURCE_DIR", ".")
@@ -64,11 +66,76 @@ class RunRecordedTest(unittest.TestCase):
             self.assertEqual(f"{c['x'][i]:.3f}", row["x"])
             self.assertEqual(f"{c['vy'][i]:.3f}", row["vy"])
 
+    def test_stepped_equals_run_recorded(self):
+        sim = dualgrid.RecordedSimulation(self.seq, seed=5, modes=["velocity", "dual"])
+        steps = list(sim)
+        r = sim.results()
+        self.assertEqual(len(steps), self.cli["steps"])
+        for mode in ("velocity", "dual"):
+            self.assertEqual(r["metrics"][mode], self.cli["modes"][mode], mode)
+            clusters = [c for s in steps for c in s.clusters[mode]]
+            cli = [row for row in self.cli_clusters if row["mode"] == mode]
+            self.assertEqual([f"{c['x']:.3f}" for c in clusters], [row["x"] for row in cli])
+        self.assertEqual(r["input"], self.py["input"])
+        # Labelled points come with the detections; the scans' times increase.
+        labels = np.concatenate([s.detections["label"] for s in steps])
+        self.assertGreater(np.count_nonzero(labels >= 0), 0)
+        self.assertTrue(np.all(np.diff([s.time for s in steps]) > 0))
+
+    def test_read_recorded_without_filtering(self):
+        r = dualgrid.read_recorded(self.seq)
+        pts, scans = r["points"], r["scans"]
+        self.assertEqual(r["kind"], "radarscenes")
+        self.assertEqual(len(pts["x"]), self.py["input"]["detections"])
+        self.assertEqual(len(scans["time"]), self.py["input"]["scans"])
+        self.assertEqual(int(scans["points"].sum()), len(pts["x"]))
+        self.assertEqual(len(r["track_names"]), self.py["input"]["tracks"])
+        # Every point carries its scan's time and sensor; scans in time order.
+        self.assertTrue(np.array_equal(pts["time"], scans["time"][pts["scan"]]))
+        self.assertTrue(np.array_equal(pts["sensor"], scans["sensor"][pts["scan"]]))
+        self.assertTrue(np.all(np.diff(scans["timestamp_us"]) >= 0))
+        self.assertTrue(np.all(np.isfinite(pts["x"])) and np.all(pts["range"] > 0))
+        # Labelled: moving points (labels 0..10) and their tracks; the sensors as SensorParams.
+        moving = (pts["label"] >= 0) & (pts["label"] < 11)
+        self.assertGreater(np.count_nonzero(moving), 0)
+        self.assertTrue(np.all(pts["track"][moving] >= 0))
+        self.assertTrue(all(isinstance(s, dualgrid.SensorParams) for s in r["sensors"]))
+        import pandas as pd
+        self.assertEqual(len(pd.DataFrame(pts)), len(pts["x"]))
+        with self.assertRaisesRegex(ValueError, "scenes.json"):
+            dualgrid.read_recorded(self.tmp.name)
+
     def test_bad_input_is_value_error(self):
         with self.assertRaisesRegex(ValueError, "scenes.json"):
             dualgrid.run_recorded(self.tmp.name)
         with self.assertRaisesRegex(ValueError, "unknown mode"):
             dualgrid.run_recorded(self.seq, modes=["fast"])
+
+
+class ExportTest(unittest.TestCase):
+    """export_radarscenes writes what `dualgrid export` writes: both read back the same."""
+
+    def test_export_equals_the_cli(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = os.path.join(tmp, "run")
+            subprocess.run([os.environ["DUALGRID_EXE"], "run",
+                            os.path.join(SOURCE, "scenarios", "simple_road.yaml"), "--out", run,
+                            "--duration", "2", "--modes", "dual", "--detections", "exact",
+                            "--no-figures", "--no-record", "-q"], check=True)
+            cli = os.path.join(tmp, "cli")
+            subprocess.run([os.environ["DUALGRID_EXE"], "export", run, "--out", cli, "-q"],
+                           check=True)
+            seq = dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
+            self.assertEqual(seq, os.path.join(tmp, "py", "data", "sequence_1"))
+            a = dualgrid.read_recorded(seq)
+            b = dualgrid.read_recorded(os.path.join(cli, "data", "sequence_1"))
+            self.assertGreater(len(a["points"]["x"]), 100)
+            for part in ("points", "scans"):
+                for k in a[part]:
+                    self.assertTrue(np.array_equal(a[part][k], b[part][k]), (part, k))
+            self.assertEqual(a["track_names"], b["track_names"])
+            with self.assertRaisesRegex(ValueError, "exists and is not an empty folder"):
+                dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
 
 
 if __name__ == "__main__":

@@ -52,6 +52,9 @@ struct StepView {
   const std::vector<ModeScorer>& scorers;
   /// Ground-truth objects in the grid frame, as scored (the same for every mode).
   const std::vector<eval::TruthObject>& objects;
+  /// Ground-truth eval::CellClass per cell of the grid (TruthClasses; the same geometry for every
+  /// mode, index y * cells_x + x); empty without modes.
+  const std::vector<std::uint8_t>& truth_classes;
   bool with_velocities = false;
 };
 

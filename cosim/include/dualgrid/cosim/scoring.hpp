@@ -3,6 +3,8 @@
 #pragma once
 
 #include <limits>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,16 @@ void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s);
 /// culled to the grid first.
 std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame& grid_frame,
                                        const sim::Frame& frame, const sim::ScenarioSpec& spec);
+
+/// The particles the paper clusters (Sec. V): `grid`'s weighted particles (after the weight
+/// update, before resampling; weights normalised per cell to its dynamic mass) in the cells whose
+/// `classes` entry (eval::CellClass per cell, index y * cells_x + x) is dynamic, with a positive
+/// weight and outside `exclude` (the ego's box: nothing else can be there). Grid frame. Replaces
+/// `out`'s contents, in the particles' order. Throws std::invalid_argument when classes.size()
+/// is not the grid's cell count.
+void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint8_t> classes,
+                      const std::optional<OrientedBox>& exclude,
+                      std::vector<eval::WeightedParticle>* out);
 
 class ModeScorer {
  public:
