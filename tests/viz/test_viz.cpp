@@ -602,7 +602,9 @@ TEST_CASE("Charts render degenerate inputs over generated cases", "[viz][propert
     line.log_y = trial % 3 == 0;
     const int nseries = count(rng);
     for (int i = 0; i < nseries; ++i) {
-      LineSeries s{"s" + std::to_string(i), {}, {}, {}, 2.0, i % 2 == 1, {}};
+      std::string name = "s";  // not "s" + to_string: GCC 12's false -Wrestrict
+      name += std::to_string(i);
+      LineSeries s{name, {}, {}, {}, 2.0, i % 2 == 1, {}};
       const int n = count(rng);
       const double x0 = u(rng);
       const bool errors = rng() % 3 == 0;
