@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -453,7 +454,7 @@ void SumoSimulation::ApplyDepartures() {
 }
 
 void SumoSimulation::ApplyActions() {
-  const double now = libsumo::Simulation::getTime() - spec_.begin;  // run time
+  const double now = RunTime(libsumo::Simulation::getTime());
   while (next_action_ < spec_.actions.size() && spec_.actions[next_action_].time <= now + 1e-9) {
     const ActionSpec& a = spec_.actions[next_action_++];
     const std::vector<std::string> ids = libsumo::Vehicle::getIDList();
@@ -466,8 +467,14 @@ void SumoSimulation::ApplyActions() {
   }
 }
 
+double SumoSimulation::RunTime(double sumo_time) const {
+  // SUMO counts whole milliseconds: the difference rounded to them is exact, so a run's times
+  // are the same numbers whatever its begin.
+  return std::round((sumo_time - spec_.begin) * 1000.0) / 1000.0;
+}
+
 std::string SumoSimulation::Clock(double sumo_time) const {
-  return "SUMO time " + Num(sumo_time) + " s (run time " + Num(sumo_time - spec_.begin) + " s)";
+  return "SUMO time " + Num(sumo_time) + " s (run time " + Num(RunTime(sumo_time)) + " s)";
 }
 
 bool SumoSimulation::Step() {
@@ -508,7 +515,7 @@ bool SumoSimulation::Step() {
       libsumo::Vehicle::setSpeed(spec_.ego.id, spec_.ego_speed.speed);
     Frame f;
     f.step = step_;
-    f.time = libsumo::Simulation::getTime() - spec_.begin;  // run time
+    f.time = RunTime(libsumo::Simulation::getTime());
     f.vehicles.reserve(ids.size());
     std::map<std::string, double> yaws;
     for (const std::string& id : ids) {

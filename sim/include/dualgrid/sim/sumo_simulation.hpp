@@ -84,6 +84,8 @@ class SumoSimulation {
 
   /// With `ego: {from_routes: auto}`: the first run's choice and its reason (auto_ego.hpp).
   const std::optional<AutoEgoChoice>& auto_ego_choice() const { return auto_choice_; }
+  /// Run time [s since spec.begin] of a SUMO time [s], in SUMO's whole milliseconds.
+  double RunTime(double sumo_time) const;
   /// "SUMO time T s (run time T - begin s)", for messages.
   std::string Clock(double sumo_time) const;
 
