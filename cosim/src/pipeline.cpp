@@ -118,7 +118,7 @@ void Pipeline::MakeFilters(bool cycle_is_step) {
 void Pipeline::Start(const std::filesystem::path& network_dir,
                      const std::filesystem::path& work_dir) {
   if (source_->started()) throw std::logic_error("Pipeline::Start called twice");
-  source_->Start(network_dir, work_dir);
+  source_->Start({network_dir, work_dir});
 }
 
 void Pipeline::Finish() { source_->Finish(); }

@@ -109,7 +109,7 @@ RecordedSource::RecordedSource(const RecordedSequence& sequence, RecordedOptions
 
 std::unique_ptr<DetectionSource> RecordedSource::Twin() const {
   auto twin = std::make_unique<RecordedSource>(seq_, options_);
-  twin->Start({}, {});
+  twin->Start();
   return twin;
 }
 

@@ -13,10 +13,9 @@ SumoSource::SumoSource(const scenario::ScenarioConfig& config, IdRegistry& ids) 
     static_scene_.targets.push_back({ids.Id(p.id), p.box, Velocity::Zero(), 0.0, p.rcs_dbsm});
 }
 
-void SumoSource::Start(const std::filesystem::path& network_dir,
-                       const std::filesystem::path& work_dir) {
+void SumoSource::Start(const SourceFolders& folders) {
   simulation_ = std::make_unique<sim::SumoSimulation>(
-      config_.sim, sim::ResolveNetwork(config_.sim.network, network_dir), work_dir);
+      config_.sim, sim::ResolveNetwork(config_.sim.network, folders.network_dir), folders.work_dir);
 }
 
 void SumoSource::Finish() {

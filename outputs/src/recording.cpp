@@ -69,6 +69,7 @@ json HeaderJson(const Header& h) {
             {"complete", h.complete},
             {"status", h.status}};
   if (h.multipath) j["multipath"] = true;
+  if (h.truth_label != Header{}.truth_label) j["truth_label"] = h.truth_label;
   j["parked"] = json::array();
   for (const Box& b : h.parked) j["parked"].push_back(BoxJson(b));
   j["rails"] = json::array();
@@ -235,6 +236,8 @@ Reader::Reader(const fs::path& run_dir) : dir_(run_dir / "replay") {
   h.complete = root["complete"].Flag();
   h.status = root["status"].Text();
   if (root.Has("multipath")) h.multipath = root["multipath"].Flag();
+  if (root.Has("truth_label")) h.truth_label = root["truth_label"].Text();
+  if (h.truth_label.empty()) root["truth_label"].Fail("a name");
   // What one frame inflates to must be allocatable: the video and the viewer hold one.
   const std::uint64_t cells = static_cast<std::uint64_t>(h.cells_x) * h.cells_y;
   if ((cells * 7 + 4 * static_cast<std::uint64_t>(h.max_particles)) * h.modes.size() >

@@ -66,7 +66,8 @@ struct RunObservers {
         pictures(o.out, SnapshotTimes(o.snapshots, config), o, warnings) {
     cosim.AddObserver(&files);
     if (o.record) {
-      recording.emplace(o.out, config, o.record_interval, o.record_particles, warnings);
+      recording.emplace(o.out, config, o.record_interval, o.record_particles,
+                        WordsFor(o.references).legend, warnings);
       cosim.AddObserver(&*recording);
     }
     if (o.check_invariants) {

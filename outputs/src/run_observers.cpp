@@ -53,11 +53,13 @@ void RunFilesObserver::Close() {
 
 RecordingObserver::RecordingObserver(const std::filesystem::path& out,
                                      const scenario::ScenarioConfig& config, double interval_s,
-                                     int max_particles, std::vector<std::string>* warnings)
+                                     int max_particles, std::string truth_label,
+                                     std::vector<std::string>* warnings)
     : out_(out),
       every_(std::max(1, static_cast<int>(std::lround(interval_s / config.sim.step_length)))),
       step_count_(config.sim.StepCount()),
       max_particles_(max_particles),
+      truth_label_(std::move(truth_label)),
       warnings_(warnings) {}
 
 // Every every_-th step, and the last one (a run shorter than the interval still has a frame).
@@ -83,6 +85,7 @@ void RecordingObserver::OnStep(const cosim::StepView& v) {
     if (!writer_) {
       header_ = replay::MakeHeader(v.pipeline, v.mode_names,
                                    every_ * v.pipeline.config().sim.step_length, max_particles_);
+      header_.truth_label = truth_label_;
       writer_ = std::make_unique<replay::Writer>(out_ / "replay", header_);
     }
     writer_->Add(

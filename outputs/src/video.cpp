@@ -259,6 +259,7 @@ viz::ReplayLayoutOptions Layout(const replay::Header& h, const replay::Frame& fi
   layout.panels = static_cast<int>(modes);
   if (o.detections) layout.sensors = h.sensors;
   layout.particles = o.particles;
+  layout.truth_label = h.truth_label;
   try {
     layout.Validate();
   } catch (const std::invalid_argument& e) {

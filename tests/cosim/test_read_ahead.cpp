@@ -95,7 +95,7 @@ class LyingSource : public cosim::RecordedSource {
       : RecordedSource(own, o), other_(other), options_(o) {}
   std::unique_ptr<cosim::DetectionSource> Twin() const override {
     auto twin = std::make_unique<cosim::RecordedSource>(other_, options_);
-    twin->Start({}, {});
+    twin->Start();
     return twin;
   }
 

@@ -89,8 +89,23 @@ def main():
     print(f"cycles after 1.5 s with a cluster on the car: {hits}/{len(late)} ({share:.2f})")
     if share < 0.8:
         fail(f"the car is tracked in {share:.2f} of the late cycles (>= 0.8 expected)")
+    check_replay_words(binary, out)
     check_variants(binary, work)
     subprocess.run(["rm", "-rf", work])
+
+
+def check_replay_words(binary, out):
+    """The replay names the references as the figures do: tracks estimated from labelled
+    points, never SUMO's ground truth (docs/replay.md)."""
+    index = json.load(open(os.path.join(out, "replay", "index.json")))
+    if index.get("truth_label") != "track estimate":
+        fail(f"replay/index.json truth_label: {index.get('truth_label')!r}, not 'track estimate'")
+    r = subprocess.run([binary, "replay", out, "--html", "-q"], capture_output=True, text=True)
+    if r.returncode != 0:
+        fail(f"replay --html exited {r.returncode}: {r.stderr.strip()}")
+    page = read(os.path.join(out, "replay.html"))
+    if '"truth_label":"track estimate"' not in page:
+        fail("the viewer page does not carry the recording's truth_label")
 
 
 def make(root, *extra):

@@ -6,6 +6,7 @@
 
 #include "dualgrid/scenario/aspect_case.hpp"
 #include "dualgrid/scenario/guardrail_case.hpp"
+#include "dualgrid/scenario/tangential_case.hpp"
 
 using namespace dualgrid::scenario;
 
@@ -59,4 +60,45 @@ TEST_CASE("the guard-rail case is text, and refuses traffic that never passes") 
   c = GuardRailCase{};
   c.offset = 0.5;
   CHECK_THROWS_WITH(GuardRailScenario(c), Catch::StartsWith("--offset"));
+}
+
+TEST_CASE("the crossing and parallel cases are text, with defaults by kind") {
+  TangentialCase c;  // crossing
+  CHECK(c.Speed() == 15.0);
+  CHECK(c.Spacing() == 20.0);
+  std::string text = TangentialScenario(c);
+  CHECK(text.find("network: crossing") != std::string::npos);
+  CHECK(text.find("id: cross_4") != std::string::npos);
+  CHECK(text.find("id: cross_5") == std::string::npos);
+  CHECK(text.find("focus_object: cross_1") != std::string::npos);
+  c.kind = "parallel";
+  CHECK(c.Speed() == c.ego_speed + 0.3);
+  CHECK(c.Spacing() == 40.0);
+  text = TangentialScenario(c);
+  CHECK(text.find("network: highway") != std::string::npos);
+  CHECK(text.find("id: side_4") != std::string::npos);
+  c.kind = "guardrail";  // defaults only: its text is GuardRailScenario's
+  CHECK(c.Speed() == c.ego_speed + 5.0);
+  CHECK(c.Spacing() == 50.0);
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--kind"));
+}
+
+TEST_CASE("the crossing and parallel cases name the option that cannot be built") {
+  TangentialCase c;
+  c.ego_speed = 0.0;
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--ego-speed"));
+  c = TangentialCase{};
+  c.speed = 20.0;  // 25 m of grid in 1.25 s: too short to be scored
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--speed 20.0"));
+  c = TangentialCase{};
+  c.count = 12;
+  c.spacing = 60.0;  // 30 + 11 x 60 m beyond the 600 m approach
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--first-distance"));
+  c = TangentialCase{};
+  c.kind = "parallel";
+  c.speed = c.ego_speed + 6.0;
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--speed must be within"));
+  c.speed.reset();
+  c.spacing = 30.0;  // below 18 m + 20 m/s x 1 s
+  CHECK_THROWS_WITH(TangentialScenario(c), Catch::StartsWith("--spacing must be >= 38.0"));
 }

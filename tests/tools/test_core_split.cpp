@@ -1,14 +1,14 @@
-// How experiment, sweep and regress share the cores (tools/src/cli_checks.hpp, SplitCores).
+// How experiment, sweep and regress share the cores (dualgrid/core/core_split.hpp, SplitCores).
 #include <catch2/catch.hpp>
 
 #include <sched.h>
 
 #include <string>
 
-#include "../../tools/src/cli_checks.hpp"
+#include "dualgrid/core/core_split.hpp"
 
-using dualgrid::tools::Cores;
-using dualgrid::tools::SplitCores;
+using dualgrid::Cores;
+using dualgrid::SplitCores;
 
 TEST_CASE("Cores counts the CPUs this process may use", "[cores]") {
   cpu_set_t set;

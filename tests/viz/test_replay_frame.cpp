@@ -1,6 +1,8 @@
 // The replay video's frame (viz::ReplayRenderer): layout rules, cell colours where the cells are,
 // cluster outlines in their role's colour, clear errors for bad input.
 #include <catch2/catch.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -129,6 +131,9 @@ TEST_CASE("replay frame: bad layouts and pictures are refused naming the field",
   ReplayLayoutOptions empty = Layout(r, 1);
   empty.view = {};
   CHECK_THROWS_WITH(ReplayRenderer(empty), Catch::Contains("view"));
+  ReplayLayoutOptions unnamed = Layout(r, 1);
+  unnamed.truth_label.clear();
+  CHECK_THROWS_WITH(ReplayRenderer(unnamed), Catch::Contains("truth_label"));
   ReplayRenderer renderer(Layout(r, 2));
   ReplayPicture pic;
   pic.panels.resize(1);
@@ -138,4 +143,30 @@ TEST_CASE("replay frame: bad layouts and pictures are refused naming the field",
   pic.panels[1].raster = r;
   pic.panels[1].raster.dynamic.pop_back();
   CHECK_THROWS_WITH(renderer.Render(pic), Catch::Contains("panels[1].raster"));
+}
+
+TEST_CASE("replay frame: the legend names the reference boxes as the layout says",
+          "[viz][replay]") {
+  // A recorded run's references are not ground truth (outputs::WordsFor): the legend entry is the
+  // layout's truth_label, and only the header strip above the panels changes with it.
+  const GridRaster r = FreeRaster(40, 40);
+  ReplayPicture pic;
+  pic.heading = "recorded · seed 1";
+  pic.panels.resize(1);
+  pic.panels[0].raster = r;
+  ReplayLayoutOptions sumo = Layout(r, 1), tracks = Layout(r, 1);
+  tracks.truth_label = "track estimate";
+  CHECK(sumo.truth_label == "ground truth");
+  ReplayRenderer a(sumo), b(tracks);
+  REQUIRE(a.height() == b.height());
+  const std::size_t row = static_cast<std::size_t>(a.width()) * 4;
+  const std::vector<std::uint8_t> fa(a.Render(pic), a.Render(pic) + row * a.height());
+  const std::vector<std::uint8_t> fb(b.Render(pic), b.Render(pic) + row * b.height());
+  // The header strip (and the panel's title) lie above the top edge of the panel's map.
+  const WorldRect view = r.Extent();
+  const auto header_rows =
+      static_cast<std::size_t>(a.ToPixel(0, Position(view.min.x(), view.max.y())).y());
+  REQUIRE(header_rows > 0);
+  CHECK(!std::equal(fa.begin(), fa.begin() + row * header_rows, fb.begin()));
+  CHECK(std::equal(fa.begin() + row * header_rows, fa.end(), fb.begin() + row * header_rows));
 }

@@ -1,13 +1,10 @@
 #include "cli_checks.hpp"
 #include "dualgrid/core/text.hpp"
 
-#include <sched.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <thread>
 
 namespace dualgrid::tools {
 namespace {
@@ -15,31 +12,6 @@ namespace {
 std::string Shown(double v) { return FormatSignificant(v, 6); }
 
 }  // namespace
-
-int Cores() {
-  // The CPUs this process may run on (taskset, a Slurm allocation's cpuset), not the machine's.
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
-  return std::max(1u, std::thread::hardware_concurrency());
-}
-
-CoreSplit SplitCores(int jobs, int threads, int tasks) {
-  CoreSplit s;
-  s.cores = Cores();
-  s.jobs = jobs > 0 ? jobs : std::max(1, std::min(s.cores, tasks));
-  s.threads = threads > 0 ? threads : std::max(1, s.cores / s.jobs);
-  return s;
-}
-
-std::string CoreSplit::Describe() const {
-  std::string out = std::to_string(jobs) + (jobs == 1 ? " process" : " processes") +
-                    " at a time x " + std::to_string(threads) +
-                    (threads == 1 ? " thread" : " threads") + " on " + std::to_string(cores) +
-                    (cores == 1 ? " core" : " cores");
-  if (jobs * threads > cores) out += " (oversubscribed as asked: expect slowdowns)";
-  return out;
-}
 
 CLI::Validator WholeNumber(long long lo, long long hi) {
   const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";

@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dualgrid/core/core_split.hpp"
+
 namespace dualgrid::tools {
 
 /// Largest seed accepted anywhere: 2^53 - 1, so that a seed written to JSON is read back exactly
@@ -19,20 +21,6 @@ inline constexpr int kMaxSeeds = 10000;
 inline constexpr int kMaxThreadsPerCore = 4;
 /// Longest simulated duration [s] accepted on the command line (as in a scenario file).
 inline constexpr double kMaxDuration = 86400.0;
-
-/// The machine's cores (at least 1).
-int Cores();
-
-/// How parallel runs share the cores: `jobs` child processes at a time, each with `threads` OpenMP
-/// threads. Given values (> 0) are kept; by default jobs = min(cores, tasks) and
-/// threads = cores / jobs, so that jobs x threads <= cores (spinning or oversubscribed OpenMP
-/// teams slow every run by an order of magnitude on a shared machine: docs/performance.md).
-struct CoreSplit {
-  int jobs = 1, threads = 1, cores = 1;
-  /// "2 processes at a time x 1 thread on 2 cores", flagged when jobs x threads > cores.
-  std::string Describe() const;
-};
-CoreSplit SplitCores(int jobs, int threads, int tasks);
 
 /// A whole number in [lo, hi] (no sign for lo >= 0, no fraction, no trailing text).
 CLI::Validator WholeNumber(long long lo, long long hi);

@@ -63,6 +63,7 @@ void ReplayLayoutOptions::Validate() const {
   if (!view.IsValid(&error)) throw std::invalid_argument("view: " + error);
   if (panels < 1 || panels > 8) throw std::invalid_argument("panels: expected 1 to 8");
   if (!(arrow_seconds > 0.0)) throw std::invalid_argument("arrow_seconds: expected > 0");
+  if (truth_label.empty()) throw std::invalid_argument("truth_label: expected a name, got ''");
 }
 
 struct ReplayRenderer::Impl {
@@ -327,7 +328,7 @@ struct ReplayRenderer::Impl {
         cairo_stroke(cr);
       };
     };
-    x += LegendEntry(cr, x, y, "ground truth", outline(colors::kBlack));
+    x += LegendEntry(cr, x, y, o.truth_label, outline(colors::kBlack));
     x += LegendEntry(cr, x, y, "ego", outline(colors::kEgo));
     x += LegendEntry(cr, x, y, "cluster: matched", outline(kMatched));
     x += LegendEntry(cr, x, y, "duplicate", outline(kDuplicate));

@@ -25,15 +25,22 @@ class IdRegistry;
 using PointLabels = std::vector<int>;
 using recorded::kStaticLabel;
 
+/// The folders a source may need to start: where networks are looked up and where logs go. A
+/// source uses what it needs (SumoSource both; RecordedSource neither).
+struct SourceFolders {
+  std::filesystem::path network_dir;  ///< networks named by name are looked up here
+  std::filesystem::path work_dir;     ///< receives the source's logs (SUMO's route file, sumo.log)
+};
+
 /// One step's worth of detections and the ego's state. Lifetime: Start() once, then Advance()
 /// until it returns false; Finish() at the end. Not copyable.
 class DetectionSource {
  public:
   virtual ~DetectionSource() = default;
 
-  /// Prepares the source (SUMO starts; `work_dir` receives its log). Called by Pipeline::Start.
-  virtual void Start(const std::filesystem::path& network_dir,
-                     const std::filesystem::path& work_dir) = 0;
+  /// Prepares the source (SUMO starts on its network in `folders.network_dir`, logging to
+  /// `folders.work_dir`). Called by Pipeline::Start.
+  virtual void Start(const SourceFolders& folders) = 0;
   virtual bool started() const = 0;
   /// Ends the source (SUMO writes its outputs); what was read stays readable.
   virtual void Finish() {}
@@ -80,8 +87,7 @@ class SumoSource : public DetectionSource {
   /// `config` must outlive the source. Registers the scenario's static obstacles in `ids` (they
   /// take the first ids).
   SumoSource(const scenario::ScenarioConfig& config, IdRegistry& ids);
-  void Start(const std::filesystem::path& network_dir,
-             const std::filesystem::path& work_dir) override;
+  void Start(const SourceFolders& folders) override;
   bool started() const override { return simulation_ != nullptr; }
   void Finish() override;
   bool Advance(IdRegistry& ids) override;

@@ -40,9 +40,8 @@ class RecordedSource : public DetectionSource {
  public:
   /// `sequence` must outlive the source.
   RecordedSource(const RecordedSequence& sequence, RecordedOptions options);
-  void Start(const std::filesystem::path&, const std::filesystem::path&) override {
-    started_ = true;
-  }
+  /// Ready to Advance(): a recorded sequence needs no folders (it is in memory already).
+  void Start() { started_ = true; }
   bool started() const override { return started_; }
   bool Advance(IdRegistry& ids) override;
   void Scan(IdRegistry& ids, std::vector<radar::Detection>* detections,
@@ -65,6 +64,8 @@ class RecordedSource : public DetectionSource {
   double last_time() const;
 
  private:
+  /// The interface's Start: no folder is used (Start()).
+  void Start(const SourceFolders&) override { Start(); }
   void EstimateTracks(IdRegistry& ids);
 
   const RecordedSequence& seq_;

@@ -103,6 +103,10 @@ struct Header {
   /// sensors.multipath was on: detections may carry a path (index key `multipath`, written only
   /// when true).
   bool multipath = false;
+  /// What the reference boxes (Frame::truth) are: the figures' legend word (outputs::WordsFor:
+  /// "ground truth" for SUMO, "annotated" or "track estimate" for recorded data). Index key
+  /// `truth_label`, written only when not "ground truth".
+  std::string truth_label = "ground truth";
 };
 
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).

@@ -50,8 +50,10 @@ class RunFilesObserver : public cosim::StepObserver {
 /// the last one. A failed write stops the recording with a warning, never the run.
 class RecordingObserver : public cosim::StepObserver {
  public:
+  /// `truth_label`: what the reference boxes are called (replay::Header::truth_label).
   RecordingObserver(const std::filesystem::path& out, const scenario::ScenarioConfig& config,
-                    double interval_s, int max_particles, std::vector<std::string>* warnings);
+                    double interval_s, int max_particles, std::string truth_label,
+                    std::vector<std::string>* warnings);
   bool WantsVelocities(int step, double time) override;
   void OnStep(const cosim::StepView& v) override;
   /// Writes the index (the recording is usable only then); a failure costs only the replay.
@@ -66,6 +68,7 @@ class RecordingObserver : public cosim::StepObserver {
   int every_ = 1;
   int step_count_ = 0;
   int max_particles_ = 0;
+  std::string truth_label_;
   std::vector<std::string>* warnings_;
   std::unique_ptr<replay::Writer> writer_;
   bool failed_ = false;

@@ -58,6 +58,9 @@ struct ReplayLayoutOptions {
   /// rows as the width needs.
   std::vector<std::string> sensors;
   bool particles = false;  ///< pictures carry particles: a legend entry for them
+  /// The legend's name of the reference boxes (ReplayPanel::truth): "ground truth" for SUMO,
+  /// the figures' word for recorded data (GridFigureOptions::truth_label). Not empty.
+  std::string truth_label = "ground truth";
   /// Throws std::invalid_argument naming the field.
   void Validate() const;
 };
