@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dualgrid/core/core_split.hpp"
+#include "dualgrid/sim/scenario.hpp"
 
 namespace dualgrid::tools {
 
@@ -20,7 +21,7 @@ inline constexpr int kMaxSeeds = 10000;
 /// counts exhaust the stack space of the thread pool.
 inline constexpr int kMaxThreadsPerCore = 4;
 /// Longest simulated duration [s] accepted on the command line (as in a scenario file).
-inline constexpr double kMaxDuration = 86400.0;
+inline constexpr double kMaxDuration = sim::kMaxDuration;
 
 /// A whole number in [lo, hi] (no sign for lo >= 0, no fraction, no trailing text).
 CLI::Validator WholeNumber(long long lo, long long hi);
