@@ -288,8 +288,7 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
 
   const auto wall_start = std::chrono::steady_clock::now();
   cosim.Start(o.network_dir, o.out);
-  if (const std::string note = AutoEgoNote(cosim.pipeline()); !note.empty() && !o.quiet)
-    std::cerr << "dualgrid: " << note << "\n";
+  PrintAutoEgoNote(cosim.pipeline(), o.quiet);
   RunFolderResult r;
   RunObservers observers(cosim, config, o, &r.warnings);
   Simulate(cosim, config, recorded, callbacks);

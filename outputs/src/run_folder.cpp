@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iostream>
 #include <stdexcept>
 #include <vector>
 
@@ -81,12 +82,17 @@ bool FaultInjected(const std::string& what) {
   return list.find("," + what + ",") != std::string::npos;
 }
 
-std::string AutoEgoNote(const cosim::Pipeline& pipeline) {
+void PrintAutoEgoNote(const cosim::Pipeline& pipeline, bool quiet) {
   const sim::ScenarioSpec& spec = pipeline.config().sim;
-  if (!spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return "";
+  if (!spec.ego_from_routes || spec.ego.id != sim::kAutoEgo || !pipeline.sumo()) return;
   const auto& choice = pipeline.simulation().auto_ego_choice();
-  return "ego: auto chose '" + pipeline.simulation().ego_id() + "' (" +
-         (choice ? choice->Reason() : std::string()) + "; docs/scenarios.md)";
+  // A scene where no vehicle ever sees another is said even when quiet: its results are empty.
+  if (choice && choice->with_traffic == 0)
+    std::cerr << "dualgrid: warning: ego: auto chose '" << choice->id << "', but "
+              << choice->Reason() << "\n";
+  if (quiet) return;
+  std::cerr << "dualgrid: ego: auto chose '" << pipeline.simulation().ego_id() << "' ("
+            << (choice ? choice->Reason() : std::string()) << "; docs/scenarios.md)\n";
 }
 
 nlohmann::json EndRecord(const cosim::CoSimulation& cs, int stop_signal, std::string* status) {

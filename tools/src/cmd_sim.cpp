@@ -114,8 +114,7 @@ int RunSim(const SimOptions& sim_options) {
   const auto wall_start = std::chrono::steady_clock::now();
   cosim.Start(options.network_dir, options.out);
   const cosim::Pipeline& pipeline = cosim.pipeline();
-  if (const std::string note = AutoEgoNote(pipeline); !note.empty() && !options.quiet)
-    std::cerr << "dualgrid: " << note << "\n";
+  PrintAutoEgoNote(pipeline, options.quiet);
   SimFiles files(sim_options, config.radar.options.multipath.enabled);
   WriteObstacles(spec, options.out / "obstacles.csv");
   SimTally tally;

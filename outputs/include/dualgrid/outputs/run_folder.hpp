@@ -34,9 +34,10 @@ bool FaultInjected(const std::string& what);
 /// mean equal outputs, whatever the thread count.
 nlohmann::json OutputDigests(const std::filesystem::path& dir);
 
-/// After Start(): the note naming the vehicle that `ego: {from_routes: auto}` chose; "" when the
-/// ego was named.
-std::string AutoEgoNote(const cosim::Pipeline& pipeline);
+/// After Start(), when `ego: {from_routes: auto}` chose the ego: prints to stderr the vehicle it
+/// chose and why (unless `quiet`), and a warning when no vehicle ever had another in its grid
+/// (always: nothing can then be scored). Prints nothing when the ego was named.
+void PrintAutoEgoNote(const cosim::Pipeline& pipeline, bool quiet);
 
 /// How a co-simulation ended, for summary.json and the one-line note: `complete` (no signal came
 /// and SUMO reached the duration or the ego left the network: the scenario's own end), `end`
