@@ -121,7 +121,6 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                         config_.dynamic_threshold, predicted_);
     classes = predicted_;
   }
-  const filter::ParticleSet& p = grid.weighted_particles();
   dynamic_particles_.clear();
   const BoxTest ego(ego_box);
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
@@ -131,10 +130,10 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
       classes, [](std::uint8_t c) { return c == kDynamic; },
       [&](std::size_t, std::int64_t first, std::int64_t last) {
         for (std::int64_t i = first; i < last; ++i) {
-          if (!(p.weight[i] > 0.0f)) continue;
-          const Position pos(p.x[i], p.y[i]);
-          if (ego.Contains(pos)) continue;
-          dynamic_particles_.push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+          const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
+          if (!(p.weight > 0.0f)) continue;
+          if (ego.Contains(p.position)) continue;
+          dynamic_particles_.push_back({p.position, p.velocity, p.weight});
         }
       });
   clusters_ = clusterer_.Run(dynamic_particles_);
