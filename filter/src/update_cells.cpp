@@ -132,6 +132,61 @@ detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
   return in;
 }
 
+// Eqs. (10-12) for one cell's particles in double, one particle at a time: the path of cells
+// whose per-cell factors (UpdateCells) do not fit in float.
+void DynamicGrid::ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
+                                  double q_norm, double scale, double rho_p, double sum_pos,
+                                  double sum_vel, double fast_mass) const {
+  const FilterParams& p = cycle_params_;
+  const auto mode_factor = [&](double lp, double lv) {
+    return p.mode == WeightMode::kPosition   ? lp
+           : p.mode == WeightMode::kVelocity ? lv
+                                             : std::max(lp, lv);  // eq. (14)
+  };
+  if (literal_norm) {
+    // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
+    // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
+    // A single mode's other weight is not in q_norm and would drift without bound (float
+    // overflow): it is normalised on its own to rho_p, as in the per-cell form.
+    // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
+    // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
+    // <= 1. The other weight's share is w / sum <= 1, times rho_p.
+    const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
+    const bool own_v = fell_back || p.mode != WeightMode::kPosition;
+    const auto norm = [&](double w, bool own, double sum) {
+      if (!(q_norm > 0.0)) return 0.0;
+      if (own) return w * scale / q_norm;
+      return sum > 0.0 ? rho_p * (w / sum) : 0.0;
+    };
+    for (std::int64_t i = c.lo; i < c.hi; ++i) {
+      if (c.weight[i] == 0.0) continue;
+      const double wp = fell_back ? c.weight[i] : c.w_position[i];
+      const double wv = fell_back ? c.weight[i] : c.w_velocity[i];
+      c.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
+      c.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
+      c.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
+    }
+  }
+
+  // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
+  double sum_res = 0.0;
+  for (std::int64_t i = c.lo; i < c.hi && !literal_norm; ++i) {
+    if (c.weight[i] == 0.0) continue;
+    const double m = c.weight[i];
+    const double wp = sum_pos > 0.0 ? rho_p * c.w_position[i] / sum_pos : rho_p * m / fast_mass;
+    const double wv = sum_vel > 0.0 ? rho_p * c.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
+    c.w_position[i] = wp;
+    c.w_velocity[i] = wv;
+    const double wr = mode_factor(wp, wv);  // w_resample
+    c.weight[i] = wr;
+    sum_res += wr;
+  }
+  if (sum_res > 0.0 && !literal_norm) {
+    const double k = rho_p / sum_res;
+    for (std::int64_t i = c.lo; i < c.hi; ++i) c.weight[i] = static_cast<float>(c.weight[i] * k);
+  }
+}
+
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
@@ -344,47 +399,38 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         rho_b = share * a_birth / q_norm;
         if (literal_norm) f_up = free_part * a_free / q_norm;
       }
+      // --- Eqs. (10-12) for the particles: on SIMD lanes (NormaliseWeights) with per-cell
+      // factors, where they are finite in float; else (rare: tiny sums) the double path. ---
+      NormaliseFactors nf;
+      nf.literal = literal_norm;
+      nf.mode = p.mode;
+      double kp, kv, kw = 0.0;
       if (literal_norm) {
-        // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
-        // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
-        // A single mode's other weight is not in q_norm and would drift without bound (float
-        // overflow): it is normalised on its own to rho_p, as in the per-cell form.
-        // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
-        // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
-        // <= 1. The other weight's share is w / sum <= 1, times rho_p.
+        // Own weights w * scale / q_norm; with scale != 1 the unscaled q_norm is subnormal and
+        // every float weight below it is 0, so the factor is 0 (not scale / q_norm = inf).
+        const double own = q_norm > 0.0 && scale == 1.0 ? 1.0 / q_norm : 0.0;
         const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
         const bool own_v = fell_back || p.mode != WeightMode::kPosition;
-        const auto norm = [&](double w, bool own, double sum) {
-          if (!(q_norm > 0.0)) return 0.0;
-          if (own) return w * scale / q_norm;
-          return sum > 0.0 ? rho_p * (w / sum) : 0.0;
-        };
-        for (std::int64_t i = lo; i < hi; ++i) {
-          if (q.weight[i] == 0.0) continue;
-          const double wp = fell_back ? q.weight[i] : q.w_position[i];
-          const double wv = fell_back ? q.weight[i] : q.w_velocity[i];
-          q.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
-          q.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
-          q.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
-        }
+        nf.mass_p = nf.mass_v = fell_back;
+        kp = own_p ? own : (q_norm > 0.0 && sum_pos > 0.0 ? rho_p / sum_pos : 0.0);
+        kv = own_v ? own : (q_norm > 0.0 && sum_vel > 0.0 ? rho_p / sum_vel : 0.0);
+        kw = own;
+      } else {
+        nf.mass_p = !(sum_pos > 0.0);
+        nf.mass_v = !(sum_vel > 0.0);
+        kp = rho_p / (nf.mass_p ? fast_mass : sum_pos);
+        kv = rho_p / (nf.mass_v ? fast_mass : sum_vel);
       }
-
-      // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
-      double sum_res = 0.0;
-      for (std::int64_t i = lo; i < hi && !literal_norm; ++i) {
-        if (q.weight[i] == 0.0) continue;
-        const double m = q.weight[i];
-        const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
-        const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
-        q.w_position[i] = wp;
-        q.w_velocity[i] = wv;
-        const double wr = mode_factor(wp, wv);  // w_resample
-        q.weight[i] = wr;
-        sum_res += wr;
-      }
-      if (sum_res > 0.0 && !literal_norm) {
-        const double k = rho_p / sum_res;
-        for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
+      constexpr double kFloatMax = std::numeric_limits<float>::max();
+      if (hi > lo && !(std::abs(kp) <= kFloatMax && std::abs(kv) <= kFloatMax)) {
+        ScalarNormalise(cp, literal_norm, fell_back, q_norm, scale, rho_p, sum_pos, sum_vel,
+                        fast_mass);
+      } else if (hi > lo) {
+        nf.kp = static_cast<float>(kp);
+        nf.kv = static_cast<float>(kv);
+        nf.kw = static_cast<float>(kw);
+        const double sum_res = NormaliseWeights(nf, cp);
+        if (sum_res > 0.0 && !literal_norm) ScaleWeights(static_cast<float>(rho_p / sum_res), cp);
       }
       free_[s] = f_up;
       static_[s] = s_up;

@@ -161,6 +161,40 @@ CellSums WeighParticles(const WeighInputs& in, const CellParticles& c) {
           LaneSum(acc.vel),  LaneSum(acc.mode), LaneSum(acc.a_dyn)};
 }
 
+double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c) {
+  const DF df;
+  const std::int64_t n = static_cast<std::int64_t>(hn::Lanes(df));
+  const VF kp = hn::Set(df, f.kp), kv = hn::Set(df, f.kv), kw = hn::Set(df, f.kw);
+  VF sum = hn::Zero(df);
+  // One vector at p[0..lanes) (weight, w_position, w_velocity), of which `valid` lanes count.
+  const auto vector = [&](float* pw, float* pwp, float* pwv, std::size_t valid) {
+    const VF m = hn::LoadU(df, pw), wp = hn::LoadU(df, pwp), wv = hn::LoadU(df, pwv);
+    const auto live = hn::And(hn::FirstN(df, valid), hn::Ne(m, hn::Zero(df)));
+    const VF sp = f.mass_p ? m : wp, sv = f.mass_v ? m : wv;
+    const VF np = hn::Mul(sp, kp), nv = hn::Mul(sv, kv);
+    const VF nw = f.literal ? hn::Mul(ModeFactor(f.mode, sp, sv), kw) : ModeFactor(f.mode, np, nv);
+    hn::StoreU(hn::IfThenElse(live, np, wp), df, pwp);
+    hn::StoreU(hn::IfThenElse(live, nv, wv), df, pwv);
+    hn::StoreU(hn::IfThenElse(live, nw, m), df, pw);
+    sum = hn::Add(sum, hn::IfThenElseZero(live, nw));
+  };
+  std::int64_t i = c.lo;
+  for (; i + n <= c.hi; i += n) vector(c.weight + i, c.w_position + i, c.w_velocity + i, n);
+  if (i < c.hi) {
+    const std::size_t m = static_cast<std::size_t>(c.hi - i);
+    alignas(64) float buf[3][kMaxLanes] = {};
+    float* const dst[3] = {c.weight + i, c.w_position + i, c.w_velocity + i};
+    for (int a = 0; a < 3; ++a) std::memcpy(buf[a], dst[a], m * sizeof(float));
+    vector(buf[0], buf[1], buf[2], m);
+    for (int a = 0; a < 3; ++a) std::memcpy(dst[a], buf[a], m * sizeof(float));
+  }
+  return LaneSum(sum);
+}
+
+void ScaleWeights(float k, const CellParticles& c) {
+  for (std::int64_t i = c.lo; i < c.hi; ++i) c.weight[i] *= k;  // the compiler's lanes
+}
+
 const char* SimdTarget() { return hwy::TargetName(HWY_TARGET); }
 
 }  // namespace dualgrid::filter::detail

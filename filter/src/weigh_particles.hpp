@@ -53,6 +53,23 @@ struct CellSums {
 /// in a fixed order: the result depends on the particles alone (one SIMD target per build).
 CellSums WeighParticles(const WeighInputs& in, const CellParticles& c);
 
+/// Per-cell factors of the weights' normalisation (eqs. 10-12, UpdateCells): a particle with
+/// weight m != 0 and weights (wp, wv) gets sources sp = (mass_p ? m : wp), sv = (mass_v ? m : wv),
+/// w_position = sp kp, w_velocity = sv kv and weight = mode(sp, sv) kw (literal) or
+/// mode(w_position, w_velocity) (per cell, scaled afterwards by ScaleWeights). Particles with
+/// weight 0 are left as they are.
+struct NormaliseFactors {
+  bool mass_p = false, mass_v = false, literal = false;
+  float kp = 0, kv = 0, kw = 0;
+  WeightMode mode = WeightMode::kDual;
+};
+
+/// Normalises one cell's weights (NormaliseFactors); returns the sum of the new weights (lanes in
+/// a fixed order).
+double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c);
+/// weight *= k for the cell's particles.
+void ScaleWeights(float k, const CellParticles& c);
+
 /// Name of the SIMD target this build uses (docs/performance.md, "Issue 37").
 const char* SimdTarget();
 

@@ -29,7 +29,8 @@ namespace dualgrid::filter {
 
 namespace detail {
 struct WeighInputs;
-}
+struct CellParticles;
+}  // namespace detail
 
 /// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
 /// elsewhere in the grid offsets it, as dualgrid's filter.ahead / filter.left do).
@@ -193,6 +194,10 @@ class DynamicGrid {
   void UpdateCells(std::span<const Measurement> z);
   // This cycle's float detection tables of the particle kernel (into det_f_).
   detail::WeighInputs WeighTables(std::span<const Measurement> z);
+  // Eqs. (10-12) for one cell's particles in double (cells whose factors overflow float).
+  void ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
+                       double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
+                       double fast_mass) const;
   void Birth(std::span<const Measurement> z);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
