@@ -2,6 +2,8 @@
 // static target per build: docs/performance.md, "Issue 37", why not dynamic dispatch).
 #include "weigh_particles.hpp"
 
+#include "dualgrid/filter/simd.hpp"
+
 #include <algorithm>
 #include <cstring>
 
@@ -195,6 +197,10 @@ void ScaleWeights(float k, const CellParticles& c) {
   for (std::int64_t i = c.lo; i < c.hi; ++i) c.weight[i] *= k;  // the compiler's lanes
 }
 
+}  // namespace dualgrid::filter::detail
+
+namespace dualgrid::filter {
+
 const char* SimdTarget() { return hwy::TargetName(HWY_TARGET); }
 
-}  // namespace dualgrid::filter::detail
+}  // namespace dualgrid::filter

@@ -70,7 +70,4 @@ double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c);
 /// weight *= k for the cell's particles.
 void ScaleWeights(float k, const CellParticles& c);
 
-/// Name of the SIMD target this build uses (docs/performance.md, "Issue 37").
-const char* SimdTarget();
-
 }  // namespace dualgrid::filter::detail
