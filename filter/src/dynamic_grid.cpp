@@ -127,26 +127,24 @@ void ExportParticles(const LocalParticles& in, std::size_t n, std::int64_t gx, s
 
 }  // namespace
 
-const ParticleSet& DynamicGrid::particles() const {
+const ParticleSet& DynamicGrid::ExportOnce(Exported& out, const LocalParticles& in, std::int64_t gx,
+                                           std::int64_t gy) const {
   const std::lock_guard<std::mutex> lock(export_lock_.m);
-  if (!exported_.valid) {
-    ExportParticles(particles_, particles_.size(), origin_gx_, origin_gy_, params_.resolution,
-                    exported_.set);
-    exported_.valid = true;
+  if (!out.valid) {
+    ExportParticles(in, in.size(), gx, gy, params_.resolution, out.set);
+    out.valid = true;
   }
-  return exported_.set;
+  return out.set;
 }
 
+const ParticleSet& DynamicGrid::particles() const {
+  return ExportOnce(exported_, particles_, origin_gx_, origin_gy_);
+}
+
+// All of sorted_ (as before the float state): entries past num_weighted_particles() are stale but
+// sized like the set.
 const ParticleSet& DynamicGrid::weighted_particles() const {
-  const std::lock_guard<std::mutex> lock(export_lock_.m);
-  if (!exported_weighted_.valid) {
-    // All of sorted_ (as before the float state): entries past num_weighted_particles() are
-    // stale but sized like the set.
-    ExportParticles(sorted_, sorted_.size(), sorted_gx_, sorted_gy_, params_.resolution,
-                    exported_weighted_.set);
-    exported_weighted_.valid = true;
-  }
-  return exported_weighted_.set;
+  return ExportOnce(exported_weighted_, sorted_, sorted_gx_, sorted_gy_);
 }
 
 double DynamicGrid::NewbornMass() const {

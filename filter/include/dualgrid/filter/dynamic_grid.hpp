@@ -239,6 +239,9 @@ class DynamicGrid {
   mutable Exported exported_, exported_weighted_;
   mutable ExportLock export_lock_;
   void InvalidateExports() { exported_.valid = exported_weighted_.valid = false; }
+  // `out`, made from `in` (grid-local, origin (gx, gy)) unless still valid.
+  const ParticleSet& ExportOnce(Exported& out, const detail::LocalParticles& in, std::int64_t gx,
+                                std::int64_t gy) const;
   detail::AlignedVector<std::int32_t> cell_of_;  // storage cell per particle, num_cells_ if outside
   std::vector<std::int64_t> cell_start_;         // num_cells_ + 2: particle ranges of sorted_
   std::vector<std::int32_t> hist_;               // per-chunk histograms of the counting sort

@@ -7,6 +7,8 @@
 #include <new>
 #include <vector>
 
+#include "dualgrid/filter/particles.hpp"
+
 namespace dualgrid::filter::detail {
 
 /// std::allocator with 64-byte alignment (one cache line; whole SIMD vectors of any x86 width).
@@ -40,13 +42,7 @@ struct LocalParticles {
     for (auto* v : {&x, &y, &vx, &vy, &w_position, &w_velocity, &weight}) v->resize(n);
   }
   void CopyFrom(const LocalParticles& src, std::size_t i, std::size_t k) {
-    x[k] = src.x[i];
-    y[k] = src.y[i];
-    vx[k] = src.vx[i];
-    vy[k] = src.vy[i];
-    w_position[k] = src.w_position[i];
-    w_velocity[k] = src.w_velocity[i];
-    weight[k] = src.weight[i];
+    CopyParticle(src, i, *this, k);
   }
 };
 
