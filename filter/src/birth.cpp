@@ -108,12 +108,13 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   const std::int64_t sx = s % nx_, sy = s / nx_;
   const float lx = static_cast<float>(Mod(sx - origin_gx_, nx_));
   const float ly = static_cast<float>(Mod(sy - origin_gy_, ny_));
+  const float r = static_cast<float>(params_.resolution);
   if (j < 0) {
     // Birth mass needs a detection nearby; only a rounding jump of the prefix sums at a block
     // boundary could land here. Keep the slots harmless (zero mass at the cell centre).
     for (std::int64_t k = k_lo; k < k_hi; ++k) {
-      births_.x[k] = lx + 0.5f;
-      births_.y[k] = ly + 0.5f;
+      births_.x[k] = (lx + 0.5f) * r;
+      births_.y[k] = (ly + 0.5f) * r;
       births_.vx[k] = births_.vy[k] = 0.0f;
       births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = 0.0f;
     }
@@ -146,8 +147,8 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
                          cnt, 1, raw2[0], raw2[1], raw2[2], raw2[3]);
     for (std::int64_t t = 0; t < cnt; ++t) {
       const std::int64_t k = k0 + t;
-      births_.x[k] = lx + detail::ToUnit24(raw[0][t]);
-      births_.y[k] = ly + detail::ToUnit24(raw[1][t]);
+      births_.x[k] = (lx + detail::ToUnit24(raw[0][t])) * r;
+      births_.y[k] = (ly + detail::ToUnit24(raw[1][t])) * r;
       float n0, n1;
       detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
       Vector2 v;

@@ -113,10 +113,10 @@ namespace {
 void ExportParticles(const LocalParticles& in, std::size_t n, std::int64_t gx, std::int64_t gy,
                      double r, ParticleSet& out) {
   out.resize(n);
-  const double x0 = static_cast<double>(gx), y0 = static_cast<double>(gy);
+  const double x0 = static_cast<double>(gx) * r, y0 = static_cast<double>(gy) * r;
   for (std::size_t i = 0; i < n; ++i) {
-    out.x[i] = (x0 + in.x[i]) * r;
-    out.y[i] = (y0 + in.y[i]) * r;
+    out.x[i] = x0 + in.x[i];
+    out.y[i] = y0 + in.y[i];
   }
   std::copy_n(in.vx.begin(), n, out.vx.begin());
   std::copy_n(in.vy.begin(), n, out.vy.begin());

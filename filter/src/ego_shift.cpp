@@ -25,8 +25,8 @@ void DynamicGrid::Initialize(const EgoInput& ego) {
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     CounterRng rng(seed_, RngPurpose::kFilterInit, 0, static_cast<std::uint32_t>(i));
-    particles_.x[i] = static_cast<float>(rng.Uniform() * nx_);  // grid-local cells
-    particles_.y[i] = static_cast<float>(rng.Uniform() * ny_);
+    particles_.x[i] = static_cast<float>(rng.Uniform() * nx_ * params_.resolution);  // local [m]
+    particles_.y[i] = static_cast<float>(rng.Uniform() * ny_ * params_.resolution);
     particles_.vx[i] = particles_.vy[i] = 0.0f;
     particles_.w_position[i] = particles_.w_velocity[i] = particles_.weight[i] = 0.0f;
   }
@@ -69,7 +69,7 @@ void DynamicGrid::ShiftTo(const Position& ego) {
     for (std::int64_t c = 0; c < std::abs(dy); ++c)
       ResetRow(dy > 0 ? origin_gy_ + ny_ + c : gy + c);
   }
-  // The particles' grid-local coordinates move by the same whole cells: exact, and done in the
+  // The particles' grid-local coordinates move by the same whole cells (dx r metres), in the
   // prediction's pass (PredictAndSort), which reads every particle anyway.
   shift_gx_ = dx;
   shift_gy_ = dy;

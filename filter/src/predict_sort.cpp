@@ -20,10 +20,12 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
   const float sv = static_cast<float>(params_.process_noise_velocity * std::sqrt(dt));
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
   const std::int64_t c1 = num_cells_ + 1;  // bucket num_cells_ collects particles off the grid
-  // Positions in grid-local cells (LocalParticles): the grid's shift of this cycle is subtracted
-  // (exact: whole cells, |x| << 2^24) before the motion is added.
-  const PositionMap<float> map{static_cast<float>(dt), static_cast<float>(1.0 / params_.resolution),
-                               static_cast<float>(shift_gx_), static_cast<float>(shift_gy_)};
+  // Positions in grid-local metres (LocalParticles): the grid's shift of this cycle (whole cells,
+  // k r) is subtracted before the motion is added.
+  const float r = static_cast<float>(params_.resolution);
+  const float inv_r = static_cast<float>(1.0 / params_.resolution);
+  const PositionMap<float> map{static_cast<float>(dt), 1.0f, static_cast<float>(shift_gx_) * r,
+                               static_cast<float>(shift_gy_) * r};
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
   // Any chunking gives the same sorted order (stable): one chunk when one thread runs them all.
   const bool one_thread = OneThreadHere();
@@ -49,7 +51,8 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
                          sy0i = static_cast<std::int32_t>(sy0),
                          off = static_cast<std::int32_t>(num_cells_);
       for (std::int64_t i = b0; i < b1; ++i) {
-        const float fx = std::floor(particles_.x[i]), fy = std::floor(particles_.y[i]);
+        const float fx = std::floor(particles_.x[i] * inv_r),
+                    fy = std::floor(particles_.y[i] * inv_r);
         const bool inside = fx >= 0.0f && fy >= 0.0f && fx < fnx && fy < fny;  // false for NaN too
         // Storage index without integer division (hot loop): wrap once.
         std::int32_t sx = sx0i + (inside ? static_cast<std::int32_t>(fx) : 0);

@@ -23,17 +23,17 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   const double c = std::cos(angle), s = std::sin(angle);
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
   LocalParticles& q = particles_;
-  // Positions through the caller's frame in double: old local cells -> old caller coordinates
-  // -> turned -> new local cells (the new origin, OriginFor(ego) below).
+  // Positions through the caller's frame in double: old local metres -> old caller coordinates
+  // -> turned -> new local metres (the new origin, OriginFor(ego) below).
   const std::array<std::int64_t, 2> new_origin = OriginFor(ego);
-  const double r = params_.resolution, inv_r = 1.0 / r;
+  const double r = params_.resolution;
   const double ox = static_cast<double>(origin_gx_), oy = static_cast<double>(origin_gy_);
   const double nx0 = static_cast<double>(new_origin[0]), ny0 = static_cast<double>(new_origin[1]);
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    const double x = (ox + q.x[i]) * r, y = (oy + q.y[i]) * r, vx = q.vx[i], vy = q.vy[i];
-    q.x[i] = static_cast<float>((c * x + s * y) * inv_r - nx0);
-    q.y[i] = static_cast<float>((-s * x + c * y) * inv_r - ny0);
+    const double x = ox * r + q.x[i], y = oy * r + q.y[i], vx = q.vx[i], vy = q.vy[i];
+    q.x[i] = static_cast<float>((c * x + s * y) - nx0 * r);
+    q.y[i] = static_cast<float>((-s * x + c * y) - ny0 * r);
     q.vx[i] = static_cast<float>(c * vx + s * vy);
     q.vy[i] = static_cast<float>(-s * vx + c * vy);
   }

@@ -87,17 +87,19 @@ detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
   const FilterParams& p = cycle_params_;
   const MeasurementGrid& mg = *mg_;
   const std::size_t nz = z.size();
-  // Nine float columns: bucket-order x, y [cells]; per detection u0, u1, u2, fit_k, fit_t, vr_x,
-  // vr_y (WeighInputs). At least one row: the kernel gathers row 0 for lanes without a detection.
+  // Nine float columns: bucket-order x, y [m, grid-local]; per detection u0, u1, u2, fit_k, fit_t,
+  // vr_x, vr_y (WeighInputs). At least one row: the kernel gathers row 0 for lanes without a
+  // detection.
   const std::size_t rows = std::max<std::size_t>(nz, 1);
   if (det_f_.size() < 9 * rows) det_f_.assign(9 * rows, 0.0f);  // grow only
   float* col[9];
   for (std::size_t c = 0; c < 9; ++c) col[c] = det_f_.data() + c * rows;
-  const double r = params_.resolution, inv_r = 1.0 / r;
+  const double r = params_.resolution;
   const std::int64_t placed = mg.bucket_start_[static_cast<std::size_t>(mg.nbx_) * mg.nby_];
-  for (std::int64_t k = 0; k < placed; ++k) {  // grid-local cells, as the particles
-    col[0][k] = static_cast<float>(mg.det_x_[k] * inv_r - static_cast<double>(origin_gx_));
-    col[1][k] = static_cast<float>(mg.det_y_[k] * inv_r - static_cast<double>(origin_gy_));
+  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
+  for (std::int64_t k = 0; k < placed; ++k) {  // grid-local metres, as the particles
+    col[0][k] = static_cast<float>(mg.det_x_[k] - x0);
+    col[1][k] = static_cast<float>(mg.det_y_[k] - y0);
   }
   const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
   for (std::size_t j = 0; j < nz; ++j) {
@@ -110,9 +112,9 @@ detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
     col[8][j] = static_cast<float>(z[j].radial_velocity.y());
   }
   WeighInputs in;
-  const double cutoff = p.cutoff_sigmas * p.sigma_f * inv_r;
-  in.inv_2sf2_cells = static_cast<float>(0.5 * r * r / (p.sigma_f * p.sigma_f));
-  in.cutoff2_cells = static_cast<float>(cutoff * cutoff);
+  const double cutoff = p.cutoff_sigmas * p.sigma_f;
+  in.inv_2sf2 = static_cast<float>(0.5 / (p.sigma_f * p.sigma_f));
+  in.cutoff2 = static_cast<float>(cutoff * cutoff);
   in.inv_2v2 = static_cast<float>(0.5 / (p.sigma_v * p.sigma_v));
   in.keep = static_cast<float>(1.0 - p.decay_eps);
   in.slow2 = static_cast<float>(p.static_speed * p.static_speed);
@@ -232,7 +234,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const std::int64_t* const bucket_start = mg.bucket_start_.data();
   const int nbx = mg.nbx_, nby = mg.nby_;
   const WeighInputs weigh = WeighTables(z);
-  const float inv_bucket = 1.0f / static_cast<float>(mg.bucket_cells_);
+  const float inv_bucket = static_cast<float>(1.0 / (mg.bucket_cells_ * params_.resolution));
   const std::uint8_t* const view_bits = mg.view_.data();
   double* const free_l = free_.data();
   double* const static_l = static_.data();

@@ -39,11 +39,11 @@ inline VF ModeFactor(WeightMode mode, VF lp, VF lv) {
 }
 
 // Nearest candidate detection of each lane's particle within the cutoff: squared distance
-// [cells^2] into d2, index j (or -1) into jn. Ties go to the lower index.
+// [m^2] into d2, index j (or -1) into jn. Ties go to the lower index.
 inline void Nearest(const WeighInputs& in, const CellParticles& c, VF x, VF y, VF& d2, VI& jn) {
   const DF df;
   const DI di;
-  d2 = hn::Set(df, in.cutoff2_cells);
+  d2 = hn::Set(df, in.cutoff2);
   jn = hn::Set(di, -1);
   const VI minus_one = hn::Set(di, -1);
   for (const auto& range : c.cand) {
@@ -102,7 +102,7 @@ inline void WeighVector(const WeighInputs& in, const CellParticles& c, const flo
   const auto has = hn::RebindMask(df, hn::Gt(jn, hn::Set(di, -1)));
   const VI jc = hn::Max(jn, hn::Zero(di));
   const VF fd =
-      hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(d2, hn::Set(df, in.inv_2sf2_cells)))));
+      hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(d2, hn::Set(df, in.inv_2sf2)))));
   const VF e2v = VelocityError(in, vx, vy, jc);
   const VF fv =
       hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(e2v, hn::Set(df, in.inv_2v2)))));

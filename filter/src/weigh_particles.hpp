@@ -8,17 +8,16 @@
 
 namespace dualgrid::filter::detail {
 
-/// Per-cycle inputs of WeighParticles. Positions in grid-local cells (LocalParticles), distances
-/// squared in cells^2, so the position kernel's factor is r^2 / (2 sigma_f^2).
+/// Per-cycle inputs of WeighParticles. Positions in grid-local metres (LocalParticles).
 struct WeighInputs {
-  float inv_2sf2_cells = 0;  ///< r^2 / (2 sigma_f^2) [1 / cell^2]
-  float cutoff2_cells = 0;   ///< (cutoff_sigmas sigma_f / r)^2 [cell^2]
-  float inv_2v2 = 0;         ///< 1 / (2 sigma_v^2) [s^2/m^2]
-  float keep = 0;            ///< 1 - decay_eps
-  float slow2 = 0;           ///< static_speed^2 [m^2/s^2]
+  float inv_2sf2 = 0;  ///< 1 / (2 sigma_f^2) [1/m^2]
+  float cutoff2 = 0;   ///< (cutoff_sigmas sigma_f)^2 [m^2]
+  float inv_2v2 = 0;   ///< 1 / (2 sigma_v^2) [s^2/m^2]
+  float keep = 0;      ///< 1 - decay_eps
+  float slow2 = 0;     ///< static_speed^2 [m^2/s^2]
   WeightMode mode = WeightMode::kDual;
   bool radial = true, radial_fit = false;
-  /// Detections in bucket order k: grid-local position [cells] and index j.
+  /// Detections in bucket order k: grid-local position [m] and index j.
   const float *det_x = nullptr, *det_y = nullptr;
   const int* det_item = nullptr;
   /// Per detection index j: unit line of sight (u0, u1), signed radial speed u2 [m/s], the fit's

@@ -144,8 +144,8 @@ class DynamicGrid {
   /// scorer reads the few particles of dynamic cells every cycle).
   ParticleView WeightedParticle(std::size_t i) const {
     const double r = params_.resolution;
-    return {{(static_cast<double>(sorted_gx_) + sorted_.x[i]) * r,
-             (static_cast<double>(sorted_gy_) + sorted_.y[i]) * r},
+    return {{static_cast<double>(sorted_gx_) * r + sorted_.x[i],
+             static_cast<double>(sorted_gy_) * r + sorted_.y[i]},
             {sorted_.vx[i], sorted_.vy[i]},
             sorted_.weight[i]};
   }
@@ -219,7 +219,7 @@ class DynamicGrid {
   std::vector<double> free_, static_, dynamic_, born_;
   std::vector<std::uint8_t> view_;  // the last cycle's MeasurementGrid bits (Cell, ExportMasses)
 
-  // Particles (float, grid-local cell units): persistent set, sorted working copy, new-born.
+  // Particles (float, grid-local metres): persistent set, sorted working copy, new-born.
   detail::LocalParticles particles_, sorted_, births_;
   // Whole cells the grid moved in this cycle's ShiftTo, subtracted in the prediction's pass.
   std::int64_t shift_gx_ = 0, shift_gy_ = 0;
@@ -264,12 +264,15 @@ class DynamicGrid {
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
   if (!initialized_ || !p.allFinite()) return std::nullopt;
-  // The particles' grid-local float cells (PredictAndSort sorts by floor of them): a position of
-  // weighted_particles() rounds back to the particle's own float, so its cell is the one it was
-  // weighed in, whatever the resolution.
-  const double inv_r = 1.0 / params_.resolution;
-  const float fx = std::floor(static_cast<float>(p.x() * inv_r - static_cast<double>(origin_gx_)));
-  const float fy = std::floor(static_cast<float>(p.y() * inv_r - static_cast<double>(origin_gy_)));
+  // The particles' grid-local float metres and the sort's arithmetic (PredictAndSort): a
+  // position of weighted_particles() gives back the particle's own float, so its cell is the one
+  // it was weighed in, whatever the resolution.
+  const double r = params_.resolution;
+  const float inv_r = static_cast<float>(1.0 / r);
+  const float fx =
+      std::floor(static_cast<float>(p.x() - static_cast<double>(origin_gx_) * r) * inv_r);
+  const float fy =
+      std::floor(static_cast<float>(p.y() - static_cast<double>(origin_gy_) * r) * inv_r);
   if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(nx_) && fy < static_cast<float>(ny_)))
     return std::nullopt;
   return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};

@@ -1,4 +1,4 @@
-// The filter's own particle state (internal): float structure of arrays in grid-local cell units,
+// The filter's own particle state (internal): float structure of arrays in grid-local metres,
 // 64-byte aligned. docs/algorithm.md, "Float state".
 #pragma once
 
@@ -30,10 +30,10 @@ struct AlignedAllocator {
 template <typename T>
 using AlignedVector = std::vector<T, AlignedAllocator<T>>;
 
-/// Particles of a DynamicGrid. x, y: position in cells relative to the grid's logical cell
-/// (0, 0) corner (the caller's frame position is ((origin_gx + x) r, (origin_gy + y) r)), so a
-/// particle's cell is (floor(x), floor(y)) and a whole-cell shift of the grid is an exact
-/// integer subtraction. vx, vy [m/s] in the caller's frame; the weights as ParticleSet's.
+/// Particles of a DynamicGrid. x, y [m]: position relative to the corner of the grid's logical
+/// cell (0, 0) (the caller's frame position is (origin_gx r + x, origin_gy r + y)), so a
+/// particle's cell is (floor(x / r), floor(y / r)) and a shift of the grid by k whole cells
+/// subtracts k r. vx, vy [m/s] in the caller's frame; the weights as ParticleSet's.
 struct LocalParticles {
   AlignedVector<float> x, y, vx, vy, w_position, w_velocity, weight;
 
