@@ -54,9 +54,9 @@ TEST_CASE("Reframe turns every particle exactly and keeps its weights", "[filter
   const ParticleSet& after = g.particles();
   REQUIRE(after.size() == before.size());
   int wrong = 0;
-  // The filter keeps positions as float grid-local cells (docs/algorithm.md, "Float state"): the
+  // The filter keeps positions as float grid-local metres (docs/algorithm.md, "Float state"): the
   // turned position is rounded once to a float of magnitude M = its offset from the new grid's
-  // corner [cells], |error| <= 2^-24 M cells, plus the double arithmetic's (~1e-13 m).
+  // corner [m], |error| <= 2^-24 M, plus the double arithmetic's (~1e-13 m).
   const double r = g.resolution();
   const double x0 = static_cast<double>(g.origin_index()[0]) * r;
   const double y0 = static_cast<double>(g.origin_index()[1]) * r;
