@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 
 PACKAGES=(build-essential cmake pkg-config sumo sumo-tools libeigen3-dev libyaml-cpp-dev catch2 libcli11-dev
   nlohmann-json3-dev librandom123-dev libbenchmark-dev libcairo2-dev libpng-dev zlib1g-dev
-  parallel ffmpeg pybind11-dev python3-dev python3-numpy libexpat1-dev libhdf5-dev)
+  parallel ffmpeg pybind11-dev python3-dev python3-numpy libexpat1-dev libhdf5-dev libhwy-dev)
 # Only the test suite needs these: the replay viewer's browser test drives Debian's Chromium from
 # Python's standard library (tests/viz/viewer_check.py); the Python module's tests hand its
 # results to pandas (tests/python/test_run_scenario.py); the recorded-data tests write RadarScenes

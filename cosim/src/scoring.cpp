@@ -109,7 +109,6 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
     throw std::invalid_argument("DynamicParticles: " + std::to_string(classes.size()) +
                                 " cell classes for a grid of " +
                                 std::to_string(grid.cells_x() * grid.cells_y()) + " cells");
-  const filter::ParticleSet& p = grid.weighted_particles();
   out->clear();
   const std::optional<BoxTest> ego = exclude ? std::optional<BoxTest>(*exclude) : std::nullopt;
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
@@ -119,10 +118,10 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
       classes, [](std::uint8_t c) { return c == kDynamic; },
       [&](std::size_t, std::int64_t first, std::int64_t last) {
         for (std::int64_t i = first; i < last; ++i) {
-          if (!(p.weight[i] > 0.0f)) continue;
-          const Position pos(p.x[i], p.y[i]);
-          if (ego && ego->Contains(pos)) continue;
-          out->push_back({pos, Velocity(p.vx[i], p.vy[i]), p.weight[i]});
+          const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
+          if (!(p.weight > 0.0f)) continue;
+          if (ego && ego->Contains(p.position)) continue;
+          out->push_back({p.position, p.velocity, p.weight});
         }
       });
 }

@@ -57,7 +57,6 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
   const double u = offset_rng.Uniform();
   const double scale = static_cast<double>(nb) / total;
   const double mass = total / static_cast<double>(nb);
-  const double r = params_.resolution;
   const double vmax = params_.birth_max_tangential_speed;
   const auto start = [&](std::int64_t i, double cumulative) -> std::int64_t {
     if (i == 0) return 0;
@@ -94,7 +93,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
       if (born != 0.0) acc += born;
       const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
       if (k_lo == k_hi) return;
-      GenerateBirths(z, s, k_lo, k_hi, mass, r, vmax);
+      GenerateBirths(z, s, k_lo, k_hi, mass, vmax);
     };
     const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
     for (std::int32_t t = 0; t < born_count_[ch]; ++t) visit(list[t], born_[list[t]]);
@@ -103,18 +102,19 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
 }
 
 void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
-                                 std::int64_t k_hi, double mass, double r, double vmax) {
+                                 std::int64_t k_hi, double mass, double vmax) {
   const int j = mg_->near_det_[s];
-  // Global cell of storage index s: the unique one inside the current window.
+  // Logical (grid-local) cell of storage index s: the unique one inside the current window.
   const std::int64_t sx = s % nx_, sy = s / nx_;
-  const std::int64_t gx = origin_gx_ + Mod(sx - origin_gx_, nx_);
-  const std::int64_t gy = origin_gy_ + Mod(sy - origin_gy_, ny_);
+  const float lx = static_cast<float>(Mod(sx - origin_gx_, nx_));
+  const float ly = static_cast<float>(Mod(sy - origin_gy_, ny_));
+  const float r = static_cast<float>(params_.resolution);
   if (j < 0) {
     // Birth mass needs a detection nearby; only a rounding jump of the prefix sums at a block
     // boundary could land here. Keep the slots harmless (zero mass at the cell centre).
     for (std::int64_t k = k_lo; k < k_hi; ++k) {
-      births_.x[k] = (static_cast<double>(gx) + 0.5) * r;
-      births_.y[k] = (static_cast<double>(gy) + 0.5) * r;
+      births_.x[k] = (lx + 0.5f) * r;
+      births_.y[k] = (ly + 0.5f) * r;
       births_.vx[k] = births_.vy[k] = 0.0f;
       births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = 0.0f;
     }
@@ -147,8 +147,8 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
                          cnt, 1, raw2[0], raw2[1], raw2[2], raw2[3]);
     for (std::int64_t t = 0; t < cnt; ++t) {
       const std::int64_t k = k0 + t;
-      births_.x[k] = (static_cast<double>(gx) + detail::ToUnit24(raw[0][t])) * r;
-      births_.y[k] = (static_cast<double>(gy) + detail::ToUnit24(raw[1][t])) * r;
+      births_.x[k] = (lx + detail::ToUnit24(raw[0][t])) * r;
+      births_.y[k] = (ly + detail::ToUnit24(raw[1][t])) * r;
       float n0, n1;
       detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
       Vector2 v;

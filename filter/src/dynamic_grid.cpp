@@ -93,6 +93,7 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
+  InvalidateExports();
   mg_ = &measurement;
   const std::span<const Measurement> z = measurement.measurements();
   cycle_params_ = ForCycle(params_, dt);  // per-cycle factors for this dt
@@ -104,6 +105,46 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
   view_ = measurement.view_;  // same size: a copy, no allocation (Cell, ExportMasses)
   mg_ = nullptr;
   ++step_;
+}
+
+namespace {
+
+// The first n particles of `in` (grid-local, origin (gx, gy)) in the caller's frame.
+void ExportParticles(const LocalParticles& in, std::size_t n, std::int64_t gx, std::int64_t gy,
+                     double r, ParticleSet& out) {
+  out.resize(n);
+  const double x0 = static_cast<double>(gx) * r, y0 = static_cast<double>(gy) * r;
+  for (std::size_t i = 0; i < n; ++i) {
+    out.x[i] = x0 + in.x[i];
+    out.y[i] = y0 + in.y[i];
+  }
+  std::copy_n(in.vx.begin(), n, out.vx.begin());
+  std::copy_n(in.vy.begin(), n, out.vy.begin());
+  std::copy_n(in.w_position.begin(), n, out.w_position.begin());
+  std::copy_n(in.w_velocity.begin(), n, out.w_velocity.begin());
+  std::copy_n(in.weight.begin(), n, out.weight.begin());
+}
+
+}  // namespace
+
+const ParticleSet& DynamicGrid::ExportOnce(Exported& out, const LocalParticles& in, std::int64_t gx,
+                                           std::int64_t gy) const {
+  const std::lock_guard<std::mutex> lock(export_lock_.m);
+  if (!out.valid) {
+    ExportParticles(in, in.size(), gx, gy, params_.resolution, out.set);
+    out.valid = true;
+  }
+  return out.set;
+}
+
+const ParticleSet& DynamicGrid::particles() const {
+  return ExportOnce(exported_, particles_, origin_gx_, origin_gy_);
+}
+
+// All of sorted_ (as before the float state): entries past num_weighted_particles() are stale but
+// sized like the set.
+const ParticleSet& DynamicGrid::weighted_particles() const {
+  return ExportOnce(exported_weighted_, sorted_, sorted_gx_, sorted_gy_);
 }
 
 double DynamicGrid::NewbornMass() const {

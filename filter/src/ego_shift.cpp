@@ -16,20 +16,19 @@ namespace dualgrid::filter {
 using namespace detail;
 
 void DynamicGrid::Initialize(const EgoInput& ego) {
-  const double r = params_.resolution;
   const auto origin = OriginFor(ego.pose.position);
   origin_gx_ = origin[0];
   origin_gy_ = origin[1];
   // Particles start spread over the grid with zero weight: the first births replace them.
-  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
+  shift_gx_ = shift_gy_ = 0;
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
     CounterRng rng(seed_, RngPurpose::kFilterInit, 0, static_cast<std::uint32_t>(i));
-    particles_.x[i] = x0 + rng.Uniform() * nx_ * r;
-    particles_.y[i] = y0 + rng.Uniform() * ny_ * r;
-    particles_.vx[i] = particles_.vy[i] = 0.0;
-    particles_.w_position[i] = particles_.w_velocity[i] = particles_.weight[i] = 0.0;
+    particles_.x[i] = static_cast<float>(rng.Uniform() * nx_ * params_.resolution);  // local [m]
+    particles_.y[i] = static_cast<float>(rng.Uniform() * ny_ * params_.resolution);
+    particles_.vx[i] = particles_.vy[i] = 0.0f;
+    particles_.w_position[i] = particles_.w_velocity[i] = particles_.weight[i] = 0.0f;
   }
   initialized_ = true;
 }
@@ -70,6 +69,10 @@ void DynamicGrid::ShiftTo(const Position& ego) {
     for (std::int64_t c = 0; c < std::abs(dy); ++c)
       ResetRow(dy > 0 ? origin_gy_ + ny_ + c : gy + c);
   }
+  // The particles' grid-local coordinates move by the same whole cells (dx r metres), in the
+  // prediction's pass (PredictAndSort), which reads every particle anyway.
+  shift_gx_ = dx;
+  shift_gy_ = dy;
   origin_gx_ = gx;
   origin_gy_ = gy;
 }

@@ -99,7 +99,7 @@ int FilterParams::CellsY() const {
 
 double FilterParams::MemoryBytes() const {
   const double cells = static_cast<double>(CellsX()) * CellsY();
-  return 94.0 * cells + 88.0 * num_particles + 44.0 * num_birth;
+  return 94.0 * cells + 68.0 * num_particles + 36.0 * num_birth;
 }
 
 FilterParams ForCycle(const FilterParams& p, double dt) {

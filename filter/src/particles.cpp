@@ -36,42 +36,6 @@ void PredictionNormals(std::uint64_t seed, std::uint64_t step, std::int64_t b0, 
   BoxMuller(u[2], u[3], g2, g3, m);
 }
 
-void PredictRange(ParticleSet& p, std::int64_t lo, std::int64_t hi, double dt, float sp, float sv,
-                  double persistence, std::uint64_t seed, std::uint64_t step,
-                  const PredictionNoise* shared) {
-  const bool noisy = sp > 0.0f || sv > 0.0f;
-  // Blocks of particles: raw Philox draws first, then the Box-Muller transform as straight-line
-  // array code the compiler vectorises (the scalar transform cost ~4x more per particle). Every
-  // particle's noise depends on its index only, so any blocking gives the same result, and so
-  // do the shared draws (PredictionNoise: the same function over other blocks).
-  constexpr std::int64_t kBlock = kPredictBlock;
-  for (std::int64_t b0 = lo; b0 < hi; b0 += kBlock) {
-    const std::int64_t m = std::min(kBlock, hi - b0);
-    alignas(64) float own[4][kBlock];
-    const float* g[4];
-    if (noisy && shared != nullptr) {
-      for (int c = 0; c < 4; ++c) g[c] = shared->channel(c) + b0;
-    } else {
-      if (noisy) {
-        PredictionNormals(seed, step, b0, m, own[0], own[1], own[2], own[3]);
-      } else {
-        for (int c = 0; c < 4; ++c) std::fill_n(own[c], m, 0.0f);
-      }
-      for (int c = 0; c < 4; ++c) g[c] = own[c];
-    }
-    for (std::int64_t k = 0; k < m; ++k) {
-      const std::int64_t i = b0 + k;
-      p.x[i] += p.vx[i] * dt + sp * g[0][k];
-      p.y[i] += p.vy[i] * dt + sp * g[1][k];
-      p.vx[i] += sv * g[2][k];
-      p.vy[i] += sv * g[3][k];
-      p.weight[i] *= persistence;
-      p.w_position[i] *= persistence;
-      p.w_velocity[i] *= persistence;
-    }
-  }
-}
-
 }  // namespace detail
 
 void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_vel,
@@ -82,8 +46,8 @@ void PredictParticles(ParticleSet& p, double dt, double sigma_pos, double sigma_
   constexpr std::int64_t kBlock = detail::kPredictBlock;
   const std::int64_t blocks = (n + kBlock - 1) / kBlock;
   ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t b) {
-    detail::PredictRange(p, b * kBlock, std::min(n, (b + 1) * kBlock), dt, sp, sv, persistence,
-                         seed, step, nullptr);
+    detail::PredictRange(p, b * kBlock, std::min(n, (b + 1) * kBlock),
+                         detail::PositionMap<double>{dt}, sp, sv, persistence, seed, step, nullptr);
   });
 }
 

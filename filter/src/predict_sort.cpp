@@ -20,7 +20,12 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
   const float sv = static_cast<float>(params_.process_noise_velocity * std::sqrt(dt));
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
   const std::int64_t c1 = num_cells_ + 1;  // bucket num_cells_ collects particles off the grid
-  const double inv_r = 1.0 / params_.resolution;
+  // Positions in grid-local metres (LocalParticles): the grid's shift of this cycle (whole cells,
+  // k r) is subtracted before the motion is added.
+  const float r = static_cast<float>(params_.resolution);
+  const float inv_r = static_cast<float>(1.0 / params_.resolution);
+  const PositionMap<float> map{static_cast<float>(dt), 1.0f, static_cast<float>(shift_gx_) * r,
+                               static_cast<float>(shift_gy_) * r};
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
   // Any chunking gives the same sorted order (stable): one chunk when one thread runs them all.
   const bool one_thread = OneThreadHere();
@@ -39,21 +44,22 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
     const std::int64_t chunk_hi = (k + 1) * n / chunks;
     for (std::int64_t b0 = k * n / chunks; b0 < chunk_hi; b0 += detail::kPredictBlock) {
       const std::int64_t b1 = std::min(chunk_hi, b0 + detail::kPredictBlock);
-      detail::PredictRange(particles_, b0, b1, dt, sp, sv, cycle_params_.persistence, seed_, step_,
+      detail::PredictRange(particles_, b0, b1, map, sp, sv, cycle_params_.persistence, seed_, step_,
                            noise);
+      const float fnx = static_cast<float>(nx_), fny = static_cast<float>(ny_);
+      const std::int32_t nx = nx_, ny = ny_, sx0i = static_cast<std::int32_t>(sx0),
+                         sy0i = static_cast<std::int32_t>(sy0),
+                         off = static_cast<std::int32_t>(num_cells_);
       for (std::int64_t i = b0; i < b1; ++i) {
-        const double fx = std::floor(particles_.x[i] * inv_r) - static_cast<double>(origin_gx_);
-        const double fy = std::floor(particles_.y[i] * inv_r) - static_cast<double>(origin_gy_);
-        const bool inside = fx >= 0.0 && fy >= 0.0 && fx < nx_ && fy < ny_;  // false for NaN too
-        std::int64_t c = num_cells_;
-        if (inside) {
-          // Storage index without integer division (hot loop): wrap once.
-          std::int64_t sx = sx0 + static_cast<std::int64_t>(fx);
-          std::int64_t sy = sy0 + static_cast<std::int64_t>(fy);
-          if (sx >= nx_) sx -= nx_;
-          if (sy >= ny_) sy -= ny_;
-          c = sy * nx_ + sx;
-        }
+        const float fx = std::floor(particles_.x[i] * inv_r),
+                    fy = std::floor(particles_.y[i] * inv_r);
+        const bool inside = fx >= 0.0f && fy >= 0.0f && fx < fnx && fy < fny;  // false for NaN too
+        // Storage index without integer division (hot loop): wrap once.
+        std::int32_t sx = sx0i + (inside ? static_cast<std::int32_t>(fx) : 0);
+        std::int32_t sy = sy0i + (inside ? static_cast<std::int32_t>(fy) : 0);
+        sx -= sx >= nx ? nx : 0;
+        sy -= sy >= ny ? ny : 0;
+        const std::int32_t c = inside ? sy * nx + sx : off;
         cell_of_[i] = c;
         ++h[c];
       }
@@ -116,6 +122,9 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
       for (int k = 0; k < chunks; ++k) scatter(k);
     }
   }
+  shift_gx_ = shift_gy_ = 0;  // applied
+  sorted_gx_ = origin_gx_;
+  sorted_gy_ = origin_gy_;
   sorted_current_ = true;  // sorted_ and cell_start_ bin the particles on the current cells
 }
 

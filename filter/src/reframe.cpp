@@ -22,15 +22,22 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   // New coordinates of a point with old coordinates p: R(-angle) p.
   const double c = std::cos(angle), s = std::sin(angle);
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
-  ParticleSet& q = particles_;
+  LocalParticles& q = particles_;
+  // Positions through the caller's frame in double: old local metres -> old caller coordinates
+  // -> turned -> new local metres (the new origin, OriginFor(ego) below).
+  const std::array<std::int64_t, 2> new_origin = OriginFor(ego);
+  const double r = params_.resolution;
+  const double ox = static_cast<double>(origin_gx_), oy = static_cast<double>(origin_gy_);
+  const double nx0 = static_cast<double>(new_origin[0]), ny0 = static_cast<double>(new_origin[1]);
 #pragma omp parallel for schedule(static)
   for (std::int64_t i = 0; i < n; ++i) {
-    const double x = q.x[i], y = q.y[i], vx = q.vx[i], vy = q.vy[i];
-    q.x[i] = c * x + s * y;
-    q.y[i] = -s * x + c * y;
+    const double x = ox * r + q.x[i], y = oy * r + q.y[i], vx = q.vx[i], vy = q.vy[i];
+    q.x[i] = static_cast<float>((c * x + s * y) - nx0 * r);
+    q.y[i] = static_cast<float>((-s * x + c * y) - ny0 * r);
     q.vx[i] = static_cast<float>(c * vx + s * vy);
     q.vy[i] = static_cast<float>(-s * vx + c * vy);
   }
+  InvalidateExports();
 
   // The old layers, then each new cell from the old cell under its centre.
   const std::size_t cells = static_cast<std::size_t>(num_cells_);
@@ -44,9 +51,7 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   const std::int64_t ogx = origin_gx_, ogy = origin_gy_;
   // Plain variables, not a structured binding: clang 14 (the fuzz and TSan builds) cannot
   // capture a binding into the OpenMP region.
-  const std::array<std::int64_t, 2> origin = OriginFor(ego);
-  const std::int64_t gx = origin[0], gy = origin[1];
-  const double r = params_.resolution;
+  const std::int64_t gx = new_origin[0], gy = new_origin[1];
 #pragma omp parallel for schedule(static)
   for (std::int64_t iy = 0; iy < ny_; ++iy) {
     const double yn = (static_cast<double>(gy + iy) + 0.5) * r;

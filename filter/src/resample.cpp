@@ -92,7 +92,7 @@ void DynamicGrid::Resample() {
       } else {
         particles_.CopyFrom(births_, i - n_in, k);
       }
-      particles_.weight[k] = particles_.w_position[k] = particles_.w_velocity[k] = 0.0;
+      particles_.weight[k] = particles_.w_position[k] = particles_.w_velocity[k] = 0.0f;
     });
     return;
   }
@@ -111,7 +111,7 @@ void DynamicGrid::Resample() {
       const std::int64_t k0 = k1;
       k1 = SystematicStart(cum, i + 1, n_src, scale, u, n);
       if (k0 == k1) continue;
-      const ParticleSet& src = i < n_in ? sorted_ : births_;
+      const LocalParticles& src = i < n_in ? sorted_ : births_;
       const std::int64_t si = i < n_in ? i : i - n_in;
       // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
       const double ratio = share / src.weight[si];

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include "grid_internal.hpp"
+#include "weigh_particles.hpp"
 
 namespace dualgrid::filter {
 
@@ -82,6 +83,112 @@ std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t
 
 }  // namespace
 
+detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
+  const FilterParams& p = cycle_params_;
+  const MeasurementGrid& mg = *mg_;
+  const std::size_t nz = z.size();
+  // Nine float columns: bucket-order x, y [m, grid-local]; per detection u0, u1, u2, fit_k, fit_t,
+  // vr_x, vr_y (WeighInputs). At least one row: the kernel gathers row 0 for lanes without a
+  // detection.
+  const std::size_t rows = std::max<std::size_t>(nz, 1);
+  if (det_f_.size() < 9 * rows) det_f_.assign(9 * rows, 0.0f);  // grow only
+  float* col[9];
+  for (std::size_t c = 0; c < 9; ++c) col[c] = det_f_.data() + c * rows;
+  const double r = params_.resolution;
+  const std::int64_t placed = mg.bucket_start_[static_cast<std::size_t>(mg.nbx_) * mg.nby_];
+  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
+  for (std::int64_t k = 0; k < placed; ++k) {  // grid-local metres, as the particles
+    col[0][k] = static_cast<float>(mg.det_x_[k] - x0);
+    col[1][k] = static_cast<float>(mg.det_y_[k] - y0);
+  }
+  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  for (std::size_t j = 0; j < nz; ++j) {
+    col[2][j] = static_cast<float>(mg.det_los_[3 * j]);
+    col[3][j] = static_cast<float>(mg.det_los_[3 * j + 1]);
+    col[4][j] = static_cast<float>(mg.det_los_[3 * j + 2]);
+    col[5][j] = radial_fit ? static_cast<float>(det_fit_k_[j]) : 0.0f;
+    col[6][j] = radial_fit ? static_cast<float>(mg.det_fit_t_[j]) : 0.0f;
+    col[7][j] = static_cast<float>(z[j].radial_velocity.x());
+    col[8][j] = static_cast<float>(z[j].radial_velocity.y());
+  }
+  WeighInputs in;
+  const double cutoff = p.cutoff_sigmas * p.sigma_f;
+  in.inv_2sf2 = static_cast<float>(0.5 / (p.sigma_f * p.sigma_f));
+  in.cutoff2 = static_cast<float>(cutoff * cutoff);
+  in.inv_2v2 = static_cast<float>(0.5 / (p.sigma_v * p.sigma_v));
+  in.keep = static_cast<float>(1.0 - p.decay_eps);
+  in.slow2 = static_cast<float>(p.static_speed * p.static_speed);
+  in.mode = p.mode;
+  in.radial = p.velocity_likelihood != VelocityLikelihood::kVector;
+  in.radial_fit = radial_fit;
+  in.det_x = col[0];
+  in.det_y = col[1];
+  in.det_item = mg.bucket_items_.data();
+  in.u0 = col[2];
+  in.u1 = col[3];
+  in.u2 = col[4];
+  in.fit_k = col[5];
+  in.fit_t = col[6];
+  in.vr_x = col[7];
+  in.vr_y = col[8];
+  return in;
+}
+
+// Eqs. (10-12) for one cell's particles in double, one particle at a time: the path of cells
+// whose per-cell factors (UpdateCells) do not fit in float.
+void DynamicGrid::ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
+                                  double q_norm, double scale, double rho_p, double sum_pos,
+                                  double sum_vel, double fast_mass) const {
+  const FilterParams& p = cycle_params_;
+  const auto mode_factor = [&](double lp, double lv) {
+    return p.mode == WeightMode::kPosition   ? lp
+           : p.mode == WeightMode::kVelocity ? lv
+                                             : std::max(lp, lv);  // eq. (14)
+  };
+  if (literal_norm) {
+    // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
+    // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
+    // A single mode's other weight is not in q_norm and would drift without bound (float
+    // overflow): it is normalised on its own to rho_p, as in the per-cell form.
+    // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
+    // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
+    // <= 1. The other weight's share is w / sum <= 1, times rho_p.
+    const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
+    const bool own_v = fell_back || p.mode != WeightMode::kPosition;
+    const auto norm = [&](double w, bool own, double sum) {
+      if (!(q_norm > 0.0)) return 0.0;
+      if (own) return w * scale / q_norm;
+      return sum > 0.0 ? rho_p * (w / sum) : 0.0;
+    };
+    for (std::int64_t i = c.lo; i < c.hi; ++i) {
+      if (c.weight[i] == 0.0) continue;
+      const double wp = fell_back ? c.weight[i] : c.w_position[i];
+      const double wv = fell_back ? c.weight[i] : c.w_velocity[i];
+      c.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
+      c.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
+      c.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
+    }
+  }
+
+  // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
+  double sum_res = 0.0;
+  for (std::int64_t i = c.lo; i < c.hi && !literal_norm; ++i) {
+    if (c.weight[i] == 0.0) continue;
+    const double m = c.weight[i];
+    const double wp = sum_pos > 0.0 ? rho_p * c.w_position[i] / sum_pos : rho_p * m / fast_mass;
+    const double wv = sum_vel > 0.0 ? rho_p * c.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
+    c.w_position[i] = wp;
+    c.w_velocity[i] = wv;
+    const double wr = mode_factor(wp, wv);  // w_resample
+    c.weight[i] = wr;
+    sum_res += wr;
+  }
+  if (sum_res > 0.0 && !literal_norm) {
+    const double k = rho_p / sum_res;
+    for (std::int64_t i = c.lo; i < c.hi; ++i) c.weight[i] = static_cast<float>(c.weight[i] * k);
+  }
+}
+
 void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
@@ -91,10 +198,8 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);
   const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
   const double keep = 1.0 - p.decay_eps;
-  const double slow2 = p.static_speed * p.static_speed;
   const double max_speed2 = p.max_speed * p.max_speed;
-  const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
-  ParticleSet& q = sorted_;
+  LocalParticles& q = sorted_;
   // Per detection, once per cycle: f_v of the static hypothesis (v = 0; the same in both
   // likelihood forms, since a zero velocity has no line-of-sight component either), and for the
   // radial likelihood the unit line of sight u and the signed compensated radial speed v_r . u.
@@ -119,8 +224,6 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
     for (int j = 0; j < nz; ++j)
       if (fit_k[j] > 0.0) det_fv0_[j] *= ExpUnder(-fit_t[j] * fit_t[j] * fit_k[j]);
   const double* const fv0_of = det_fv0_.data();
-  const double* const los_of = mg.det_los_.data();
-  const bool radial = p.velocity_likelihood != VelocityLikelihood::kVector;
   const bool literal_norm = p.normalisation == Normalisation::kLiteral;
   const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
   const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
@@ -129,10 +232,9 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const int* const near = mg.near_det_.data();
   const double* const near_d2 = mg.near_d2_.data();
   const std::int64_t* const bucket_start = mg.bucket_start_.data();
-  const int* const bucket_items = mg.bucket_items_.data();
-  const double* const det_x = mg.det_x_.data();
-  const double* const det_y = mg.det_y_.data();
   const int nbx = mg.nbx_, nby = mg.nby_;
+  const WeighInputs weigh = WeighTables(z);
+  const float inv_bucket = static_cast<float>(1.0 / (mg.bucket_cells_ * params_.resolution));
   const std::uint8_t* const view_bits = mg.view_.data();
   double* const free_l = free_.data();
   double* const static_l = static_.data();
@@ -205,92 +307,43 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         f_up *= k;
       }
 
-      // --- Particle weights, eqs. (7) and (8), unnormalised. The per-cycle factors double as the
-      // likelihood of each hypothesis in the joint normalisation below. ---
+      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
+      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
+      CellParticles cp{q.x.data(),
+                       q.y.data(),
+                       q.vx.data(),
+                       q.vy.data(),
+                       q.weight.data(),
+                       q.w_position.data(),
+                       q.w_velocity.data(),
+                       lo,
+                       hi,
+                       {{0, 0}, {0, 0}, {0, 0}},
+                       observed,
+                       static_cast<float>(cap),
+                       static_cast<float>(literal_norm ? cap : 1.0)};
+      if (hi > lo) {
+        const int bx = std::clamp(static_cast<int>(std::floor(q.x[lo] * inv_bucket)), 0, nbx - 1);
+        const int by = std::clamp(static_cast<int>(std::floor(q.y[lo] * inv_bucket)), 0, nby - 1);
+        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx - 1, bx + 1);
+        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby - 1, by + 1); ++yy, ++r) {
+          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx;
+          cp.cand[r][0] = bucket_start[row + x_lo];
+          cp.cand[r][1] = bucket_start[row + x_hi + 1];
+        }
+      }
+      // --- Particle weights, eqs. (7) and (8), unnormalised (SIMD lanes: WeighParticles). The
+      // per-cycle factors double as the likelihood of each hypothesis in the joint
+      // normalisation below. ---
+      const CellSums sums = WeighParticles(weigh, cp);
+      const double slow_mass = sums.slow_mass, fast_mass = sums.fast_mass;
+      const double sum_pos = sums.sum_pos, sum_vel = sums.sum_vel, sum_mode = sums.sum_mode;
+      double a_dyn = sums.a_dyn;
       const auto mode_factor = [&](double lp, double lv) {
         return p.mode == WeightMode::kPosition   ? lp
                : p.mode == WeightMode::kVelocity ? lv
                                                  : std::max(lp, lv);  // eq. (14)
       };
-      double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
-      double sum_mode = 0.0;  // sum_k w_k of eq. (9) with the particles' own weights (literal)
-      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
-      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
-      std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
-      bool any_candidate = false;
-      if (hi > lo) {
-        const auto [bx, by] = mg.BucketOf(q.x[lo], q.y[lo]);
-        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx - 1, bx + 1);
-        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby - 1, by + 1); ++yy, ++r) {
-          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx;
-          cand[r][0] = bucket_start[row + x_lo];
-          cand[r][1] = bucket_start[row + x_hi + 1];
-          any_candidate = any_candidate || cand[r][1] > cand[r][0];
-        }
-      }
-      for (std::int64_t i = lo; i < hi; ++i) {
-        const double m = q.weight[i] * cap;
-        q.weight[i] = m;
-        if (q.vx[i] * q.vx[i] + q.vy[i] * q.vy[i] < slow2) {
-          // A particle at (almost) zero speed is the static hypothesis (occ and v = 0): its mass
-          // votes static and the particle dies at resampling.
-          slow_mass += m;
-          q.w_position[i] = q.w_velocity[i] = q.weight[i] = 0.0;
-          continue;
-        }
-        // Nearest detection within the cutoff (ties to the lower detection index).
-        int jn = -1;
-        double d2 = cutoff2;
-        if (any_candidate) {
-          const double px = q.x[i], py = q.y[i];
-          for (const auto& range : cand) {
-            for (std::int64_t k = range[0]; k < range[1]; ++k) {
-              const double ex = det_x[k] - px, ey = det_y[k] - py;
-              const double e2 = ex * ex + ey * ey;
-              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items[k] < jn)) {
-                d2 = e2;
-                jn = bucket_items[k];
-              }
-            }
-          }
-        }
-        double lp = keep, lv = keep;  // unobserved: decayed prior
-        if (jn >= 0 || observed) {
-          // Float exp: kernel values need no double precision and this runs per particle.
-          const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
-          double fv = 0.0;
-          if (jn >= 0) {
-            double e2;
-            if (radial) {  // line-of-sight component against the measured radial speed
-              const double* u = los_of + 3 * jn;
-              const double e = q.vx[i] * u[0] + q.vy[i] * u[1] - u[2];
-              e2 = e * e;
-              if (radial_fit && fit_k[jn] > 0.0) {  // along the tangent (-u_y, u_x): the fit
-                const double et = -q.vx[i] * u[1] + q.vy[i] * u[0] - fit_t[jn];
-                e2 += et * et * fit_k[jn] / inv_2v2;  // in units of sigma_v^2
-              }
-            } else {  // eq. (8): the full vector against mu_v = (v_rx, v_ry)
-              const double ex = q.vx[i] - z[jn].radial_velocity.x();
-              const double ey = q.vy[i] - z[jn].radial_velocity.y();
-              e2 = ex * ex + ey * ey;
-            }
-            fv = ExpUnder(static_cast<float>(-e2 * inv_2v2));
-          }
-          lp = fd * keep;                    // eq. (7)
-          lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
-        }
-        // The literal normalisation sums the particles' own weights, so they share the cap of
-        // their mass; the per-cell form renormalises them below and needs no cap.
-        const double wcap = literal_norm ? cap : 1.0;
-        const double wp = lp * q.w_position[i] * wcap, wv = lv * q.w_velocity[i] * wcap;
-        q.w_position[i] = wp;
-        q.w_velocity[i] = wv;
-        fast_mass += m;
-        sum_pos += wp;
-        sum_vel += wv;
-        sum_mode += mode_factor(wp, wv);
-        a_dyn += m * mode_factor(lp, lv);
-      }
       // The static hypothesis is scored like a particle with v = 0 at the cell centre.
       double ls_pos = keep, ls_vel = keep;
       if (j >= 0 || observed) {
@@ -348,47 +401,38 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         rho_b = share * a_birth / q_norm;
         if (literal_norm) f_up = free_part * a_free / q_norm;
       }
+      // --- Eqs. (10-12) for the particles: on SIMD lanes (NormaliseWeights) with per-cell
+      // factors, where they are finite in float; else (rare: tiny sums) the double path. ---
+      NormaliseFactors nf;
+      nf.literal = literal_norm;
+      nf.mode = p.mode;
+      double kp, kv, kw = 0.0;
       if (literal_norm) {
-        // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
-        // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
-        // A single mode's other weight is not in q_norm and would drift without bound (float
-        // overflow): it is normalised on its own to rho_p, as in the per-cell form.
-        // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
-        // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
-        // <= 1. The other weight's share is w / sum <= 1, times rho_p.
+        // Own weights w * scale / q_norm; with scale != 1 the unscaled q_norm is subnormal and
+        // every float weight below it is 0, so the factor is 0 (not scale / q_norm = inf).
+        const double own = q_norm > 0.0 && scale == 1.0 ? 1.0 / q_norm : 0.0;
         const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
         const bool own_v = fell_back || p.mode != WeightMode::kPosition;
-        const auto norm = [&](double w, bool own, double sum) {
-          if (!(q_norm > 0.0)) return 0.0;
-          if (own) return w * scale / q_norm;
-          return sum > 0.0 ? rho_p * (w / sum) : 0.0;
-        };
-        for (std::int64_t i = lo; i < hi; ++i) {
-          if (q.weight[i] == 0.0) continue;
-          const double wp = fell_back ? q.weight[i] : q.w_position[i];
-          const double wv = fell_back ? q.weight[i] : q.w_velocity[i];
-          q.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
-          q.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
-          q.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
-        }
+        nf.mass_p = nf.mass_v = fell_back;
+        kp = own_p ? own : (q_norm > 0.0 && sum_pos > 0.0 ? rho_p / sum_pos : 0.0);
+        kv = own_v ? own : (q_norm > 0.0 && sum_vel > 0.0 ? rho_p / sum_vel : 0.0);
+        kw = own;
+      } else {
+        nf.mass_p = !(sum_pos > 0.0);
+        nf.mass_v = !(sum_vel > 0.0);
+        kp = rho_p / (nf.mass_p ? fast_mass : sum_pos);
+        kv = rho_p / (nf.mass_v ? fast_mass : sum_vel);
       }
-
-      // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
-      double sum_res = 0.0;
-      for (std::int64_t i = lo; i < hi && !literal_norm; ++i) {
-        if (q.weight[i] == 0.0) continue;
-        const double m = q.weight[i];
-        const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
-        const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
-        q.w_position[i] = wp;
-        q.w_velocity[i] = wv;
-        const double wr = mode_factor(wp, wv);  // w_resample
-        q.weight[i] = wr;
-        sum_res += wr;
-      }
-      if (sum_res > 0.0 && !literal_norm) {
-        const double k = rho_p / sum_res;
-        for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
+      constexpr double kFloatMax = std::numeric_limits<float>::max();
+      if (hi > lo && !(std::abs(kp) <= kFloatMax && std::abs(kv) <= kFloatMax)) {
+        ScalarNormalise(cp, literal_norm, fell_back, q_norm, scale, rho_p, sum_pos, sum_vel,
+                        fast_mass);
+      } else if (hi > lo) {
+        nf.kp = static_cast<float>(kp);
+        nf.kv = static_cast<float>(kv);
+        nf.kw = static_cast<float>(kw);
+        const double sum_res = NormaliseWeights(nf, cp);
+        if (sum_res > 0.0 && !literal_norm) ScaleWeights(static_cast<float>(rho_p / sum_res), cp);
       }
       free_[s] = f_up;
       static_[s] = s_up;

@@ -67,7 +67,9 @@ struct TargetView {
   bool has_particles = false;
 };
 
-inline TargetView LookAt(const DynamicGrid& grid, OrientedBox box, double margin) {
+/// Grid: DynamicGrid, or the double reference filter_ref::DynamicGrid (test_float_bound.cpp).
+template <typename Grid>
+TargetView LookAt(const Grid& grid, OrientedBox box, double margin) {
   box.length += 2.0 * margin;
   box.width += 2.0 * margin;
   TargetView v;
@@ -77,12 +79,12 @@ inline TargetView LookAt(const DynamicGrid& grid, OrientedBox box, double margin
     for (double x = box.center.x() - reach; x <= box.center.x() + reach; x += r) {
       const auto c = grid.CellOf({x, y});
       if (!c || !box.Contains(grid.CellCenter(*c))) continue;
-      const CellState s = grid.Cell(*c);
+      const auto s = grid.Cell(*c);
       v.max_dynamic = std::max(v.max_dynamic, s.dynamic);
       v.max_static = std::max(v.max_static, s.static_occ);
     }
   }
-  const ParticleSet& p = grid.particles();
+  const auto& p = grid.particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!box.Contains({p.x[i], p.y[i]})) continue;
     v.mean_velocity += p.weight[i] * Velocity(p.vx[i], p.vy[i]);
@@ -110,9 +112,9 @@ struct Trace {
 //           foot point of the side face (+-0.6 m, so |v_r| <= 25 * 0.6 / 8 = 1.9 m/s).
 //  kStatic: parked box 30 m ahead of the resting ego, zero Doppler.
 // From cycle `silent_from` on the sensor still observes but reports no detection (a missed target).
-inline Trace Run(Case c, FilterParams fp, std::uint64_t seed, int cycles = 60,
-                 int silent_from = 1 << 30) {
-  DynamicGrid g(fp, seed);
+template <typename Grid = DynamicGrid>
+Trace Run(Case c, FilterParams fp, std::uint64_t seed, int cycles = 60, int silent_from = 1 << 30) {
+  Grid g(fp, seed);
   const double dt = 0.05;
   Trace tr;
   for (int k = 0; k < cycles; ++k) {

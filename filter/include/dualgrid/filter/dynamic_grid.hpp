@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -18,12 +19,18 @@
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/local_particles.hpp"
 #include "dualgrid/filter/measurement_grid.hpp"
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/filter/particles.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
 
 namespace dualgrid::filter {
+
+namespace detail {
+struct WeighInputs;
+struct CellParticles;
+}  // namespace detail
 
 /// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
 /// elsewhere in the grid offsets it, as dualgrid's filter.ahead / filter.left do).
@@ -50,6 +57,13 @@ struct CellState {
   Matrix2 velocity_cov = Matrix2::Zero();
   /// Inside the field of view of at least one sensor this cycle.
   bool observed = false;
+};
+
+/// One weighted particle in the caller's frame (DynamicGrid::WeightedParticle).
+struct ParticleView {
+  Position position;  ///< [m]
+  Velocity velocity;  ///< [m/s]
+  float weight = 0.0f;
 };
 
 class DynamicGrid {
@@ -111,16 +125,29 @@ class DynamicGrid {
   void ExportMasses(std::span<float> free, std::span<float> static_occ, std::span<float> dynamic,
                     std::span<std::uint8_t> observed) const;
 
-  /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count).
-  const ParticleSet& particles() const { return particles_; }
+  /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count), in
+  /// the caller's frame. The filter keeps them in float grid-local coordinates (docs/algorithm.md,
+  /// "Float state"); this copy in double caller coordinates is made at the first call after an
+  /// Update or Reframe (O(particles), thread-safe) and kept until the next one.
+  const ParticleSet& particles() const;
   /// Persistent particles after the last weight update, before birth and resampling, sorted by
   /// cell: `weight` is the mode's weight normalised so that each cell's weights sum to its
   /// dynamic mass (particles slower than static_speed carry 0). The first
   /// num_weighted_particles() entries are valid. This is the weighted particle set the paper
-  /// clusters (Sec. V); after resampling all weights are equal.
-  const ParticleSet& weighted_particles() const { return sorted_; }
+  /// clusters (Sec. V); after resampling all weights are equal. A copy as particles()' (the frame
+  /// of the last Update, also after a Reframe).
+  const ParticleSet& weighted_particles() const;
   std::size_t num_weighted_particles() const {
     return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
+  }
+  /// Entry i < num_weighted_particles() of weighted_particles() without copying the set (the
+  /// scorer reads the few particles of dynamic cells every cycle).
+  ParticleView WeightedParticle(std::size_t i) const {
+    const double r = params_.resolution;
+    return {{static_cast<double>(sorted_gx_) * r + sorted_.x[i],
+             static_cast<double>(sorted_gy_) * r + sorted_.y[i]},
+            {sorted_.vx[i], sorted_.vy[i]},
+            sorted_.weight[i]};
   }
   /// Calls f(k, first, last) for every cell holding weighted particles whose value v in `layer`
   /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer, or a layer
@@ -165,10 +192,16 @@ class DynamicGrid {
   void PredictAndSort(double dt, const PredictionNoise* noise);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
   void UpdateCells(std::span<const Measurement> z);
+  // This cycle's float detection tables of the particle kernel (into det_f_).
+  detail::WeighInputs WeighTables(std::span<const Measurement> z);
+  // Eqs. (10-12) for one cell's particles in double (cells whose factors overflow float).
+  void ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
+                       double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
+                       double fast_mass) const;
   void Birth(std::span<const Measurement> z);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
-                      std::int64_t k_hi, double mass, double r, double vmax);
+                      std::int64_t k_hi, double mass, double vmax);
   void Resample();
 
   FilterParams params_;
@@ -186,11 +219,32 @@ class DynamicGrid {
   std::vector<double> free_, static_, dynamic_, born_;
   std::vector<std::uint8_t> view_;  // the last cycle's MeasurementGrid bits (Cell, ExportMasses)
 
-  // Particles: persistent set (public), sorted working copy, new-born.
-  ParticleSet particles_, sorted_, births_;
-  std::vector<std::int64_t> cell_of_;     // storage cell per particle, num_cells_ if outside
-  std::vector<std::int64_t> cell_start_;  // num_cells_ + 2: particle ranges of sorted_
-  std::vector<std::int32_t> hist_;        // per-chunk histograms of the counting sort
+  // Particles (float, grid-local metres): persistent set, sorted working copy, new-born.
+  detail::LocalParticles particles_, sorted_, births_;
+  // Whole cells the grid moved in this cycle's ShiftTo, subtracted in the prediction's pass.
+  std::int64_t shift_gx_ = 0, shift_gy_ = 0;
+  // Origin of the cells sorted_ is sorted on (weighted_particles(): the frame of the last Update).
+  std::int64_t sorted_gx_ = 0, sorted_gy_ = 0;
+  // particles() / weighted_particles() in the caller's frame, made on demand under the lock.
+  struct Exported {
+    ParticleSet set;
+    bool valid = false;
+  };
+  struct ExportLock {  // copies and moves make a new mutex
+    std::mutex m;
+    ExportLock() = default;
+    ExportLock(const ExportLock&) {}
+    ExportLock& operator=(const ExportLock&) { return *this; }
+  };
+  mutable Exported exported_, exported_weighted_;
+  mutable ExportLock export_lock_;
+  void InvalidateExports() { exported_.valid = exported_weighted_.valid = false; }
+  // `out`, made from `in` (grid-local, origin (gx, gy)) unless still valid.
+  const ParticleSet& ExportOnce(Exported& out, const detail::LocalParticles& in, std::int64_t gx,
+                                std::int64_t gy) const;
+  detail::AlignedVector<std::int32_t> cell_of_;  // storage cell per particle, num_cells_ if outside
+  std::vector<std::int64_t> cell_start_;         // num_cells_ + 2: particle ranges of sorted_
+  std::vector<std::int32_t> hist_;               // per-chunk histograms of the counting sort
   std::vector<std::int64_t> hist_total_;
   std::vector<double> scan_out_;    // resampling prefix sums of the source weights
   std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
@@ -205,16 +259,22 @@ class DynamicGrid {
   std::optional<MeasurementGrid> own_measurement_;  // the first standalone Update makes it
   std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
   std::vector<double> det_fit_k_;       // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
+  detail::AlignedVector<float> det_f_;  // WeighTables' columns
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
   if (!initialized_ || !p.allFinite()) return std::nullopt;
-  // The arithmetic of the particles' sort (PredictAndSort): a particle's cell is the one it was
-  // weighed in, whatever the resolution.
-  const double inv_r = 1.0 / params_.resolution;
-  const double fx = std::floor(p.x() * inv_r) - static_cast<double>(origin_gx_);
-  const double fy = std::floor(p.y() * inv_r) - static_cast<double>(origin_gy_);
-  if (fx < 0.0 || fy < 0.0 || fx >= nx_ || fy >= ny_) return std::nullopt;
+  // The particles' grid-local float metres and the sort's arithmetic (PredictAndSort): a
+  // position of weighted_particles() gives back the particle's own float, so its cell is the one
+  // it was weighed in, whatever the resolution.
+  const double r = params_.resolution;
+  const float inv_r = static_cast<float>(1.0 / r);
+  const float fx =
+      std::floor(static_cast<float>(p.x() - static_cast<double>(origin_gx_) * r) * inv_r);
+  const float fy =
+      std::floor(static_cast<float>(p.y() - static_cast<double>(origin_gy_) * r) * inv_r);
+  if (!(fx >= 0.0f && fy >= 0.0f && fx < static_cast<float>(nx_) && fy < static_cast<float>(ny_)))
+    return std::nullopt;
   return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
 }
 

@@ -141,12 +141,13 @@ struct FilterParams {
   /// Heap memory of one DynamicGrid with these parameters after its first Update [bytes], from
   /// its layout: per cell 94 bytes (81 of the grid: four double masses, free-space bits, cell
   /// ranges, birth list, 8 sort histograms; 13 of its own MeasurementGrid: free-space bits,
-  /// nearest detection and distance), per persistent particle 88 (the particle and its sorted
-  /// copy, 36 each, cell index, resampling sum), per new-born particle 44. A grid fed a shared
-  /// MeasurementGrid never allocates its own (13 bytes per cell less). Within a few percent of
-  /// the measured allocation (tests/filter/test_params.cpp); detection buffers (which grow with
-  /// the detections per cycle) are not included. Lets a caller refuse a configuration before
-  /// allocating it.
+  /// nearest detection and distance), per persistent particle 68 (the particle and its sorted
+  /// copy, 28 each in float, 32-bit cell index, resampling sum), per new-born particle 36; the
+  /// double copies particles() and weighted_particles() make on demand (36 each) are not included.
+  /// A grid fed a shared MeasurementGrid never allocates its own (13 bytes per cell less). Within a
+  /// few percent of the measured allocation (tests/filter/test_params.cpp); detection buffers
+  /// (which grow with the detections per cycle) are not included. Lets a caller refuse a
+  /// configuration before allocating it.
   double MemoryBytes() const;
 
   /// True when every field is usable; otherwise names the offending field in *error.

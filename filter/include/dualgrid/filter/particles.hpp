@@ -9,6 +9,19 @@
 
 namespace dualgrid::filter {
 
+/// dst's particle k = src's particle i, all seven fields (ParticleSet or the filter's
+/// detail::LocalParticles: the same field names).
+template <typename Set>
+void CopyParticle(const Set& src, std::size_t i, Set& dst, std::size_t k) {
+  dst.x[k] = src.x[i];
+  dst.y[k] = src.y[i];
+  dst.vx[k] = src.vx[i];
+  dst.vy[k] = src.vy[i];
+  dst.w_position[k] = src.w_position[i];
+  dst.w_velocity[k] = src.w_velocity[i];
+  dst.weight[k] = src.weight[i];
+}
+
 /// Particles in the filter's frame (the caller's; in dualgrid the grid frame, docs/algorithm.md)
 /// [m], [m/s]. Positions are double (coordinates can be far from the origin: the grid frame only
 /// turns the world's, keeping their magnitude); velocities and weights are float, which halves the
@@ -25,13 +38,7 @@ struct ParticleSet {
   void resize(std::size_t n);
   /// Copies particle `src_index` of `src` into slot `dst_index` of this set.
   void CopyFrom(const ParticleSet& src, std::size_t src_index, std::size_t dst_index) {
-    x[dst_index] = src.x[src_index];
-    y[dst_index] = src.y[src_index];
-    vx[dst_index] = src.vx[src_index];
-    vy[dst_index] = src.vy[src_index];
-    w_position[dst_index] = src.w_position[src_index];
-    w_velocity[dst_index] = src.w_velocity[src_index];
-    weight[dst_index] = src.weight[src_index];
+    CopyParticle(src, src_index, *this, dst_index);
   }
 };
 

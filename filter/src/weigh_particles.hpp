@@ -1,0 +1,72 @@
+// The per-particle part of step 5 (paper eqs. 7, 8, 14), vectorised (internal): one cell's
+// particles in float, SIMD lanes through Highway. docs/algorithm.md, "Float state".
+#pragma once
+
+#include <cstdint>
+
+#include "dualgrid/filter/params.hpp"
+
+namespace dualgrid::filter::detail {
+
+/// Per-cycle inputs of WeighParticles. Positions in grid-local metres (LocalParticles).
+struct WeighInputs {
+  float inv_2sf2 = 0;  ///< 1 / (2 sigma_f^2) [1/m^2]
+  float cutoff2 = 0;   ///< (cutoff_sigmas sigma_f)^2 [m^2]
+  float inv_2v2 = 0;   ///< 1 / (2 sigma_v^2) [s^2/m^2]
+  float keep = 0;      ///< 1 - decay_eps
+  float slow2 = 0;     ///< static_speed^2 [m^2/s^2]
+  WeightMode mode = WeightMode::kDual;
+  bool radial = true, radial_fit = false;
+  /// Detections in bucket order k: grid-local position [m] and index j.
+  const float *det_x = nullptr, *det_y = nullptr;
+  const int* det_item = nullptr;
+  /// Per detection index j: unit line of sight (u0, u1), signed radial speed u2 [m/s], the fit's
+  /// tangential factor fit_k (1 / (2 (sigma_v^2 + s_t^2)), 0: none) and speed fit_t [m/s], the
+  /// compensated radial velocity vector (vr_x, vr_y) [m/s].
+  const float *u0 = nullptr, *u1 = nullptr, *u2 = nullptr, *fit_k = nullptr, *fit_t = nullptr;
+  const float *vr_x = nullptr, *vr_y = nullptr;
+};
+
+/// One cell's particles [lo, hi) of the sorted set (arrays as LocalParticles').
+struct CellParticles {
+  const float *x, *y, *vx, *vy;
+  float *weight, *w_position, *w_velocity;
+  std::int64_t lo, hi;
+  /// The cell's candidate detections: bucket-order ranges [cand[r][0], cand[r][1]).
+  std::int64_t cand[3][2];
+  bool observed;
+  float cap;   ///< the dynamic-mass cap of the cell's weights (1 / d_pred above 1)
+  float wcap;  ///< cap for the literal normalisation, 1 for the per-cell one
+};
+
+/// Sums of one cell's particle loop (as UpdateCells' eqs. 9-12 read them).
+struct CellSums {
+  double slow_mass = 0, fast_mass = 0, sum_pos = 0, sum_vel = 0, sum_mode = 0, a_dyn = 0;
+};
+
+/// For each particle: m = weight * cap; below static_speed its weights become 0 (m counts as
+/// slow mass); otherwise the nearest candidate detection within the cutoff (ties to the lower
+/// index j), the position and velocity likelihoods lp, lv (eqs. 7, 8: decayed prior `keep`
+/// where neither a detection nor the field of view scores it), weight <- m, w_position <- lp
+/// w_position wcap, w_velocity <- lv w_velocity wcap. Returns the sums. The lanes' sums are added
+/// in a fixed order: the result depends on the particles alone (one SIMD target per build).
+CellSums WeighParticles(const WeighInputs& in, const CellParticles& c);
+
+/// Per-cell factors of the weights' normalisation (eqs. 10-12, UpdateCells): a particle with
+/// weight m != 0 and weights (wp, wv) gets sources sp = (mass_p ? m : wp), sv = (mass_v ? m : wv),
+/// w_position = sp kp, w_velocity = sv kv and weight = mode(sp, sv) kw (literal) or
+/// mode(w_position, w_velocity) (per cell, scaled afterwards by ScaleWeights). Particles with
+/// weight 0 are left as they are.
+struct NormaliseFactors {
+  bool mass_p = false, mass_v = false, literal = false;
+  float kp = 0, kv = 0, kw = 0;
+  WeightMode mode = WeightMode::kDual;
+};
+
+/// Normalises one cell's weights (NormaliseFactors); returns the sum of the new weights (lanes in
+/// a fixed order).
+double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c);
+/// weight *= k for the cell's particles.
+void ScaleWeights(float k, const CellParticles& c);
+
+}  // namespace dualgrid::filter::detail

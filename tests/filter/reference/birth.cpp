@@ -1,0 +1,181 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Step 7 of the cycle (docs/algorithm.md): new-born particles from the birth mass (Nuss et al.'s
+// birth; the paper gives it no equation), velocities from the Doppler of eq. (1).
+#include "dynamic_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dualgrid/core/parallel.hpp"
+#include "dualgrid/core/random.hpp"
+#include "fast_normal.hpp"
+#include "grid_internal.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+using namespace detail;
+
+void DynamicGrid::Birth(std::span<const Measurement> z) {
+  const std::int64_t nb = static_cast<std::int64_t>(births_.size());
+  const std::int64_t nc = num_cells_;
+  // Prefix sums of the birth masses with the summation order of ExclusiveScan (blocks of
+  // kScanBlock), without materialising them: block totals here, running sums in the loop below.
+  const std::int64_t blocks = (nc + kScanBlock - 1) / kScanBlock;
+  std::vector<double>& tot = born_block_;
+  tot.resize(blocks + 1);
+  // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so only the cells of
+  // UpdateCells' per-chunk lists (non-zero mass, in cell order) are visited: same sums.
+  const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
+  constexpr std::int64_t kChunksPerBlock = kScanBlock / kCellChunk;
+  const auto for_each_born = [&](std::int64_t b, auto&& f) {
+    for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
+         ++ch) {
+      const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+      for (std::int32_t t = 0; t < born_count_[ch]; ++t) f(list[t]);
+    }
+  };
+  ParallelFor(
+      blocks, Schedule::kStatic,
+      [&](std::int64_t b) {
+        double acc = 0.0;
+        for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
+        tot[b + 1] = acc;
+      },
+      /*worth=*/blocks > 8);
+  tot[0] = 0.0;
+  for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
+  const double total = tot[blocks];
+  if (nb == 0) return;
+  if (!(total > 0.0)) {
+    std::fill(births_.weight.begin(), births_.weight.end(), 0.0);
+    std::fill(births_.w_position.begin(), births_.w_position.end(), 0.0);
+    std::fill(births_.w_velocity.begin(), births_.w_velocity.end(), 0.0);
+    return;
+  }
+  // New-born particles are spread over cells in proportion to their birth mass (systematic
+  // allocation, SystematicRanges); every birth carries the same mass total / num_birth.
+  CounterRng offset_rng(seed_, RngPurpose::kFilterBirth, step_, 0xFFFFFFFFu);
+  const double u = offset_rng.Uniform();
+  const double scale = static_cast<double>(nb) / total;
+  const double mass = total / static_cast<double>(nb);
+  const double r = params_.resolution;
+  const double vmax = params_.birth_max_tangential_speed;
+  const auto start = [&](std::int64_t i, double cumulative) -> std::int64_t {
+    if (i == 0) return 0;
+    if (i == nc) return nb;
+    return std::clamp(CeilToInt(cumulative * scale - u), std::int64_t{0}, nb);
+  };
+  // Running sum at each chunk start (sequential from the block base, as in the loop below), so
+  // that the births can be generated chunk by chunk (load balance: births cluster in few blocks).
+  double* const chunk_acc = born_chunk_acc_.data();
+  ParallelFor(
+      blocks, Schedule::kStatic,
+      [&](std::int64_t b) {
+        double acc = tot[b];
+        for (std::int64_t ch = b * kChunksPerBlock;
+             ch < std::min(n_chunks, (b + 1) * kChunksPerBlock); ++ch) {
+          chunk_acc[ch] = acc;
+          const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+          for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
+        }
+      },
+      /*worth=*/blocks > 8);
+  ParallelFor(n_chunks, Schedule::kDynamic, [&](std::int64_t ch) {
+    const std::int64_t b = ch / kChunksPerBlock;
+    const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;
+    const bool has_last = last < (ch + 1) * kCellChunk;  // the block's last cell is in this chunk
+    double acc = chunk_acc[ch];
+    bool last_seen = false;
+    // Inside a block a zero mass leaves the running sum unchanged: empty range. Only the cells
+    // with mass and the block's last cell (where the block total takes over) can get births.
+    const auto visit = [&](std::int64_t s, double born) {
+      const bool block_end = s == last;
+      last_seen = last_seen || block_end;
+      const double cum_s = acc;
+      if (born != 0.0) acc += born;
+      const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
+      if (k_lo == k_hi) return;
+      GenerateBirths(z, s, k_lo, k_hi, mass, r, vmax);
+    };
+    const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+    for (std::int32_t t = 0; t < born_count_[ch]; ++t) visit(list[t], born_[list[t]]);
+    if (has_last && !last_seen) visit(last, 0.0);
+  });
+}
+
+void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
+                                 std::int64_t k_hi, double mass, double r, double vmax) {
+  const int j = mg_->near_det_[s];
+  // Global cell of storage index s: the unique one inside the current window.
+  const std::int64_t sx = s % nx_, sy = s / nx_;
+  const std::int64_t gx = origin_gx_ + Mod(sx - origin_gx_, nx_);
+  const std::int64_t gy = origin_gy_ + Mod(sy - origin_gy_, ny_);
+  if (j < 0) {
+    // Birth mass needs a detection nearby; only a rounding jump of the prefix sums at a block
+    // boundary could land here. Keep the slots harmless (zero mass at the cell centre).
+    for (std::int64_t k = k_lo; k < k_hi; ++k) {
+      births_.x[k] = (static_cast<double>(gx) + 0.5) * r;
+      births_.y[k] = (static_cast<double>(gy) + 0.5) * r;
+      births_.vx[k] = births_.vy[k] = 0.0f;
+      births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = 0.0f;
+    }
+    return;
+  }
+  const Measurement& m = z[j];
+  Vector2 los = m.position - m.sensor_position;
+  const double los_n = los.norm();
+  los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
+  const Vector2 tangent(-los.y(), los.x());
+  const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
+  const double vt_max = std::min(
+      vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed - v_radial * v_radial)));
+  const bool uniform = params_.birth_velocity == BirthVelocity::kUniform;
+  // doppler_fit: where the fit knows the tangential part better than the uniform draw (whose
+  // standard deviation is vt_max / sqrt(3)), births draw it from the fit, but for a share kept
+  // uniform (FitDetectionVelocities).
+  const bool fitted = params_.birth_velocity == BirthVelocity::kDopplerFit &&
+                      mg_->det_fit_sd_[j] < vt_max / std::sqrt(3.0);
+  const double fit_t = fitted ? mg_->det_fit_t_[j] : 0.0,
+               fit_sd = fitted ? mg_->det_fit_sd_[j] : 0.0;
+  constexpr std::int64_t kBatch = 64;
+  alignas(64) std::uint32_t raw[4][kBatch], raw2[4][kBatch];
+  for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
+    const std::int64_t cnt = std::min(kBatch, k_hi - k0);
+    // Draws 0-3 (block 0) and 4 (block 1) of CounterRng(seed, kFilterBirth, step, k).
+    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
+                         cnt, 0, raw[0], raw[1], raw[2], raw[3]);
+    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
+                         cnt, 1, raw2[0], raw2[1], raw2[2], raw2[3]);
+    for (std::int64_t t = 0; t < cnt; ++t) {
+      const std::int64_t k = k0 + t;
+      births_.x[k] = (static_cast<double>(gx) + detail::ToUnit24(raw[0][t])) * r;
+      births_.y[k] = (static_cast<double>(gy) + detail::ToUnit24(raw[1][t])) * r;
+      float n0, n1;
+      detail::Normal2FromRaw(raw[2][t], raw[3][t], &n0, &n1);
+      Vector2 v;
+      if (uniform) {
+        // Uniform in the disc |v| <= max_speed (area-uniform radius): no Doppler information.
+        const double speed = params_.max_speed * std::sqrt(detail::ToUnit24(raw2[0][t]));
+        const double angle = 2.0 * kPi * detail::ToUnit24(raw2[1][t]);
+        v = speed * Vector2(std::cos(angle), std::sin(angle));
+      } else {
+        // Radial component from the Doppler, tangential one unobservable by this detection:
+        // sampled uniformly, within what keeps the speed at most max_speed, or from the fit.
+        // (Draw 5 and the second normal are used by doppler_fit only: doppler is unchanged.)
+        double vt = vt_max * (2.0 * detail::ToUnit24(raw2[0][t]) - 1.0);
+        if (fitted && detail::ToUnit24(raw2[1][t]) >= params_.birth_fit_uniform_share)
+          vt = std::clamp(fit_t + fit_sd * n1, -vt_max, vt_max);
+        v = (v_radial + params_.birth_sigma_radial * n0) * los + vt * tangent;
+      }
+      births_.vx[k] = v.x();
+      births_.vy[k] = v.y();
+      births_.weight[k] = births_.w_position[k] = births_.w_velocity[k] = mass;
+    }
+  }
+}
+
+}  // namespace dualgrid::filter_ref

@@ -1,0 +1,85 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Step 9 of the cycle (docs/algorithm.md, paper Sec. V): per-cell read-out of the masses and of the
+// weighted velocity mean and covariance of a cell's particles, on demand (not part of Update).
+#include "dynamic_grid.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "grid_internal.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+using namespace detail;
+
+CellState DynamicGrid::Cell(CellIndex c) const {
+  if (c.x < 0 || c.y < 0 || c.x >= nx_ || c.y >= ny_) {
+    throw std::out_of_range("DynamicGrid::Cell: index (" + std::to_string(c.x) + ", " +
+                            std::to_string(c.y) + ") outside " + std::to_string(nx_) + " x " +
+                            std::to_string(ny_));
+  }
+  const std::int64_t s = Storage(origin_gx_ + c.x, origin_gy_ + c.y);
+  CellState out;
+  out.free = free_[s];
+  out.static_occ = static_[s];
+  out.dynamic = dynamic_[s];
+  out.unknown = std::max(0.0, 1.0 - out.free - out.static_occ - out.dynamic);
+  // Velocity statistics on demand from the weighted particles of the last update (sorted_ and
+  // its cell ranges stay valid until the next Update): saves five layers of memory traffic.
+  double wsum = 0.0, mx = 0.0, my = 0.0;
+  for (std::int64_t i = cell_start_[s]; i < cell_start_[s + 1]; ++i) {
+    wsum += sorted_.weight[i];
+    mx += sorted_.weight[i] * static_cast<double>(sorted_.vx[i]);
+    my += sorted_.weight[i] * static_cast<double>(sorted_.vy[i]);
+  }
+  if (wsum > 0.0) {
+    out.mean_velocity = {mx / wsum, my / wsum};
+    Matrix2 cov = Matrix2::Zero();
+    for (std::int64_t i = cell_start_[s]; i < cell_start_[s + 1]; ++i) {
+      const Vector2 e(sorted_.vx[i] - out.mean_velocity.x(), sorted_.vy[i] - out.mean_velocity.y());
+      cov += sorted_.weight[i] * e * e.transpose();
+    }
+    out.velocity_cov = cov / wsum;
+  }
+  out.observed = (view_[s] & kObserved) != 0;
+  return out;
+}
+
+void DynamicGrid::ExportMasses(std::span<float> free, std::span<float> static_occ,
+                               std::span<float> dynamic, std::span<std::uint8_t> observed) const {
+  const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  if (free.size() != n || static_occ.size() != n || dynamic.size() != n || observed.size() != n)
+    throw std::invalid_argument(
+        "DynamicGrid::ExportMasses: spans of " + std::to_string(free.size()) + "/" +
+        std::to_string(static_occ.size()) + "/" + std::to_string(dynamic.size()) + "/" +
+        std::to_string(observed.size()) + " entries for " + std::to_string(n) + " cells");
+  // A logical row is its circular storage row from column sx0 on, wrapping once: two contiguous
+  // runs, each a plain loop the compiler vectorises.
+  static_assert(kObserved == 1, "observed[] is 0 or 1");
+  const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  const auto copy = [&](std::size_t i, std::int64_t s, std::int64_t count) {
+    const double* const f = free_.data() + s;
+    const double* const st = static_.data() + s;
+    const double* const d = dynamic_.data() + s;
+    const std::uint8_t* const v = view_.data() + s;
+    for (std::int64_t k = 0; k < count; ++k) {
+      free[i + k] = static_cast<float>(f[k]);
+      static_occ[i + k] = static_cast<float>(st[k]);
+      dynamic[i + k] = static_cast<float>(d[k]);
+      observed[i + k] = static_cast<std::uint8_t>(v[k] & kObserved);  // 0 or 1
+    }
+  };
+  for (int y = 0; y < ny_; ++y) {
+    const std::int64_t row = Mod(origin_gy_ + y, ny_) * nx_;
+    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_);
+    copy(i, row + sx0, nx_ - sx0);
+    copy(i + static_cast<std::size_t>(nx_ - sx0), row, sx0);
+  }
+}
+
+}  // namespace dualgrid::filter_ref

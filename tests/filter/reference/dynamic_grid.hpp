@@ -1,0 +1,254 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Radar-only dynamic occupancy grid with position, velocity and dual particle weights
+// (Ronecker, Stolz, Watzenig 2023) on a Nuss-style random-finite-set particle grid.
+// Pipeline and choices: docs/algorithm.md.
+//
+// Frame: the filter is frame-agnostic. Every input and output is in one Cartesian frame, the
+// caller's (in dualgrid the grid frame, docs/algorithm.md "Grid frame"), and the grid's cells are
+// axis-aligned with it.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/params.hpp"
+#include "measurement_grid.hpp"
+#include "particles.hpp"
+#include "prediction_noise.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+/// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
+/// elsewhere in the grid offsets it, as dualgrid's filter.ahead / filter.left do).
+struct EgoInput {
+  Pose2 pose;
+  Velocity velocity = Velocity::Zero();
+};
+
+/// Logical cell index: x along the frame's +x, y along its +y, 0..cells-1, independent of storage.
+struct CellIndex {
+  int x = 0;
+  int y = 0;
+};
+
+/// Masses of one cell after the last Update; free + static_occ + dynamic + unknown = 1.
+struct CellState {
+  double free = 0.0;
+  double static_occ = 0.0;
+  double dynamic = 0.0;
+  double unknown = 1.0;
+  /// Weighted mean and covariance of the persistent moving particles of the cell after the
+  /// weight update (before resampling); zero when the cell has none.
+  Velocity mean_velocity = Velocity::Zero();
+  Matrix2 velocity_cov = Matrix2::Zero();
+  /// Inside the field of view of at least one sensor this cycle.
+  bool observed = false;
+};
+
+class DynamicGrid {
+ public:
+  /// Throws std::invalid_argument when !params.IsValid().
+  DynamicGrid(const FilterParams& params, std::uint64_t seed);
+
+  /// One filter cycle. The first call initialises the grid around the ego. `dt` >= 0 [s].
+  /// Builds this cycle's measurement grid (MeasurementGrid::Build on ego.pose.position) and runs
+  /// the cycle on it. The grid's own MeasurementGrid is allocated at the first call.
+  void Update(const EgoInput& ego, std::span<const Measurement> measurements,
+              std::span<const SensorCoverage> coverage, double dt);
+  /// One filter cycle on a measurement grid built for it: `measurement.Build(ego.pose.position,
+  /// ...)` with this cycle's detections, after any Reframe. Filters whose params share the
+  /// geometry (MeasurementGrid::SharesGeometry) can share one: the co-simulation builds it once per
+  /// step for its three modes. Same results, bit for bit, as the Update above with the same
+  /// inputs. Only the call's duration reads `measurement`. Throws std::invalid_argument when it
+  /// does not share this grid's geometry, was never built, or was built for another position.
+  /// `noise`, if not null, holds this cycle's prediction normals, drawn once for filters with the
+  /// same seed and step (PredictionNoise::Draw(seed, step(), params().num_particles)): read
+  /// instead of drawing them, same results bit for bit; std::invalid_argument if it holds others.
+  void Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+              const PredictionNoise* noise = nullptr);
+
+  /// Turns the caller's frame by `angle` [rad] (counter-clockwise) about its origin, between two
+  /// cycles: the caller's next inputs come in the turned frame (the grid that follows the ego's
+  /// heading, docs/algorithm.md "Grid frame"). Every particle's position and velocity are mapped
+  /// exactly to the new frame (p -> R(-angle) p); the grid is re-centred on `ego` (new frame, as
+  /// the next Update's EgoInput will give it) and each new cell takes the free, static and
+  /// dynamic masses of the old cell under its centre (nearest cell: no mass is blurred, a cell
+  /// moves by at most half a cell diagonal); new cells outside the old grid are unknown. Until the
+  /// next Update, weighted_particles() and Cell()'s velocity moments still refer to the old frame.
+  /// No-op before the first Update or for angle == 0. O(particles + cells); its scratch layers
+  /// are allocated at the first call. Throws std::invalid_argument for a non-finite input.
+  void Reframe(double angle, const Position& ego);
+
+  int cells_x() const { return nx_; }
+  int cells_y() const { return ny_; }
+  double resolution() const { return params_.resolution; }
+  /// Number of completed Update calls (the RNG step of the next one).
+  std::uint64_t step() const { return step_; }
+  bool initialized() const { return initialized_; }
+
+  /// Position of a logical cell's centre in the caller's frame [m].
+  Position CellCenter(CellIndex c) const;
+  /// Logical cell holding `p`, std::nullopt outside the grid (or before the first Update).
+  /// Inline: the scorer calls it for every particle.
+  std::optional<CellIndex> CellOf(const Position& p) const;
+  /// Throws std::out_of_range for an index outside the grid.
+  CellState Cell(CellIndex c) const;
+  /// Global index of logical cell (0, 0): its centre is ((gx + 0.5) r, (gy + 0.5) r) [m], the
+  /// exact arithmetic of CellCenter, so callers rasterising onto the grid agree with it bit for
+  /// bit.
+  std::array<std::int64_t, 2> origin_index() const { return {origin_gx_, origin_gy_}; }
+  /// Masses [probability] and the observed flag of every cell in logical row-major order (index
+  /// y * cells_x() + x), the values Cell() returns, without its velocity moments. Each span must
+  /// hold cells_x() * cells_y() entries (std::invalid_argument otherwise). O(cells), no allocation:
+  /// the scorer reads this every cycle; figures use Cell() for the velocities only when drawn.
+  void ExportMasses(std::span<float> free, std::span<float> static_occ, std::span<float> dynamic,
+                    std::span<std::uint8_t> observed) const;
+
+  /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count).
+  const ParticleSet& particles() const { return particles_; }
+  /// Persistent particles after the last weight update, before birth and resampling, sorted by
+  /// cell: `weight` is the mode's weight normalised so that each cell's weights sum to its
+  /// dynamic mass (particles slower than static_speed carry 0). The first
+  /// num_weighted_particles() entries are valid. This is the weighted particle set the paper
+  /// clusters (Sec. V); after resampling all weights are equal.
+  const ParticleSet& weighted_particles() const { return sorted_; }
+  std::size_t num_weighted_particles() const {
+    return cell_start_.empty() ? 0 : static_cast<std::size_t>(cell_start_[num_cells_]);
+  }
+  /// Calls f(k, first, last) for every cell holding weighted particles whose value v in `layer`
+  /// (logical order, cells_x() * cells_y() entries: e.g. ExportMasses' dynamic layer, or a layer
+  /// of eval::CellClass bytes) passes keep(v) (a callable bool(T)), in the order of
+  /// weighted_particles(): k = y * cells_x() + x is the logical cell and [first, last) its
+  /// particles in weighted_particles(). Every particle of that range has CellOf() == (x, y) (the
+  /// sort and CellOf share their arithmetic); particles off the grid are in no range. Scans the
+  /// layer and reads a cell's range only where keep(v) holds: cheap when the kept cells are few
+  /// and clustered (the scorer's dynamic cells), without locating each particle. O(cells), no
+  /// allocation; nothing before the first Update. Valid between an Update and the next Reframe:
+  /// throws std::logic_error after a Reframe (the particles are not sorted into its new cells),
+  /// std::invalid_argument for a layer of another size.
+  template <typename T, typename Keep, typename F>
+  void ForEachWeightedCellWhere(std::span<const T> layer, Keep&& keep, F&& f) const;
+  const FilterParams& params() const { return params_; }
+
+  /// The new-born mass of the last Update summed over the cells (step 7's rho_b, the mass its
+  /// birth particles are drawn for); 0 before the first Update and after one without detections.
+  double NewbornMass() const;
+
+  /// Checks the invariants that hold after every Update (the soak test runs it each cycle):
+  /// every cell's masses are finite, in [0, 1] and free + static + dynamic <= 1 (unknown >= 0);
+  /// the particle count is num_particles; every particle's position, velocity and weights are
+  /// finite, weights >= 0, and the weights sum to no more than the cells' persistent dynamic plus
+  /// new-born mass (resampling creates no mass; new-born mass of a cell that got no birth
+  /// particle is dropped, so the sum may be lower). Returns a description of the first
+  /// violation, std::nullopt if none. O(cells + particles); not called by Update.
+  std::optional<std::string> CheckInvariants() const;
+
+ private:
+  // Storage index of global cell (gx, gy): circular in both axes so that shifting moves no data.
+  std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
+  // Storage column and row of logical cell (0, 0).
+  std::array<std::int64_t, 2> StorageOrigin() const;
+  void Initialize(const EgoInput& ego);
+  void ShiftTo(const Position& ego);
+  // Global index of logical cell (0, 0) for a grid centred on `ego`.
+  std::array<std::int64_t, 2> OriginFor(const Position& ego) const;
+  void ResetColumn(std::int64_t gx);
+  void ResetRow(std::int64_t gy);
+  // Prediction (PredictParticles) fused with the counting sort's first pass; `noise` may be null.
+  void PredictAndSort(double dt, const PredictionNoise* noise);
+  // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
+  void UpdateCells(std::span<const Measurement> z);
+  void Birth(std::span<const Measurement> z);
+  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
+  void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
+                      std::int64_t k_hi, double mass, double r, double vmax);
+  void Resample();
+
+  FilterParams params_;
+  // params_ with the per-cycle factors of this cycle's dt (ForCycle): what steps 2-7 read.
+  FilterParams cycle_params_;
+  std::uint64_t seed_;
+  std::uint64_t step_ = 0;
+  bool initialized_ = false;
+  int nx_, ny_;
+  std::int64_t num_cells_;
+  std::int64_t origin_gx_ = 0, origin_gy_ = 0;  // global index of logical cell (0, 0)
+  bool sorted_current_ = false;  // sorted_ is binned on the current cells (no Reframe since)
+
+  // Cell layers (storage order).
+  std::vector<double> free_, static_, dynamic_, born_;
+  std::vector<std::uint8_t> view_;  // the last cycle's MeasurementGrid bits (Cell, ExportMasses)
+
+  // Particles: persistent set (public), sorted working copy, new-born.
+  ParticleSet particles_, sorted_, births_;
+  std::vector<std::int64_t> cell_of_;     // storage cell per particle, num_cells_ if outside
+  std::vector<std::int64_t> cell_start_;  // num_cells_ + 2: particle ranges of sorted_
+  std::vector<std::int32_t> hist_;        // per-chunk histograms of the counting sort
+  std::vector<std::int64_t> hist_total_;
+  std::vector<double> scan_out_;    // resampling prefix sums of the source weights
+  std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
+  // Cells with non-zero birth mass, per UpdateCells chunk (slots [chunk * size, + count)).
+  std::vector<std::int64_t> born_cells_;
+  std::vector<std::int32_t> born_count_;
+  std::vector<double> det_fv0_;         // per detection: f_v of a particle at v = 0
+  std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
+  // The measurement grid of the running Update (the caller's or own_measurement_); null between
+  // cycles.
+  const MeasurementGrid* mg_ = nullptr;
+  std::optional<MeasurementGrid> own_measurement_;  // the first standalone Update makes it
+  std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
+  std::vector<double> det_fit_k_;       // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
+};
+
+inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
+  if (!initialized_ || !p.allFinite()) return std::nullopt;
+  // The arithmetic of the particles' sort (PredictAndSort): a particle's cell is the one it was
+  // weighed in, whatever the resolution.
+  const double inv_r = 1.0 / params_.resolution;
+  const double fx = std::floor(p.x() * inv_r) - static_cast<double>(origin_gx_);
+  const double fy = std::floor(p.y() * inv_r) - static_cast<double>(origin_gy_);
+  if (fx < 0.0 || fy < 0.0 || fx >= nx_ || fy >= ny_) return std::nullopt;
+  return CellIndex{static_cast<int>(fx), static_cast<int>(fy)};
+}
+
+template <typename T, typename Keep, typename F>
+void DynamicGrid::ForEachWeightedCellWhere(std::span<const T> layer, Keep&& keep, F&& f) const {
+  if (!initialized_ || cell_start_.empty()) return;  // no particles before the first Update
+  if (!sorted_current_)
+    throw std::logic_error(
+        "DynamicGrid::ForEachWeightedCellWhere: called after Reframe, before Update");
+  if (layer.size() != static_cast<std::size_t>(num_cells_))
+    throw std::invalid_argument("DynamicGrid::ForEachWeightedCellWhere: layer of " +
+                                std::to_string(layer.size()) + " cells for " +
+                                std::to_string(num_cells_));
+  const auto [sx0, sy0] = StorageOrigin();
+  for (std::int64_t sy = 0; sy < ny_; ++sy) {
+    const std::int64_t y = sy >= sy0 ? sy - sy0 : sy - sy0 + ny_;
+    const T* const row = layer.data() + y * nx_;
+    const std::int64_t* const start = cell_start_.data() + sy * nx_;
+    // Storage columns [0, sx0) hold logical x = sx + nx - sx0, columns [sx0, nx) x = sx - sx0:
+    // two contiguous runs of the logical row, visited in storage (= particle) order.
+    const auto run = [&](std::int64_t sx_lo, std::int64_t sx_hi, std::int64_t x_off) {
+      for (std::int64_t sx = sx_lo; sx < sx_hi; ++sx) {
+        if (!keep(row[sx + x_off]) || start[sx] == start[sx + 1]) continue;
+        f(static_cast<std::size_t>(y * nx_ + sx + x_off), start[sx], start[sx + 1]);
+      }
+    };
+    run(0, sx0, nx_ - sx0);
+    run(sx0, nx_, -sx0);
+  }
+}
+
+}  // namespace dualgrid::filter_ref

@@ -1,0 +1,406 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Step 4 of the cycle (docs/algorithm.md, paper eqs. 2-4): nearest detection per cell, detection
+// buckets, the per-sensor ray free space and the detections' lines of sight (MeasurementGrid).
+#include "measurement_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "grid_internal.hpp"
+#include "particles.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+using namespace detail;
+
+namespace {
+
+// std::atan2 per cell and sensor dominated the free-space pass.
+inline double FastAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double mx = std::max(ax, ay), mn = std::min(ax, ay);
+  if (mx == 0.0) return 0.0;
+  const double a = mn / mx, s = a * a;
+  double r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a;
+  if (ay > ax) r = 0.5 * kPi - r;
+  if (x < 0.0) r = kPi - r;
+  return y < 0.0 ? -r : r;
+}
+
+// Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
+constexpr double kAtanError = 5e-4;
+
+}  // namespace
+
+MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
+  std::string error;
+  if (!params_.IsValid(&error)) {
+    throw std::invalid_argument("dualgrid::filter::MeasurementGrid: invalid FilterParams: " +
+                                error);
+  }
+  with_fit_ = params_.birth_velocity == BirthVelocity::kDopplerFit ||
+              params_.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  nx_ = params_.CellsX();
+  ny_ = params_.CellsY();
+  num_cells_ = static_cast<std::int64_t>(nx_) * ny_;
+  const auto c = static_cast<std::size_t>(num_cells_);
+  view_.assign(c, 0);
+  near_det_.assign(c, -1);
+  near_d2_.assign(c, kInf);
+  touched_.reserve(4096);
+  const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
+  // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
+  // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
+  bucket_cells_ = static_cast<int>(std::ceil(cutoff / params_.resolution)) + 1;
+  bucket_inv_ = 1.0 / (bucket_cells_ * params_.resolution);
+  nbx_ = (nx_ + bucket_cells_ - 1) / bucket_cells_;
+  nby_ = (ny_ + bucket_cells_ - 1) / bucket_cells_;
+  bucket_count_.assign(static_cast<std::size_t>(nbx_) * nby_, 0);
+  bucket_start_.assign(static_cast<std::size_t>(nbx_) * nby_ + 1, 0);
+}
+
+bool MeasurementGrid::SharesGeometry(const FilterParams& p) const {
+  const FilterParams& q = params_;
+  const bool fit = p.birth_velocity == BirthVelocity::kDopplerFit ||
+                   p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  return p.resolution == q.resolution && p.CellsX() == nx_ && p.CellsY() == ny_ &&
+         p.cutoff_sigmas == q.cutoff_sigmas && p.sigma_f == q.sigma_f &&
+         p.free_angle_bin == q.free_angle_bin && p.free_bin_dilation == q.free_bin_dilation &&
+         fit == with_fit_ &&
+         (!fit || (p.doppler_fit_radius == q.doppler_fit_radius &&
+                   p.doppler_fit_sigma == q.doppler_fit_sigma));
+}
+
+void MeasurementGrid::Build(const Position& centre, std::span<const Measurement> z,
+                            std::span<const SensorCoverage> coverage) {
+  if (!centre.allFinite())
+    throw std::invalid_argument("MeasurementGrid::Build: the grid centre is not finite");
+  for (const SensorCoverage& c : coverage) {
+    if (!c.origin.allFinite() || !std::isfinite(c.boresight) || !(c.half_fov >= 0.0) ||
+        !(c.min_range >= 0.0) || !(c.max_range >= c.min_range) || !std::isfinite(c.max_range)) {
+      throw std::invalid_argument(
+          "MeasurementGrid::Build: SensorCoverage needs a finite origin/boresight, half_fov >= 0 "
+          "and 0 <= min_range <= max_range < inf");
+    }
+  }
+  // DynamicGrid's origin for this centre: the same cells, the same storage.
+  const auto origin = OriginFor(centre, params_.resolution, nx_, ny_);
+  origin_gx_ = origin[0];
+  origin_gy_ = origin[1];
+  z_.assign(z.begin(), z.end());  // capacity reused across builds
+  Stamp();
+  Bins(coverage);
+  FieldOfView(coverage);
+  ComputeLinesOfSight();
+  if (with_fit_) FitDetectionVelocities();
+  ++builds_;
+}
+
+void MeasurementGrid::Stamp() {
+  const std::span<const Measurement> z = z_;
+  const double r = params_.resolution;
+  const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
+  const int rc = static_cast<int>(std::ceil(cutoff / r));
+  for (std::int64_t s : touched_) {
+    near_det_[s] = -1;
+    near_d2_[s] = kInf;
+  }
+  touched_.clear();
+
+  // Nearest detection per cell centre, stamped detection by detection (serial, so ties resolve
+  // to the lower index whatever the thread count). Also fills the detection buckets.
+  std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
+  const int nz = static_cast<int>(z.size());
+  if (static_cast<int>(det_bucket_.size()) < nz) det_bucket_.resize(nz);  // grows only
+  std::vector<std::int64_t>& bucket_of = det_bucket_;
+  for (int j = 0; j < nz; ++j) {
+    bucket_of[j] = -1;
+    const Position& p = z[j].position;
+    if (!p.allFinite() || !z[j].radial_velocity.allFinite()) continue;
+    const double fx = std::floor(p.x() / r) - static_cast<double>(origin_gx_);
+    const double fy = std::floor(p.y() / r) - static_cast<double>(origin_gy_);
+    if (fx < -rc || fy < -rc || fx >= nx_ + rc || fy >= ny_ + rc) continue;
+    const int lx = static_cast<int>(fx), ly = static_cast<int>(fy);
+    const auto [bx, by] = BucketOf(p.x(), p.y());
+    bucket_of[j] = static_cast<std::int64_t>(by) * nbx_ + bx;
+    ++bucket_count_[bucket_of[j]];
+    const std::int64_t sx0 = Mod(origin_gx_, nx_);
+    for (int cy = std::max(0, ly - rc); cy <= std::min(ny_ - 1, ly + rc); ++cy) {
+      const std::int64_t row = Mod(origin_gy_ + cy, ny_) * nx_;  // one division per row
+      const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
+      for (int cx = std::max(0, lx - rc); cx <= std::min(nx_ - 1, lx + rc); ++cx) {
+        const double ex = (static_cast<double>(origin_gx_ + cx) + 0.5) * r - p.x();
+        const double d2 = ex * ex + ey * ey;
+        if (d2 > cutoff2) continue;
+        const std::int64_t sx = sx0 + cx;
+        const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
+        if (near_det_[s] < 0) touched_.push_back(s);
+        if (d2 < near_d2_[s]) {
+          near_d2_[s] = d2;
+          near_det_[s] = j;
+        }
+      }
+    }
+  }
+  const std::int64_t nb = static_cast<std::int64_t>(nbx_) * nby_;
+  ExclusiveScan(std::span<const std::int64_t>(bucket_count_.data(), nb),
+                std::span<std::int64_t>(bucket_start_.data(), nb + 1));
+  if (static_cast<int>(bucket_items_.size()) < nz) {  // grows only
+    bucket_items_.resize(nz);
+    det_x_.resize(nz);
+    det_y_.resize(nz);
+  }
+  std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
+  for (int j = 0; j < nz; ++j) {
+    if (bucket_of[j] < 0) continue;
+    const std::int64_t k = bucket_start_[bucket_of[j]] + bucket_count_[bucket_of[j]]++;
+    bucket_items_[k] = j;
+    det_x_[k] = z[j].position.x();
+    det_y_[k] = z[j].position.y();
+  }
+}
+
+void MeasurementGrid::Bins(std::span<const SensorCoverage> cov) {
+  const std::span<const Measurement> z = z_;
+  const int nz = static_cast<int>(z.size());
+
+  // Bearing bins per sensor: range of the closest detection shadowing each bin.
+  const int ns = static_cast<int>(cov.size());
+  bin_offset_.assign(ns + 1, 0);  // small vectors; capacity is reused across cycles
+  for (int s = 0; s < ns; ++s) {
+    const int bins =
+        std::max(1, static_cast<int>(std::ceil(2.0 * cov[s].half_fov / params_.free_angle_bin)));
+    bin_offset_[s + 1] = bin_offset_[s] + bins;
+  }
+  bin_range_.assign(bin_offset_[ns], kInf);
+  for (int j = 0; j < nz; ++j) {
+    const Measurement& m = z[j];
+    if (!m.position.allFinite() || !m.sensor_position.allFinite()) continue;
+    for (int s = 0; s < ns; ++s) {
+      if ((cov[s].origin - m.sensor_position).squaredNorm() > 1e-6) continue;
+      const Vector2 d = m.position - cov[s].origin;
+      const double range = d.norm();
+      const double rel = WrapAngle(FastAtan2(d.y(), d.x()) - cov[s].boresight);
+      if (std::abs(rel) > cov[s].half_fov || range > cov[s].max_range) continue;
+      const int bins = static_cast<int>(bin_offset_[s + 1] - bin_offset_[s]);
+      const int b = std::clamp(static_cast<int>((rel + cov[s].half_fov) / params_.free_angle_bin),
+                               0, bins - 1);
+      for (int k = std::max(0, b - params_.free_bin_dilation);
+           k <= std::min(bins - 1, b + params_.free_bin_dilation); ++k) {
+        double& br = bin_range_[bin_offset_[s] + k];
+        br = std::min(br, range);
+      }
+    }
+  }
+}
+
+void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
+  const int ns = static_cast<int>(cov.size());
+  const double r = params_.resolution;
+  // Field of view and ray free space per cell (rows in parallel: each cell has one writer).
+  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
+  const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  // Per-sensor trigonometry once per cycle, not per row.
+  sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
+  for (int k = 0; k < ns; ++k) {
+    sensor_trig_[4 * k] = std::cos(cov[k].boresight);
+    sensor_trig_[4 * k + 1] = std::sin(cov[k].boresight);
+    sensor_trig_[4 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+    // Inner wedge (half_fov - 4 kAtanError): its cells pass the segment test below at once.
+    const double inner = cov[k].half_fov - 4.0 * kAtanError;
+    sensor_trig_[4 * k + 3] = inner > 0.0 && cov[k].half_fov < 0.5 * kPi ? std::tan(inner) : -1.0;
+  }
+  // Last bin of the run of equal ranges each bin belongs to (per sensor): O(1) uniformity test.
+  bin_run_end_.resize(bin_range_.size());
+  for (int k = 0; k < ns; ++k) {
+    const std::int64_t b_lo = bin_offset_[k], b_hi = bin_offset_[k + 1];
+    for (std::int64_t b = b_hi - 1; b >= b_lo; --b) {
+      bin_run_end_[b] = b + 1 < b_hi && bin_range_[b + 1] == bin_range_[b]
+                            ? bin_run_end_[b + 1]
+                            : static_cast<int>(b - b_lo);
+    }
+  }
+#pragma omp parallel for schedule(dynamic, 2)
+  for (int ly = 0; ly < ny_; ++ly) {
+    const std::int64_t row = Mod(origin_gy_ + ly, ny_) * nx_;
+    const double cy = y0 + (ly + 0.5) * r;
+    std::fill_n(view_.begin() + row, nx_, 0);  // whole storage row = whole logical row
+    for (int k = 0; k < ns; ++k) {
+      const SensorCoverage& sc = cov[k];
+      const double dy = cy - sc.origin.y();
+      if (std::abs(dy) > sc.max_range) continue;
+      const double half_x = std::sqrt(sc.max_range * sc.max_range - dy * dy);
+      const int lx_lo =
+          std::max(0, static_cast<int>(std::floor((sc.origin.x() - half_x - x0) / r)));
+      const int lx_hi =
+          std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
+      // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
+      // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
+      const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
+      const bool narrow = sc.half_fov < 0.5 * kPi;
+      const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
+      const int* const run_end = bin_run_end_.data() + bin_offset_[k];
+      const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
+      const double* bins = bin_range_.data() + bin_offset_[k];
+      const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
+      const double inv_bin = 1.0 / params_.free_angle_bin;
+      const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
+      // Exact per-cell test (the reference definition of the bits).
+      const auto exact = [&](int lx) {
+        const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
+        const double d2 = dx * dx + dy * dy;
+        if (d2 < min2 || d2 > max2) return;
+        const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+        if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) return;
+        const double rel = FastAtan2(fy, fx);
+        if (std::abs(rel) > sc.half_fov) return;
+        const std::int64_t sx = sx0 + lx;
+        const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
+        const int b = std::clamp(static_cast<int>((rel + sc.half_fov) * inv_bin), 0, nbins - 1);
+        const double br = bins[b];
+        // Free in front of the bin's closest detection, unknown behind it; a bin without any
+        // detection is weakly free over the whole range.
+        view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
+                                              (br != kInf && d2 < br * br ? kFreeRay : 0));
+      };
+      int lo_x = lx_lo, hi_x = lx_hi;
+      // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
+      // (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0): their interval of dx.
+      const auto wedge = [&](double tan_w, double* dmin, double* dmax) {
+        *dmin = -kInf;
+        *dmax = kInf;
+        for (const auto& [c, d] :
+             {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
+              std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
+          if (c > 0.0) {
+            *dmin = std::max(*dmin, -d / c);
+          } else if (c < 0.0) {
+            *dmax = std::min(*dmax, -d / c);
+          } else if (d < 0.0) {
+            *dmax = -kInf;
+          }
+        }
+        return *dmin <= *dmax;
+      };
+      const double big = 4.0 * nx_;
+      int in_lo = 1, in_hi = 0;  // cells well inside the wedge (empty unless narrow)
+      if (narrow) {
+        // Clip the row to the wedge, two cells of margin (the exact test still decides every
+        // cell).
+        double dmin, dmax;
+        if (!wedge(tan_hf, &dmin, &dmax)) continue;
+        const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
+        const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
+        lo_x = std::max(lo_x, static_cast<int>(l0));
+        hi_x = std::min(hi_x, static_cast<int>(l1));
+        // The cells of the inner wedge (half_fov - 4 kAtanError, one cell of margin) pass the
+        // field-of-view part of the segment test below: segmenting the row there first saves the
+        // bisection down to the wedge edges. Only the segmentation changes, not any cell's bits.
+        if (tan_in > 0.0 && wedge(tan_in, &dmin, &dmax)) {
+          in_lo = std::max(
+              lo_x, static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big)));
+          in_hi = std::min(
+              hi_x, static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big)));
+        }
+      }
+      if (lo_x > hi_x) continue;
+      // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
+      // is within kAtanError of it, so the cells' computed bearings lie within 2 kAtanError of the
+      // hull of the end points' ones and their bins (a monotonic function of the bearing) within
+      // the bins of that hull. If all those bins hold the same range, every cell gets the same bin
+      // value as in the exact test without its atan2; otherwise the segment is split.
+      const auto rel_of = [&](int lx, double* fx_out) {
+        const double dxe = x0 + (lx + 0.5) * r - sc.origin.x();
+        const double fx = dxe * cb + dy * sb, fy = dy * cb - dxe * sb;
+        *fx_out = fx;
+        return FastAtan2(fy, fx);
+      };
+      int stack[128][2];
+      int top = 0;
+      if (in_lo <= in_hi) {
+        for (const auto& [sa, se] :
+             {std::pair{lo_x, in_lo - 1}, std::pair{in_lo, in_hi}, std::pair{in_hi + 1, hi_x}}) {
+          if (sa > se) continue;
+          stack[top][0] = sa;
+          stack[top][1] = se;
+          ++top;
+        }
+      } else {
+        stack[top][0] = lo_x;
+        stack[top][1] = hi_x;
+        ++top;
+      }
+      while (top > 0) {
+        --top;
+        const int a = stack[top][0], e = stack[top][1];
+        if (e - a < 4) {
+          for (int lx = a; lx <= e; ++lx) exact(lx);
+          continue;
+        }
+        double fxa, fxe;
+        const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
+        const double lo = std::min(ra, re) - 2.0 * kAtanError,
+                     hi = std::max(ra, re) + 2.0 * kAtanError;
+        bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
+        double br = kInf;
+        if (uniform) {
+          const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
+          const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
+          br = bins[b0];
+          uniform = run_end[b0] >= b1;
+        }
+        if (!uniform) {
+          const int mid = a + (e - a) / 2;
+          stack[top][0] = mid + 1;
+          stack[top][1] = e;
+          ++top;
+          stack[top][0] = a;
+          stack[top][1] = mid;
+          ++top;
+          continue;
+        }
+        // Branch-free over the segment (vectorises), split where the storage row wraps.
+        const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
+        const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
+        const double br2 = br * br;
+        const int wrap = static_cast<int>(nx_ - sx0);  // first lx whose storage column wraps
+        for (int part = 0; part < 2; ++part) {
+          const int pa = part == 0 ? a : std::max(a, wrap);
+          const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+          std::uint8_t* dst = view_.data() + row + sx0 - (part == 0 ? 0 : nx_);
+          for (int lx = pa; lx <= pe; ++lx) {
+            const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
+            const double d2 = dx * dx + dy * dy;
+            const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+            const bool in = (d2 >= min2) & (d2 <= max2) &
+                            ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
+            const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
+            dst[lx] |= in ? v : 0;
+          }
+        }
+      }
+    }
+  }
+}
+
+void MeasurementGrid::ComputeLinesOfSight() {
+  const int nz = static_cast<int>(z_.size());
+  if (det_los_.size() < 3 * z_.size()) det_los_.resize(3 * z_.size());  // grow only
+  for (int j = 0; j < nz; ++j) {
+    Vector2 u = z_[j].position - z_[j].sensor_position;
+    const double n = u.norm();
+    u = n > 0.0 ? Vector2(u / n) : Vector2(1.0, 0.0);
+    det_los_[3 * j] = u.x();
+    det_los_[3 * j + 1] = u.y();
+    det_los_[3 * j + 2] = z_[j].radial_velocity.dot(u);
+  }
+}
+
+}  // namespace dualgrid::filter_ref

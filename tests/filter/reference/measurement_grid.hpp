@@ -1,0 +1,124 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Step 4 of the cycle (paper eqs. 2-4) and step 4a (the Doppler fit): everything a filter cycle
+// derives from the detections, the sensors' coverage and the grid's placement alone, independent
+// of any filter's particles or weight mode. docs/algorithm.md, "One cycle".
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/measurement_grid.hpp"  // Measurement, SensorCoverage
+#include "dualgrid/filter/params.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+/// One radar detection, the paper's eq. (1) [x, y, v_rx, v_ry], in the caller's frame (the
+/// filter's, docs/algorithm.md "Grid frame").
+class DynamicGrid;
+
+/// The measurement grid of one cycle: per cell the nearest detection within the cutoff and its
+/// squared distance (eq. 2's f_d), the field-of-view and ray free-space bits (eq. 3); per
+/// detection its line of sight, its bucket, and (when the filter's birth_velocity or
+/// velocity_likelihood needs it) the Doppler fit's tangential velocity and its standard deviation.
+///
+/// Sharing: the result depends only on the inputs of Build and on the geometry fields of the
+/// FilterParams it was made with (resolution, length_x, width_y, cutoff_sigmas, sigma_f,
+/// free_angle_bin, free_bin_dilation, doppler_fit_radius, doppler_fit_sigma and whether the fit
+/// is needed), never on the weight mode or the particles. Filters that differ only in the other
+/// fields (the co-simulation's position, velocity and dual modes) can therefore build it once per
+/// cycle and each pass it to DynamicGrid::Update: same results, bit for bit, as each building its
+/// own, at a third of step 4's cost for three modes (docs/performance.md).
+///
+/// Ownership: Build copies the detections; nothing refers to the caller's memory afterwards.
+/// Memory: O(cells) bytes allocated by the constructor; the per-detection arrays grow to the
+/// largest detection count seen and are then reused (no allocation in steady state).
+class MeasurementGrid {
+ public:
+  /// Throws std::invalid_argument when !params.IsValid().
+  explicit MeasurementGrid(const FilterParams& params);
+
+  /// Builds the grid of one cycle for a filter grid centred on `centre` [m] (the position of the
+  /// cycle's EgoInput, after any Reframe). Detections or sensors with non-finite values are
+  /// skipped, as in DynamicGrid::Update. O(cells + detections x cutoff area); parallel over rows
+  /// (OpenMP), results independent of the thread count. Throws std::invalid_argument for a
+  /// non-finite centre or an invalid SensorCoverage (as DynamicGrid::Update).
+  void Build(const Position& centre, std::span<const Measurement> z,
+             std::span<const SensorCoverage> coverage);
+
+  /// True when a filter with `params` may use this grid: the geometry fields listed above are
+  /// equal. Any difference there makes DynamicGrid::Update throw.
+  bool SharesGeometry(const FilterParams& params) const;
+  /// Global index of logical cell (0, 0) of the last Build (DynamicGrid::origin_index).
+  std::array<std::int64_t, 2> origin_index() const { return {origin_gx_, origin_gy_}; }
+  /// The detections of the last Build (a copy).
+  std::span<const Measurement> measurements() const { return z_; }
+  /// Number of Build calls so far (0: never built).
+  std::uint64_t builds() const { return builds_; }
+
+ private:
+  friend class DynamicGrid;
+
+  void Stamp();  // nearest detection per cell centre and the detection buckets
+  void Bins(std::span<const SensorCoverage> cov);
+  void FieldOfView(std::span<const SensorCoverage> cov);
+  // Per detection the unit line of sight and the signed radial speed into det_los_.
+  void ComputeLinesOfSight();
+  // Per detection the tangential velocity a robust fit to its neighbours' Doppler gives, and its
+  // standard deviation (inf: no fit).
+  void FitDetectionVelocities();
+  // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
+  // every cell holding particles.
+  std::pair<int, int> BucketOf(double px, double py) const;
+
+  FilterParams params_;
+  bool with_fit_ = false;
+  int nx_, ny_;
+  std::int64_t num_cells_;
+  std::int64_t origin_gx_ = 0, origin_gy_ = 0;
+  std::uint64_t builds_ = 0;
+  std::vector<Measurement> z_;
+
+  // Per cell (storage order: circular in both axes, as DynamicGrid's layers).
+  std::vector<std::uint8_t> view_;     // field-of-view / ray free-space bits (grid_internal.hpp)
+  std::vector<int> near_det_;          // nearest detection index or -1
+  std::vector<double> near_d2_;        // its squared distance to the cell centre [m^2]
+  std::vector<std::int64_t> touched_;  // cells with near_det_ set (reset next Build)
+
+  // Detection bucket index (logical coordinates, bucket edge >= cutoff + one cell).
+  int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
+  double bucket_inv_ = 1.0;  // 1 / bucket edge [1/m], with bucket_cells_ (BucketOf)
+  std::vector<std::int64_t> bucket_count_, bucket_start_;
+  std::vector<int> bucket_items_;
+  std::vector<double> det_x_, det_y_;     // detection positions in bucket order [m]
+  std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1 (not near the grid)
+
+  // Per-sensor bearing bins for the ray free space.
+  std::vector<double> bin_range_;
+  std::vector<std::int64_t> bin_offset_;
+  std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
+  std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
+
+  std::vector<double> det_los_;                 // per detection: unit line of sight, v_r . u
+  std::vector<double> det_fit_t_, det_fit_sd_;  // per detection: the fit [m/s] (4a)
+};
+
+inline std::pair<int, int> MeasurementGrid::BucketOf(double px, double py) const {
+  // Same formula for detections and queries.
+  const double x0 = static_cast<double>(origin_gx_) * params_.resolution;
+  const double y0 = static_cast<double>(origin_gy_) * params_.resolution;
+  const double fx = std::clamp(std::floor((px - x0) * bucket_inv_), 0.0, nbx_ - 1.0);
+  const double fy = std::clamp(std::floor((py - y0) * bucket_inv_), 0.0, nby_ - 1.0);
+  return {static_cast<int>(fx), static_cast<int>(fy)};
+}
+
+}  // namespace dualgrid::filter_ref

@@ -1,0 +1,412 @@
+// Test reference (tests/filter/test_float_bound.cpp): the double filter cycle of commit 27d8ca3
+// (before issue 37), namespace dualgrid::filter_ref. Not part of the library.
+// Steps 5-6 of the cycle (docs/algorithm.md): particle weights (paper eqs. 7, 8, 14) and the joint
+// occupancy update (eqs. 9-12), cell by cell.
+#include "dynamic_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include "grid_internal.hpp"
+
+namespace dualgrid::filter {}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+using namespace ::dualgrid::filter;  // FilterParams, Measurement, SensorCoverage
+
+using namespace detail;
+
+namespace {
+
+// Two cells per operation (GCC / Clang vector extensions). Each lane is the scalar expression's
+// IEEE operation, so every cell's result is bit-identical to the scalar code; written by hand
+// because GCC 12 does not vectorise std::min feeding std::max ("control flow in loop").
+using V2 = double __attribute__((vector_size(16)));
+using M2 = std::int64_t __attribute__((vector_size(16)));  // lane masks: -1 true, 0 false
+inline V2 Min(V2 a, V2 b) { return b < a ? b : a; }        // std::min(a, b) per lane
+inline V2 Max(V2 a, V2 b) { return a < b ? b : a; }        // std::max(a, b) per lane
+
+struct FastCellInputs {
+  const std::int64_t* start;  // particle ranges per cell (cell_start_)
+  const int* near;            // nearest detection per cell, -1 if none
+  const std::uint8_t* view;   // observed / free-ray / no-return bits
+  double free_mass, free_mass_no_return, static_persistence, free_decay;
+};
+
+// The update of a cell with no particle and no detection nearby: the general equations of
+// UpdateCells with d_pred = 0 and occ_k = 0 (a free/static Dempster update, the whole occupied mass
+// static, no dynamic or new-born mass), for cells [c_lo, c_hi). Writes the masses of those cells
+// and leaves the others untouched; lists the others' offsets from c_lo in `slow` (in cell order)
+// and returns their count.
+std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t c_hi,
+                       double* free_l, double* static_l, double* dynamic_l, double* born_l,
+                       std::int32_t* slow) {
+  std::int32_t n_slow = 0;
+  // Lane values of z_free (eq. 3 with occ_k = 0): observed on a free ray -> free_mass, observed
+  // without a return -> free_mass_no_return, else 0.
+  const auto z_free = [&](std::int64_t s) {
+    const std::uint8_t v = in.view[s];
+    if (!(v & kObserved)) return 0.0;
+    return (v & kFreeRay) ? in.free_mass : (v & kNoReturn) ? in.free_mass_no_return : 0.0;
+  };
+  const auto fast = [&](std::int64_t s) {
+    return in.start[s] == in.start[s + 1] && in.near[s] < 0;
+  };
+  for (std::int64_t s = c_lo; s < c_hi; s += 2) {
+    // An odd last cell fills both lanes (the same inputs, the same result written twice).
+    const std::int64_t s1 = s + 1 < c_hi ? s + 1 : s;
+    const bool f0 = fast(s), f1 = fast(s1);
+    slow[n_slow] = static_cast<std::int32_t>(s - c_lo);
+    n_slow += f0 ? 0 : 1;
+    slow[n_slow] = static_cast<std::int32_t>(s1 - c_lo);
+    n_slow += f1 || s1 == s ? 0 : 1;
+    const V2 zf = {z_free(s), z_free(s1)};
+    const V2 st = {static_l[s], static_l[s1]}, fr = {free_l[s], free_l[s1]};
+    const V2 s_pred = Min(in.static_persistence * st, V2{1.0, 1.0});
+    const V2 f_pred = Max(V2{0.0, 0.0}, Min(in.free_decay * fr, 1.0 - s_pred));
+    const V2 u_pred = Max(V2{0.0, 0.0}, 1.0 - (0.0 + s_pred) - f_pred);
+    const V2 norm0 = 1.0 / (1.0 - s_pred * zf);
+    const V2 nf = (f_pred + u_pred * zf) * norm0;
+    const V2 ns = s_pred * (1.0 - zf) * norm0;
+    // Selects, not branches: fast and other cells interleave wherever particles are.
+    const M2 keep = {f0 ? 0 : -1, f1 ? 0 : -1};
+    const V2 dyn = {dynamic_l[s], dynamic_l[s1]}, born = {born_l[s], born_l[s1]};
+    const V2 free_new = keep ? fr : nf, static_new = keep ? st : ns;
+    const V2 dyn_new = keep ? dyn : V2{0.0, 0.0}, born_new = keep ? born : V2{0.0, 0.0};
+    free_l[s] = free_new[0];
+    free_l[s1] = free_new[1];
+    static_l[s] = static_new[0];
+    static_l[s1] = static_new[1];
+    dynamic_l[s] = dyn_new[0];
+    dynamic_l[s1] = dyn_new[1];
+    born_l[s] = born_new[0];
+    born_l[s1] = born_new[1];
+  }
+  return n_slow;
+}
+
+}  // namespace
+
+void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
+  // This cycle's factors (persistence, decay, birth probability scaled to dt).
+  const FilterParams& p = cycle_params_;
+  const MeasurementGrid& mg = *mg_;
+  const double inv_2sf2 = 0.5 / (p.sigma_f * p.sigma_f);
+  const double inv_sd2 = 1.0 / (p.sigma_static_distance * p.sigma_static_distance);
+  const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);
+  const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
+  const double keep = 1.0 - p.decay_eps;
+  const double slow2 = p.static_speed * p.static_speed;
+  const double max_speed2 = p.max_speed * p.max_speed;
+  const double cutoff = p.cutoff_sigmas * p.sigma_f, cutoff2 = cutoff * cutoff;
+  ParticleSet& q = sorted_;
+  // Per detection, once per cycle: f_v of the static hypothesis (v = 0; the same in both
+  // likelihood forms, since a zero velocity has no line-of-sight component either), and for the
+  // radial likelihood the unit line of sight u and the signed compensated radial speed v_r . u.
+  const int nz = static_cast<int>(z.size());
+  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grow only
+  for (int j = 0; j < nz; ++j)
+    det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
+  // radial_fit: per detection 1 / (2 (sigma_v^2 + s_t^2)) of the tangential term, 0 where no fit.
+  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  if (radial_fit) {
+    if (static_cast<int>(det_fit_k_.size()) < nz) det_fit_k_.resize(nz);  // grow only
+    for (int j = 0; j < nz; ++j) {
+      const double s2 = p.sigma_v * p.sigma_v + mg.det_fit_sd_[j] * mg.det_fit_sd_[j];
+      det_fit_k_[j] = std::isfinite(s2) ? 0.5 / s2 : 0.0;
+    }
+  }
+  const double* const fit_k = det_fit_k_.data();
+  const double* const fit_t = mg.det_fit_t_.data();
+  // The static hypothesis (v = 0) is scored by the same f_v: under radial_fit its tangential
+  // part 0 against the fit's v_t as well, so a fitted crossing car is not taken for static.
+  if (radial_fit)
+    for (int j = 0; j < nz; ++j)
+      if (fit_k[j] > 0.0) det_fv0_[j] *= ExpUnder(-fit_t[j] * fit_t[j] * fit_k[j]);
+  const double* const fv0_of = det_fv0_.data();
+  const double* const los_of = mg.det_los_.data();
+  const bool radial = p.velocity_likelihood != VelocityLikelihood::kVector;
+  const bool literal_norm = p.normalisation == Normalisation::kLiteral;
+  const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
+  const double fm = p.free_mass * (1.0 - 0.0), fm_nr = p.free_mass_no_return * (1.0 - 0.0);
+  const double static_persistence = p.static_persistence, free_decay = p.free_decay;
+  const std::int64_t* const start = cell_start_.data();
+  const int* const near = mg.near_det_.data();
+  const double* const near_d2 = mg.near_d2_.data();
+  const std::int64_t* const bucket_start = mg.bucket_start_.data();
+  const int* const bucket_items = mg.bucket_items_.data();
+  const double* const det_x = mg.det_x_.data();
+  const double* const det_y = mg.det_y_.data();
+  const int nbx = mg.nbx_, nby = mg.nby_;
+  const std::uint8_t* const view_bits = mg.view_.data();
+  double* const free_l = free_.data();
+  double* const static_l = static_.data();
+  double* const dynamic_l = dynamic_.data();
+  double* const born_l = born_.data();
+  // Blocks of cells in parallel, dealt round robin: the same block goes to the same thread every
+  // cycle (its cells stay in that core's cache; dynamic scheduling moved them between cores, which
+  // cost more than it balanced: docs/performance.md, round 3), and neighbouring blocks, where the
+  // particles cluster, go to different threads. Every value is computed by one thread from the
+  // same inputs, so results do not depend on the thread count. A plain pragma, not ParallelFor
+  // (dualgrid/core/parallel.hpp): the loop body as a lambda compiled to 2 % more instructions
+  // (callgrind, bench_filter paper size), more than the one team per cycle costs inside the
+  // co-simulation's per-mode threads (docs/performance.md, round 5).
+  const FastCellInputs fast_in{start, near, view_bits, fm, fm_nr, static_persistence, free_decay};
+  const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
+#pragma omp parallel for schedule(static, 1)
+  for (std::int64_t ch = 0; ch < chunks; ++ch) {
+    const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
+    // Fast path (most cells): no particle, no detection (FastCells). The other cells keep their
+    // values there and are updated in the loop below, which visits only them.
+    std::int32_t slow[kCellChunk];
+    const std::int32_t n_slow =
+        FastCells(fast_in, c_lo, c_hi, free_l, static_l, dynamic_l, born_l, slow);
+    // Cells with birth mass, in cell order (Birth reads only these).
+    std::int64_t* const born_list = born_cells_.data() + c_lo;
+    std::int32_t n_born = 0;
+    for (std::int32_t t = 0; t < n_slow; ++t) {
+      const std::int64_t s = c_lo + slow[t];
+      const std::int64_t lo = start[s], hi = start[s + 1];
+      const std::uint8_t view = view_bits[s];
+      const bool observed = (view & kObserved) != 0;
+
+      // --- Prediction: predicted masses (dynamic = sum of persistent particle weights). ---
+      double d_pred = 0.0;
+      for (std::int64_t i = lo; i < hi; ++i) d_pred += q.weight[i];
+      const double cap = d_pred > 1.0 ? 1.0 / d_pred : 1.0;  // dynamic mass is a probability
+      d_pred *= cap;
+      const double s_pred = std::min(p.static_persistence * static_[s], 1.0 - d_pred);
+      const double f_pred = std::max(0.0, std::min(p.free_decay * free_[s], 1.0 - d_pred - s_pred));
+      const double o_pred = d_pred + s_pred;
+      const double u_pred = std::max(0.0, 1.0 - o_pred - f_pred);
+
+      // --- Measurement grid: occupied (f_d, eq. 2), static (eq. 4), free (eq. 3 on rays). ---
+      double occ_k = 0.0, static_k = 0.0;
+      const int j = near[s];
+      if (j >= 0) {
+        const double d2 = near_d2[s];
+        occ_k = std::exp(-d2 * inv_2sf2);
+        static_k = ExpUnder(-0.5 * (d2 * inv_sd2 + z[j].radial_velocity.squaredNorm() * inv_sv2));
+      }
+      const double z_occ = p.occupied_mass * occ_k;
+      double z_free = 0.0;
+      if (observed) {
+        if (view & kFreeRay) {
+          z_free = p.free_mass * (1.0 - occ_k);
+        } else if (view & kNoReturn) {
+          z_free = p.free_mass_no_return * (1.0 - occ_k);
+        }
+      }
+      const double z_unk = 1.0 - z_occ - z_free;
+
+      // --- Temporal fusion (Dempster's rule on {free, occupied}). ---
+      const double conflict = o_pred * z_free + f_pred * z_occ;
+      const double norm = 1.0 / (1.0 - conflict);
+      double o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
+      double f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
+      if (o_up + f_up > 1.0) {  // rounding only
+        const double k = 1.0 / (o_up + f_up);
+        o_up *= k;
+        f_up *= k;
+      }
+
+      // --- Particle weights, eqs. (7) and (8), unnormalised. The per-cycle factors double as the
+      // likelihood of each hypothesis in the joint normalisation below. ---
+      const auto mode_factor = [&](double lp, double lv) {
+        return p.mode == WeightMode::kPosition   ? lp
+               : p.mode == WeightMode::kVelocity ? lv
+                                                 : std::max(lp, lv);  // eq. (14)
+      };
+      double slow_mass = 0.0, fast_mass = 0.0, sum_pos = 0.0, sum_vel = 0.0, a_dyn = 0.0;
+      double sum_mode = 0.0;  // sum_k w_k of eq. (9) with the particles' own weights (literal)
+      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
+      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
+      std::int64_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+      bool any_candidate = false;
+      if (hi > lo) {
+        const auto [bx, by] = mg.BucketOf(q.x[lo], q.y[lo]);
+        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx - 1, bx + 1);
+        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby - 1, by + 1); ++yy, ++r) {
+          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx;
+          cand[r][0] = bucket_start[row + x_lo];
+          cand[r][1] = bucket_start[row + x_hi + 1];
+          any_candidate = any_candidate || cand[r][1] > cand[r][0];
+        }
+      }
+      for (std::int64_t i = lo; i < hi; ++i) {
+        const double m = q.weight[i] * cap;
+        q.weight[i] = m;
+        if (q.vx[i] * q.vx[i] + q.vy[i] * q.vy[i] < slow2) {
+          // A particle at (almost) zero speed is the static hypothesis (occ and v = 0): its mass
+          // votes static and the particle dies at resampling.
+          slow_mass += m;
+          q.w_position[i] = q.w_velocity[i] = q.weight[i] = 0.0;
+          continue;
+        }
+        // Nearest detection within the cutoff (ties to the lower detection index).
+        int jn = -1;
+        double d2 = cutoff2;
+        if (any_candidate) {
+          const double px = q.x[i], py = q.y[i];
+          for (const auto& range : cand) {
+            for (std::int64_t k = range[0]; k < range[1]; ++k) {
+              const double ex = det_x[k] - px, ey = det_y[k] - py;
+              const double e2 = ex * ex + ey * ey;
+              if (e2 < d2 || (e2 == d2 && jn >= 0 && bucket_items[k] < jn)) {
+                d2 = e2;
+                jn = bucket_items[k];
+              }
+            }
+          }
+        }
+        double lp = keep, lv = keep;  // unobserved: decayed prior
+        if (jn >= 0 || observed) {
+          // Float exp: kernel values need no double precision and this runs per particle.
+          const double fd = jn < 0 ? 0.0 : std::exp(static_cast<float>(-d2 * inv_2sf2));
+          double fv = 0.0;
+          if (jn >= 0) {
+            double e2;
+            if (radial) {  // line-of-sight component against the measured radial speed
+              const double* u = los_of + 3 * jn;
+              const double e = q.vx[i] * u[0] + q.vy[i] * u[1] - u[2];
+              e2 = e * e;
+              if (radial_fit && fit_k[jn] > 0.0) {  // along the tangent (-u_y, u_x): the fit
+                const double et = -q.vx[i] * u[1] + q.vy[i] * u[0] - fit_t[jn];
+                e2 += et * et * fit_k[jn] / inv_2v2;  // in units of sigma_v^2
+              }
+            } else {  // eq. (8): the full vector against mu_v = (v_rx, v_ry)
+              const double ex = q.vx[i] - z[jn].radial_velocity.x();
+              const double ey = q.vy[i] - z[jn].radial_velocity.y();
+              e2 = ex * ex + ey * ey;
+            }
+            fv = ExpUnder(static_cast<float>(-e2 * inv_2v2));
+          }
+          lp = fd * keep;                    // eq. (7)
+          lv = fd * fv + (1.0 - fd) * keep;  // eq. (8), multiplicative blend
+        }
+        // The literal normalisation sums the particles' own weights, so they share the cap of
+        // their mass; the per-cell form renormalises them below and needs no cap.
+        const double wcap = literal_norm ? cap : 1.0;
+        const double wp = lp * q.w_position[i] * wcap, wv = lv * q.w_velocity[i] * wcap;
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        fast_mass += m;
+        sum_pos += wp;
+        sum_vel += wv;
+        sum_mode += mode_factor(wp, wv);
+        a_dyn += m * mode_factor(lp, lv);
+      }
+      // The static hypothesis is scored like a particle with v = 0 at the cell centre.
+      double ls_pos = keep, ls_vel = keep;
+      if (j >= 0 || observed) {
+        const double fv0 = j >= 0 ? fv0_of[j] : 0.0;
+        ls_pos = occ_k * keep;
+        ls_vel = occ_k * fv0 + (1.0 - occ_k) * keep;
+      }
+      const double l_static = mode_factor(ls_pos, ls_vel);
+
+      // --- Joint normalisation of the occupied mass (eqs. 9-12 on o_up). ---
+      double a_static =
+          (s_pred + slow_mass) * l_static + p.static_gain * p.occupied_mass * static_k;
+      // No birth hypothesis from a detection no road object could produce (|v_r| > max_speed):
+      // such returns are clutter; their occupied mass stays unassigned (unknown).
+      const bool plausible = j < 0 || z[j].radial_velocity.squaredNorm() <= max_speed2;
+      double a_birth = plausible ? p.birth_probability * occ_k * (1.0 - o_pred) : 0.0;
+      // Literal eqs. (9)-(12): the particles enter with their own accumulated weights.
+      if (literal_norm) a_dyn = sum_mode;
+      bool fell_back = false;
+      if (keep_prediction && a_static + a_dyn + a_birth <= 0.0) {
+        // Every hypothesis got zero likelihood (e.g. position weights far from all detections):
+        // the measurement cannot arbitrate, so the predicted split is kept. (Literal eq. (7)
+        // instead lets the occupied mass become unknown: zero_likelihood = literal.)
+        a_static = s_pred + slow_mass;
+        a_dyn = fast_mass;
+        fell_back = true;
+      }
+      // Literal: the not-occupied mass competes in the same sum (eq. 9). P_free is read as free
+      // plus unknown (1 - o_up): with free alone, a particle in a never-observed cell (no free, no
+      // static evidence) would make it 100 % dynamic (docs/algorithm.md, "Switches").
+      double a_free = literal_norm ? std::max(0.0, 1.0 - o_up) : 0.0;
+      const double free_part = a_free > 0.0 ? f_up / a_free : 0.0;  // free share of a_free
+      double q_norm = a_free + a_static + a_dyn + a_birth;
+      // Subnormal likelihoods (e.g. a static mass decayed to 5e-324 and nothing else) lose their
+      // precision in o_up * a / q_norm: the product rounds up to the smallest subnormal and the
+      // share comes out as o_up * 1, breaking F + S <= 1 (found by the soak test,
+      // docs/reliability.md). Scaling all three by 2^600 is exact and restores full precision;
+      // normal values are untouched, so results elsewhere stay bit-identical.
+      double scale = 1.0;
+      if (q_norm > 0.0 && q_norm < std::numeric_limits<double>::min()) {
+        constexpr double kScale = 0x1p600;
+        scale = kScale;
+        a_free *= kScale;
+        a_static *= kScale;
+        a_dyn *= kScale;
+        a_birth *= kScale;
+        q_norm = a_free + a_static + a_dyn + a_birth;
+      }
+      // Per cell: the shares of o_up; literal: the shares of 1 (eqs. 10-12).
+      const double share = literal_norm ? 1.0 : o_up;
+      double s_up = 0.0, rho_p = 0.0, rho_b = 0.0;
+      if (q_norm > 0.0) {
+        s_up = share * a_static / q_norm;
+        rho_p = share * a_dyn / q_norm;
+        rho_b = share * a_birth / q_norm;
+        if (literal_norm) f_up = free_part * a_free / q_norm;
+      }
+      if (literal_norm) {
+        // Eq. (12): w_k / q_norm, so the weights sum to rho_p. Both weights scale together (their
+        // ratio is the dual state); after a fall-back the masses stand in for the zero weights.
+        // A single mode's other weight is not in q_norm and would drift without bound (float
+        // overflow): it is normalised on its own to rho_p, as in the per-cell form.
+        // (w * scale) / q_norm, in this order: with q_norm subnormal, scale / q_norm alone would
+        // overflow to inf (and 0 * inf = NaN); each w <= the unscaled q_norm, so the result is
+        // <= 1. The other weight's share is w / sum <= 1, times rho_p.
+        const bool own_p = fell_back || p.mode != WeightMode::kVelocity;
+        const bool own_v = fell_back || p.mode != WeightMode::kPosition;
+        const auto norm = [&](double w, bool own, double sum) {
+          if (!(q_norm > 0.0)) return 0.0;
+          if (own) return w * scale / q_norm;
+          return sum > 0.0 ? rho_p * (w / sum) : 0.0;
+        };
+        for (std::int64_t i = lo; i < hi; ++i) {
+          if (q.weight[i] == 0.0) continue;
+          const double wp = fell_back ? q.weight[i] : q.w_position[i];
+          const double wv = fell_back ? q.weight[i] : q.w_velocity[i];
+          q.w_position[i] = static_cast<float>(norm(wp, own_p, sum_pos));
+          q.w_velocity[i] = static_cast<float>(norm(wv, own_v, sum_vel));
+          q.weight[i] = static_cast<float>(norm(mode_factor(wp, wv), true, 0.0));
+        }
+      }
+
+      // --- Per cell: normalise weights so that they sum to rho_p; w_resample by mode. ---
+      double sum_res = 0.0;
+      for (std::int64_t i = lo; i < hi && !literal_norm; ++i) {
+        if (q.weight[i] == 0.0) continue;
+        const double m = q.weight[i];
+        const double wp = sum_pos > 0.0 ? rho_p * q.w_position[i] / sum_pos : rho_p * m / fast_mass;
+        const double wv = sum_vel > 0.0 ? rho_p * q.w_velocity[i] / sum_vel : rho_p * m / fast_mass;
+        q.w_position[i] = wp;
+        q.w_velocity[i] = wv;
+        const double wr = mode_factor(wp, wv);  // w_resample
+        q.weight[i] = wr;
+        sum_res += wr;
+      }
+      if (sum_res > 0.0 && !literal_norm) {
+        const double k = rho_p / sum_res;
+        for (std::int64_t i = lo; i < hi; ++i) q.weight[i] = static_cast<float>(q.weight[i] * k);
+      }
+      free_[s] = f_up;
+      static_[s] = s_up;
+      // Reported dynamic mass: persistent particles only. New-born mass is occupied mass whose
+      // motion no prediction has confirmed yet; counting it as dynamic would mark every new
+      // detection with a Doppler (clutter included) dynamic at once. It stays in the unknown share
+      // of the cell until its particles survive a cycle (docs/algorithm.md, step 5).
+      dynamic_[s] = rho_p;
+      born_[s] = rho_b;
+      if (rho_b != 0.0) born_list[n_born++] = s;
+    }
+    born_count_[ch] = n_born;
+  }
+}
+
+}  // namespace dualgrid::filter_ref
