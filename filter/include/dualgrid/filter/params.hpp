@@ -128,8 +128,8 @@ struct FilterParams {
 
   // Departures from the paper (docs/algorithm.md, "Switches"). Defaults: the `dualgrid` preset,
   // the best setting of the ablation in docs/results.md; Preset("paper") gives the literal ones.
-  // birth_velocity and velocity_likelihood: the Doppler fit since issue 28 (docs/results.md,
-  // section 9: crossing traffic dual D_v 31.8 -> 63.6 %, the paper's scenarios unchanged).
+  // birth_velocity and velocity_likelihood: the Doppler fit (docs/algorithm.md; its effect is
+  // measured in docs/results.md, section 9).
   BirthVelocity birth_velocity = BirthVelocity::kDopplerFit;
   ZeroLikelihood zero_likelihood = ZeroLikelihood::kKeepPrediction;
   VelocityLikelihood velocity_likelihood = VelocityLikelihood::kRadialFit;

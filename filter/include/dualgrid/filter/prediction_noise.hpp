@@ -13,7 +13,7 @@ namespace dualgrid::filter {
 /// and i), so they depend on nothing else. Filters with the same seed and step count (the
 /// co-simulation's weight modes, updated in lockstep) draw the same values; the co-simulation
 /// draws them once per step and passes them to every mode's DynamicGrid::Update: same results,
-/// bit for bit, as each drawing its own (docs/performance.md, "Issue 25, round 3").
+/// bit for bit, as each drawing its own.
 ///
 /// Memory: 16 bytes per particle, allocated by the first Draw and reused.
 class PredictionNoise {
