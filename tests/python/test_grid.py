@@ -312,8 +312,13 @@ class ReframeTest(unittest.TestCase):
         c, s = math.cos(a), math.sin(a)
         grid.reframe(a, (0.0, 0.0))
         after = grid.particles()
-        np.testing.assert_allclose(after["x"], c * before["x"] + s * before["y"], atol=1e-9)
-        np.testing.assert_allclose(after["y"], -s * before["x"] + c * before["y"], atol=1e-9)
+        # Positions are float grid-local metres (docs/algorithm.md, "Float state"): the turned
+        # position is rounded once to a float of magnitude M <= the grid's diagonal [m], so
+        # |error| <= 2^-24 M, plus the double arithmetic's (~1e-13 m).
+        p = small_params()
+        tol = 2.0**-24 * math.hypot(p.length_x, p.width_y) + 1e-12
+        np.testing.assert_allclose(after["x"], c * before["x"] + s * before["y"], rtol=0, atol=tol)
+        np.testing.assert_allclose(after["y"], -s * before["x"] + c * before["y"], rtol=0, atol=tol)
         np.testing.assert_allclose(after["vx"], c * before["vx"] + s * before["vy"], atol=1e-4)
         np.testing.assert_array_equal(after["weight"], before["weight"])
         # The next cycle, in the turned frame, keeps the grid's invariants.
