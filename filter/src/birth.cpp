@@ -7,6 +7,7 @@
 
 #include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
+#include "dualgrid/filter/simd_normals.hpp"
 #include "fast_normal.hpp"
 #include "grid_internal.hpp"
 
@@ -141,10 +142,11 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
   for (std::int64_t k0 = k_lo; k0 < k_hi; k0 += kBatch) {
     const std::int64_t cnt = std::min(kBatch, k_hi - k0);
     // Draws 0-3 (block 0) and 4 (block 1) of CounterRng(seed, kFilterBirth, step, k).
-    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
-                         cnt, 0, raw[0], raw[1], raw[2], raw[3]);
-    detail::PhiloxBlocks(seed_, RngPurpose::kFilterBirth, step_, static_cast<std::uint32_t>(k0),
-                         cnt, 1, raw2[0], raw2[1], raw2[2], raw2[3]);
+    constexpr auto kPurpose = static_cast<std::uint32_t>(RngPurpose::kFilterBirth);
+    detail::PhiloxLanes(seed_, kPurpose, step_, static_cast<std::uint32_t>(k0), cnt, 0, raw[0],
+                        raw[1], raw[2], raw[3]);
+    detail::PhiloxLanes(seed_, kPurpose, step_, static_cast<std::uint32_t>(k0), cnt, 1, raw2[0],
+                        raw2[1], raw2[2], raw2[3]);
     for (std::int64_t t = 0; t < cnt; ++t) {
       const std::int64_t k = k0 + t;
       births_.x[k] = (lx + detail::ToUnit24(raw[0][t])) * r;

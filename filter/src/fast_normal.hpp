@@ -47,52 +47,8 @@ inline void FastSinCos2Pi(float u, float* s, float* c) {
 /// Uniform in [0, 1) with 24 random bits (float resolution).
 inline float ToUnit24(std::uint32_t r) { return static_cast<float>(r >> 8) * (1.0f / 16777216.0f); }
 
-/// Box-Muller over arrays: (u1[k], u2[k]) uniform in [0, 1) -> independent normals (a[k], b[k]).
-/// Branch-free so that the loop vectorises.
-inline void BoxMuller(const float* u1, const float* u2, float* a, float* b, std::int64_t n) {
-  for (std::int64_t k = 0; k < n; ++k) {
-    const float r = __builtin_sqrtf(-2.0f * FastLog(1.0f - u1[k]));  // 1 - u1 in (0, 1]
-    float s, c;
-    FastSinCos2Pi(u2[k], &s, &c);
-    a[k] = r * c;
-    b[k] = r * s;
-  }
-}
-
-/// Philox4x32-10 block `block` (0: the first four NextU32() draws, 1: the next four) of the streams
-/// CounterRng(seed, purpose, step, first_index + k) for k in [0, n), written to out0..3[k]. Same
-/// arithmetic as Random123's philox4x32 (bit-identical), laid out lane-wise so that the rounds
-/// vectorise.
-inline void PhiloxBlocks(std::uint64_t seed, RngPurpose purpose, std::uint64_t step,
-                         std::uint32_t first_index, std::int64_t n, std::uint32_t block,
-                         std::uint32_t* out0, std::uint32_t* out1, std::uint32_t* out2,
-                         std::uint32_t* out3) {
-  const std::uint32_t c0 = static_cast<std::uint32_t>(step);
-  const std::uint32_t c1 = static_cast<std::uint32_t>(step >> 32);
-  const std::uint32_t c3 = (static_cast<std::uint32_t>(purpose) << 24) + block;
-  for (std::int64_t k = 0; k < n; ++k) {
-    out0[k] = c0;
-    out1[k] = c1;
-    out2[k] = first_index + static_cast<std::uint32_t>(k);
-    out3[k] = c3;
-  }
-  std::uint32_t k0 = static_cast<std::uint32_t>(seed), k1 = static_cast<std::uint32_t>(seed >> 32);
-  for (int round = 0; round < 10; ++round) {
-    if (round > 0) {
-      k0 += 0x9E3779B9u;
-      k1 += 0xBB67AE85u;
-    }
-    for (std::int64_t k = 0; k < n; ++k) {
-      const std::uint64_t p0 = static_cast<std::uint64_t>(0xD2511F53u) * out0[k];
-      const std::uint64_t p1 = static_cast<std::uint64_t>(0xCD9E8D57u) * out2[k];
-      const std::uint32_t x1 = out1[k], x3 = out3[k];
-      out0[k] = static_cast<std::uint32_t>(p1 >> 32) ^ x1 ^ k0;
-      out1[k] = static_cast<std::uint32_t>(p1);
-      out2[k] = static_cast<std::uint32_t>(p0 >> 32) ^ x3 ^ k1;
-      out3[k] = static_cast<std::uint32_t>(p0);
-    }
-  }
-}
+// The array forms (Philox blocks lane-wise, Box-Muller over arrays) are on SIMD lanes in
+// simd_normals.cpp, with the same arithmetic as FastLog and FastSinCos2Pi above.
 
 /// Two independent standard normals (Box-Muller) from two raw 32-bit draws r1, r2.
 inline void Normal2FromRaw(std::uint32_t r1, std::uint32_t r2, float* a, float* b) {

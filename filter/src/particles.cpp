@@ -9,7 +9,7 @@
 #include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
-#include "fast_normal.hpp"
+#include "dualgrid/filter/simd_normals.hpp"
 #include "predict.hpp"
 
 namespace dualgrid::filter {
@@ -25,15 +25,7 @@ namespace detail {
 void PredictionNormals(std::uint64_t seed, std::uint64_t step, std::int64_t b0, std::int64_t m,
                        float* g0, float* g1, float* g2, float* g3) {
   assert(m <= kPredictBlock);
-  alignas(64) std::uint32_t raw[4][kPredictBlock];
-  alignas(64) float u[4][kPredictBlock];
-  PhiloxBlocks(seed, RngPurpose::kFilterPredict, step, static_cast<std::uint32_t>(b0), m, 0, raw[0],
-               raw[1], raw[2], raw[3]);
-  for (int c = 0; c < 4; ++c) {
-    for (std::int64_t k = 0; k < m; ++k) u[c][k] = ToUnit24(raw[c][k]);
-  }
-  BoxMuller(u[0], u[1], g0, g1, m);
-  BoxMuller(u[2], u[3], g2, g3, m);
+  PredictionNormalLanes(seed, step, static_cast<std::uint32_t>(b0), m, g0, g1, g2, g3);
 }
 
 }  // namespace detail
