@@ -14,6 +14,7 @@
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/filter/particles.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
+#include "floor_cycle.hpp"
 
 using namespace dualgrid;
 using namespace dualgrid::filter;
@@ -244,6 +245,59 @@ BENCHMARK(BM_FloorPass)
     ->Args({10000, 1, 20000})
     ->Args({10000, 2, 20000})
     ->Args({2000000, 2, 1440000})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+// 3. The floor of issue 37's new design: FloorCycle (floor_cycle.hpp), a whole cycle's least work
+//    in float on SSE4 lanes in one parallel region, on the scenes of BM_PaperConfig (kind 0: 50
+//    detections), BM_PaperHighway (1: 700 detections) and BM_Scale at Nuss scale (2: 2e6 + 2e5
+//    particles, 1.4e6 cells, 2,000 detections). Arguments: kind, threads.
+void BM_FloorCycle(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const int kind = static_cast<int>(state.range(0));
+  FilterParams fp;
+  if (kind == 2) {
+    fp.length_x = 1000.0;
+    fp.width_y = 350.0;
+    fp.num_particles = 2000000;
+  }
+  fp.num_birth = fp.num_particles / 10;
+  Scene scene = kind == 0   ? Scene(fp.length_x, fp.width_y, 10, 5, 200.0)
+                : kind == 1 ? Scene(fp.length_x, fp.width_y, 20, 10, 200.0, 250)
+                            : Scene(fp.length_x, fp.width_y, 400, 5, 500.0);
+  bench::FloorCycle floor(fp.num_particles, fp.num_birth, fp.CellsX(), fp.CellsY(), fp.resolution,
+                          1);
+  std::uint64_t step = 0;
+  for (int k = 0; k < 20; ++k) {  // warm-up, as RunCycles
+    scene.Step(0.05, step++);
+    floor.Run(scene.ego().pose.position, scene.z(), scene.coverage(), 0.05);
+  }
+  const std::array<double, 6> warm = floor.PhaseCpu();
+  for (auto _ : state) {
+    state.PauseTiming();
+    scene.Step(0.05, step++);
+    state.ResumeTiming();
+    floor.Run(scene.ego().pose.position, scene.z(), scene.coverage(), 0.05);
+  }
+  const char* names[6] = {"us_mgrid", "us_predict", "us_sort",
+                          "us_cells", "us_birth",   "us_resample"};
+  for (int k = 0; k < 6; ++k) {
+    state.counters[names[k]] =
+        1e6 * (floor.PhaseCpu()[k] - warm[k]) / static_cast<double>(state.iterations());
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["detections"] = static_cast<double>(scene.z().size());
+  state.counters["dynamic_mass"] = floor.DynamicMass();
+  state.counters["cells_particles"] = static_cast<double>(floor.CellsWithParticles());
+  state.counters["cells_detection"] = static_cast<double>(floor.CellsWithDetection());
+}
+BENCHMARK(BM_FloorCycle)
+    ->Args({0, 1})
+    ->Args({0, 2})
+    ->Args({1, 1})
+    ->Args({1, 2})
+    ->Args({2, 1})
+    ->Args({2, 2})
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
