@@ -13,13 +13,16 @@
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
 
+#include "dualgrid/filter/particles.hpp"
 #include "dualgrid/filter/simd_normals.hpp"
 
 namespace dualgrid::bench {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
-#if HWY_ARCH_X86
+// DUALGRID_FLOOR_ANY_TARGET: a build of this file for another target (docs/performance.md's AVX2
+// figure: the floor on wider lanes); the filter itself stays pinned.
+#if HWY_ARCH_X86 && !defined(DUALGRID_FLOOR_ANY_TARGET)
 static_assert(HWY_TARGET == HWY_SSE4, "the floor is measured on the filter's pinned SSE4 target");
 #endif
 
@@ -597,14 +600,7 @@ void FloorCycle::Run(const Position& centre, std::span<const filter::Measurement
     // hist_ now holds each thread's write offsets: the stable scatter of its chunk.
     for (std::int64_t i = static_cast<std::int64_t>(n_) * t / nt;
          i < static_cast<std::int64_t>(n_) * (t + 1) / nt; ++i) {
-      const std::int32_t d = hist_[t * c1 + cell_of_[i]]++;
-      s_.x[d] = p_.x[i];
-      s_.y[d] = p_.y[i];
-      s_.vx[d] = p_.vx[i];
-      s_.vy[d] = p_.vy[i];
-      s_.weight[d] = p_.weight[i];
-      s_.w_position[d] = p_.w_position[i];
-      s_.w_velocity[d] = p_.w_velocity[i];
+      filter::CopyParticle(p_, i, s_, hist_[t * c1 + cell_of_[i]]++);
     }
     Mark(t, 2);  // sort
 #pragma omp barrier

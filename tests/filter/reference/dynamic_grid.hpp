@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
+#include "dualgrid/filter/measurement_grid.hpp"  // the library's, unchanged since 27d8ca3
 #include "dualgrid/filter/params.hpp"
-#include "measurement_grid.hpp"
 #include "particles.hpp"
 #include "prediction_noise.hpp"
 

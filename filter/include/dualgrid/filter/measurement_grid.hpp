@@ -36,6 +36,14 @@ struct SensorCoverage {
 
 class DynamicGrid;
 
+}  // namespace dualgrid::filter
+
+namespace dualgrid::filter_ref {
+class DynamicGrid;  // tests/filter/reference: the double cycle before issue 37
+}  // namespace dualgrid::filter_ref
+
+namespace dualgrid::filter {
+
 /// The measurement grid of one cycle: per cell the nearest detection within the cutoff and its
 /// squared distance (eq. 2's f_d), the field-of-view and ray free-space bits (eq. 3); per
 /// detection its line of sight, its bucket, and (when the filter's birth_velocity or
@@ -77,6 +85,9 @@ class MeasurementGrid {
 
  private:
   friend class DynamicGrid;
+  // test_float_bound.cpp's double reference cycle reads the same tables as DynamicGrid: it links
+  // this class instead of keeping a copy of it.
+  friend class ::dualgrid::filter_ref::DynamicGrid;
 
   void Stamp();  // nearest detection per cell centre and the detection buckets
   void Bins(std::span<const SensorCoverage> cov);
