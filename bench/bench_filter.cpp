@@ -1,6 +1,7 @@
 // Cycle time of DynamicGrid::Update at the paper's configuration and at scale.
 //   bench_filter --benchmark_filter=Paper    (10k particles, 200 m x 25 m at 0.5 m)
 //   bench_filter --benchmark_filter=Scale    (1e5 .. 2e6 particles, 10 % births, 1.4e6 cells)
+//   bench_filter --benchmark_filter=Floor    (floors: the noise, one pass, a whole float cycle)
 // Arguments: particles, threads (OpenMP). Results: docs/performance.md.
 #include <benchmark/benchmark.h>
 
