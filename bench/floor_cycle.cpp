@@ -224,6 +224,12 @@ void FloorCycle::MeasurementRows(int y_lo, int y_hi) {
       }
     }
   }
+  ViewRows(y_lo, y_hi);
+}
+
+// Rows [y_lo, y_hi): the field of view's bits per cell on lanes (bearing per cell through Atan2,
+// each row clipped to each sensor's range circle and wedge).
+void FloorCycle::ViewRows(int y_lo, int y_hi) {
   const DF df;
   const DI di;
   const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(df));
@@ -332,14 +338,12 @@ void FloorCycle::Predict(int t, int threads, float dt) {
   }
 }
 
-// Cells [ch kCellChunk, ...): the quiet cells (no particle, no detection) on lanes, then the others
-// one by one: predicted masses, the weights of their particles (nearest candidate detection, two
-// exps, per-cell sums on lanes), the joint normalisation, the weights' normalisation on lanes.
-void FloorCycle::CellChunk(std::int64_t ch) {
+// The quiet cells of [c_lo, c_hi) (no particle, no detection) on lanes: the free/static update
+// with no dynamic or new-born mass; the other cells keep their values for UpdateCell.
+void FloorCycle::QuietCells(std::int64_t c_lo, std::int64_t c_hi) {
   const DF df;
   const DI di;
   const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(df));
-  const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(cells_, c_lo + kCellChunk);
   const hn::Rebind<std::uint8_t, DI> d8;
   for (std::int64_t c = c_lo; c < c_hi; c += lanes) {  // layers padded by 16: whole vectors
     const VI cnt = hn::Sub(hn::LoadU(di, &start_[c + 1]), hn::LoadU(di, &start_[c]));
@@ -364,122 +368,154 @@ void FloorCycle::CellChunk(std::int64_t ch) {
     hn::StoreU(hn::IfThenElseZero(hn::Not(quiet), hn::LoadU(df, &dynamic_[c])), df, &dynamic_[c]);
     hn::StoreU(hn::IfThenElseZero(hn::Not(quiet), hn::LoadU(df, &born_[c])), df, &born_[c]);
   }
+}
+
+// The particles [lo, hi) of one cell: the nearest of the 3 x 3 buckets' detections, eqs. (7),
+// (8) with two exps on lanes, the weights unnormalised, the per-cell sums.
+FloorCycle::CellSums FloorCycle::WeighCell(std::int32_t lo, std::int32_t hi, float cap,
+                                           bool observed) {
+  const DF df;
+  const DI di;
+  const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(df));
+  const float inv_b = 1.0f / (bucket_cells_ * r_);
+  // The particles: nearest candidate detection of the 3 x 3 buckets, eqs. (7), (8), sums.
+  std::int32_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+  if (hi > lo) {
+    const int bx = std::clamp(static_cast<int>(std::floor(s_.x[lo] * inv_b)), 0, nbx_ - 1);
+    const int by = std::clamp(static_cast<int>(std::floor(s_.y[lo] * inv_b)), 0, nby_ - 1);
+    const int x0 = std::max(0, bx - 1), x1 = std::min(nbx_ - 1, bx + 1);
+    for (int yy = std::max(0, by - 1), q = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++q) {
+      cand[q][0] = bucket_start_[yy * nbx_ + x0];
+      cand[q][1] = bucket_start_[yy * nbx_ + x1 + 1];
+    }
+  }
+  const VF z = hn::Zero(df);
+  VF acc_slow = z, acc_fast = z, acc_pos = z, acc_vel = z, acc_dyn = z;
+  const VF keep = hn::Set(df, kKeep), one = hn::Set(df, 1.0f), vcap = hn::Set(df, cap);
+  for (std::int32_t i = lo; i < hi; i += static_cast<std::int32_t>(lanes)) {
+    const std::size_t valid = static_cast<std::size_t>(std::min<std::int64_t>(lanes, hi - i));
+    const auto live = hn::FirstN(df, valid);
+    const VF x = hn::LoadU(df, &s_.x[i]), y = hn::LoadU(df, &s_.y[i]);
+    const VF vx = hn::LoadU(df, &s_.vx[i]), vy = hn::LoadU(df, &s_.vy[i]);
+    const VF m = hn::Mul(hn::LoadU(df, &s_.weight[i]), vcap);
+    const auto slow =
+        hn::And(live, hn::Lt(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Set(df, kSlow2)));
+    const auto fast = hn::AndNot(slow, live);
+    VF d2 = hn::Set(df, kCutoff * kCutoff);
+    VI jn = hn::Set(di, -1);
+    for (const auto& range : cand) {
+      for (std::int32_t k = range[0]; k < range[1]; ++k) {
+        const VF ex = hn::Sub(hn::Set(df, det_[k].x), x), ey = hn::Sub(hn::Set(df, det_[k].y), y);
+        const VF e2 = hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey));
+        const auto better = hn::Lt(e2, d2);
+        d2 = hn::IfThenElse(better, e2, d2);
+        jn = hn::IfThenElse(hn::RebindMask(di, better), hn::Set(di, det_[k].item), jn);
+      }
+    }
+    const auto has = hn::RebindMask(df, hn::Gt(jn, hn::Set(di, -1)));
+    const VI jc = hn::Max(jn, hn::Zero(di));
+    const VF e = hn::Sub(hn::Add(hn::Mul(vx, hn::GatherIndex(df, u0_.data(), jc)),
+                                 hn::Mul(vy, hn::GatherIndex(df, u1_.data(), jc))),
+                         hn::GatherIndex(df, u2_.data(), jc));
+    const VF fd =
+        hn::IfThenElseZero(has, hn::Exp(df, hn::Mul(d2, hn::Set(df, -0.5f / (kSigmaF * kSigmaF)))));
+    const VF fv = hn::IfThenElseZero(
+        has, hn::Exp(df, hn::Mul(hn::Mul(e, e), hn::Set(df, -0.5f / (kSigmaV * kSigmaV)))));
+    const auto scored = observed ? hn::FirstN(df, lanes) : has;
+    const VF lp = hn::IfThenElse(scored, hn::Mul(fd, keep), keep);
+    const VF lv =
+        hn::IfThenElse(scored, hn::Add(hn::Mul(fd, fv), hn::Mul(hn::Sub(one, fd), keep)), keep);
+    const VF wp = hn::IfThenElseZero(fast, hn::Mul(lp, hn::LoadU(df, &s_.w_position[i])));
+    const VF wv = hn::IfThenElseZero(fast, hn::Mul(lv, hn::LoadU(df, &s_.w_velocity[i])));
+    const VF mf = hn::IfThenElseZero(fast, m);
+    Put(mf, &s_.weight[i], valid);  // no write past the cell
+    Put(wp, &s_.w_position[i], valid);
+    Put(wv, &s_.w_velocity[i], valid);
+    acc_slow = hn::Add(acc_slow, hn::IfThenElseZero(slow, m));
+    acc_fast = hn::Add(acc_fast, mf);
+    acc_pos = hn::Add(acc_pos, wp);
+    acc_vel = hn::Add(acc_vel, wv);
+    acc_dyn = hn::Add(acc_dyn, hn::Mul(mf, hn::Max(lp, lv)));
+  }
+  return {LaneSum(acc_slow), LaneSum(acc_fast), LaneSum(acc_pos), LaneSum(acc_vel),
+          LaneSum(acc_dyn)};
+}
+
+// Eqs. (10-12) for the particles [lo, hi) on lanes: both weights to the cell's rho_p, the
+// resampling weight their maximum scaled to rho_p.
+void FloorCycle::NormaliseCell(std::int32_t lo, std::int32_t hi, double rho_p, double sum_pos,
+                               double sum_vel) {
+  const DF df;
+  const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(df));
+  const VF z = hn::Zero(df);
+  const VF kp = hn::Set(df, static_cast<float>(sum_pos > 0.0 ? rho_p / sum_pos : 0.0));
+  const VF kv = hn::Set(df, static_cast<float>(sum_vel > 0.0 ? rho_p / sum_vel : 0.0));
+  VF sum = z;
+  for (std::int32_t i = lo; i < hi; i += static_cast<std::int32_t>(lanes)) {
+    const std::size_t valid = static_cast<std::size_t>(std::min<std::int64_t>(lanes, hi - i));
+    const VF np = hn::Mul(hn::LoadU(df, &s_.w_position[i]), kp);
+    const VF nv = hn::Mul(hn::LoadU(df, &s_.w_velocity[i]), kv);
+    const VF nw = hn::IfThenElseZero(hn::FirstN(df, valid), hn::Max(np, nv));
+    Put(nw, &s_.weight[i], valid);
+    Put(np, &s_.w_position[i], valid);
+    Put(nv, &s_.w_velocity[i], valid);
+    sum = hn::Add(sum, nw);
+  }
+  const double sum_res = LaneSum(sum);
+  const float k = sum_res > 0.0 ? static_cast<float>(rho_p / sum_res) : 0.0f;
+  for (std::int32_t i = lo; i < hi; ++i) s_.weight[i] *= k;
+}
+
+// One cell with particles or a detection: predicted masses, the measurement (eqs. 2-4), the
+// Dempster update, the weights (WeighCell), the joint normalisation (eqs. 9-12), the weights'
+// normalisation. Returns the cell's new-born mass.
+double FloorCycle::UpdateCell(std::int64_t c) {
+  const std::int32_t lo = start_[c], hi = start_[c + 1], j = near_[c];
+  float d_pred = 0.0f;
+  for (std::int32_t i = lo; i < hi; ++i) d_pred += s_.weight[i];
+  const float cap = d_pred > 1.0f ? 1.0f / d_pred : 1.0f;
+  d_pred *= cap;
+  const float s_pred = std::min(kStaticPersistence * static_[c], 1.0f - d_pred);
+  const float f_pred = std::max(0.0f, std::min(kFreeDecay * free_[c], 1.0f - d_pred - s_pred));
+  const float o_pred = d_pred + s_pred, u_pred = std::max(0.0f, 1.0f - o_pred - f_pred);
+  const float occ = j >= 0 ? std::exp(-near_d2_[c] * (0.5f / (kSigmaF * kSigmaF))) : 0.0f;
+  const bool observed = (view_[c] & kObserved) != 0;
+  const float z_occ = kOccupiedMass * occ;
+  const float z_free =
+      observed ? ((view_[c] & kFreeRay) ? kFreeMass : kFreeMassNoReturn) * (1.0f - occ) : 0.0f;
+  const float z_unk = 1.0f - z_occ - z_free;
+  const float norm = 1.0f / (1.0f - (o_pred * z_free + f_pred * z_occ));
+  const float o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
+  const float f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
+  const CellSums sums = WeighCell(lo, hi, cap, observed);
+  double a_dyn = sums.dyn;
+  // Joint normalisation of o_up (eqs. 9-12), the weights normalised on lanes.
+  const double l_static = observed || j >= 0 ? std::max(occ * kKeep, (1.0f - occ) * kKeep) : kKeep;
+  double a_static = (s_pred + sums.slow) * l_static + 0.3 * kOccupiedMass * occ;
+  const double a_birth = kBirthProbability * occ * (1.0f - o_pred);
+  if (a_static + a_dyn + a_birth <= 0.0) {  // keep the predicted split
+    a_static = s_pred + sums.slow;
+    a_dyn = sums.fast;
+  }
+  const double q = a_static + a_dyn + a_birth;
+  const double rho_p = q > 0.0 ? o_up * a_dyn / q : 0.0, rho_b = q > 0.0 ? o_up * a_birth / q : 0.0;
+  NormaliseCell(lo, hi, rho_p, sums.pos, sums.vel);
+  free_[c] = f_up;
+  static_[c] = q > 0.0 ? static_cast<float>(o_up * a_static / q) : 0.0f;
+  dynamic_[c] = static_cast<float>(rho_p);
+  born_[c] = static_cast<float>(rho_b);
+  return rho_b;
+}
+
+// Cells [ch kCellChunk, ...): QuietCells, then UpdateCell for the others; the born cells listed.
+void FloorCycle::CellChunk(std::int64_t ch) {
+  const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(cells_, c_lo + kCellChunk);
+  QuietCells(c_lo, c_hi);
   std::int32_t n_born = 0;
   double born_sum = 0.0;
-  const float inv_b = 1.0f / (bucket_cells_ * r_);
   for (std::int64_t c = c_lo; c < c_hi; ++c) {
-    const std::int32_t lo = start_[c], hi = start_[c + 1], j = near_[c];
-    if (lo == hi && j < 0) continue;
-    float d_pred = 0.0f;
-    for (std::int32_t i = lo; i < hi; ++i) d_pred += s_.weight[i];
-    const float cap = d_pred > 1.0f ? 1.0f / d_pred : 1.0f;
-    d_pred *= cap;
-    const float s_pred = std::min(kStaticPersistence * static_[c], 1.0f - d_pred);
-    const float f_pred = std::max(0.0f, std::min(kFreeDecay * free_[c], 1.0f - d_pred - s_pred));
-    const float o_pred = d_pred + s_pred, u_pred = std::max(0.0f, 1.0f - o_pred - f_pred);
-    const float occ = j >= 0 ? std::exp(-near_d2_[c] * (0.5f / (kSigmaF * kSigmaF))) : 0.0f;
-    const bool observed = (view_[c] & kObserved) != 0;
-    const float z_occ = kOccupiedMass * occ;
-    const float z_free =
-        observed ? ((view_[c] & kFreeRay) ? kFreeMass : kFreeMassNoReturn) * (1.0f - occ) : 0.0f;
-    const float z_unk = 1.0f - z_occ - z_free;
-    const float norm = 1.0f / (1.0f - (o_pred * z_free + f_pred * z_occ));
-    const float o_up = (o_pred * (z_occ + z_unk) + u_pred * z_occ) * norm;
-    const float f_up = (f_pred * (z_free + z_unk) + u_pred * z_free) * norm;
-    // The particles: nearest candidate detection of the 3 x 3 buckets, eqs. (7), (8), sums.
-    std::int32_t cand[3][2] = {{0, 0}, {0, 0}, {0, 0}};
-    if (hi > lo) {
-      const int bx = std::clamp(static_cast<int>(std::floor(s_.x[lo] * inv_b)), 0, nbx_ - 1);
-      const int by = std::clamp(static_cast<int>(std::floor(s_.y[lo] * inv_b)), 0, nby_ - 1);
-      const int x0 = std::max(0, bx - 1), x1 = std::min(nbx_ - 1, bx + 1);
-      for (int yy = std::max(0, by - 1), q = 0; yy <= std::min(nby_ - 1, by + 1); ++yy, ++q) {
-        cand[q][0] = bucket_start_[yy * nbx_ + x0];
-        cand[q][1] = bucket_start_[yy * nbx_ + x1 + 1];
-      }
-    }
-    const VF z = hn::Zero(df);
-    VF acc_slow = z, acc_fast = z, acc_pos = z, acc_vel = z, acc_dyn = z;
-    const VF keep = hn::Set(df, kKeep), one = hn::Set(df, 1.0f), vcap = hn::Set(df, cap);
-    for (std::int32_t i = lo; i < hi; i += static_cast<std::int32_t>(lanes)) {
-      const std::size_t valid = static_cast<std::size_t>(std::min<std::int64_t>(lanes, hi - i));
-      const auto live = hn::FirstN(df, valid);
-      const VF x = hn::LoadU(df, &s_.x[i]), y = hn::LoadU(df, &s_.y[i]);
-      const VF vx = hn::LoadU(df, &s_.vx[i]), vy = hn::LoadU(df, &s_.vy[i]);
-      const VF m = hn::Mul(hn::LoadU(df, &s_.weight[i]), vcap);
-      const auto slow =
-          hn::And(live, hn::Lt(hn::Add(hn::Mul(vx, vx), hn::Mul(vy, vy)), hn::Set(df, kSlow2)));
-      const auto fast = hn::AndNot(slow, live);
-      VF d2 = hn::Set(df, kCutoff * kCutoff);
-      VI jn = hn::Set(di, -1);
-      for (const auto& range : cand) {
-        for (std::int32_t k = range[0]; k < range[1]; ++k) {
-          const VF ex = hn::Sub(hn::Set(df, det_[k].x), x), ey = hn::Sub(hn::Set(df, det_[k].y), y);
-          const VF e2 = hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey));
-          const auto better = hn::Lt(e2, d2);
-          d2 = hn::IfThenElse(better, e2, d2);
-          jn = hn::IfThenElse(hn::RebindMask(di, better), hn::Set(di, det_[k].item), jn);
-        }
-      }
-      const auto has = hn::RebindMask(df, hn::Gt(jn, hn::Set(di, -1)));
-      const VI jc = hn::Max(jn, hn::Zero(di));
-      const VF e = hn::Sub(hn::Add(hn::Mul(vx, hn::GatherIndex(df, u0_.data(), jc)),
-                                   hn::Mul(vy, hn::GatherIndex(df, u1_.data(), jc))),
-                           hn::GatherIndex(df, u2_.data(), jc));
-      const VF fd = hn::IfThenElseZero(
-          has, hn::Exp(df, hn::Mul(d2, hn::Set(df, -0.5f / (kSigmaF * kSigmaF)))));
-      const VF fv = hn::IfThenElseZero(
-          has, hn::Exp(df, hn::Mul(hn::Mul(e, e), hn::Set(df, -0.5f / (kSigmaV * kSigmaV)))));
-      const auto scored = observed ? hn::FirstN(df, lanes) : has;
-      const VF lp = hn::IfThenElse(scored, hn::Mul(fd, keep), keep);
-      const VF lv =
-          hn::IfThenElse(scored, hn::Add(hn::Mul(fd, fv), hn::Mul(hn::Sub(one, fd), keep)), keep);
-      const VF wp = hn::IfThenElseZero(fast, hn::Mul(lp, hn::LoadU(df, &s_.w_position[i])));
-      const VF wv = hn::IfThenElseZero(fast, hn::Mul(lv, hn::LoadU(df, &s_.w_velocity[i])));
-      const VF mf = hn::IfThenElseZero(fast, m);
-      Put(mf, &s_.weight[i], valid);  // no write past the cell
-      Put(wp, &s_.w_position[i], valid);
-      Put(wv, &s_.w_velocity[i], valid);
-      acc_slow = hn::Add(acc_slow, hn::IfThenElseZero(slow, m));
-      acc_fast = hn::Add(acc_fast, mf);
-      acc_pos = hn::Add(acc_pos, wp);
-      acc_vel = hn::Add(acc_vel, wv);
-      acc_dyn = hn::Add(acc_dyn, hn::Mul(mf, hn::Max(lp, lv)));
-    }
-    const double slow_mass = LaneSum(acc_slow), fast_mass = LaneSum(acc_fast);
-    const double sum_pos = LaneSum(acc_pos), sum_vel = LaneSum(acc_vel);
-    double a_dyn = LaneSum(acc_dyn);
-    // Joint normalisation of o_up (eqs. 9-12), the weights normalised on lanes.
-    const double l_static =
-        observed || j >= 0 ? std::max(occ * kKeep, (1.0f - occ) * kKeep) : kKeep;
-    double a_static = (s_pred + slow_mass) * l_static + 0.3 * kOccupiedMass * occ;
-    const double a_birth = kBirthProbability * occ * (1.0f - o_pred);
-    if (a_static + a_dyn + a_birth <= 0.0) {  // keep the predicted split
-      a_static = s_pred + slow_mass;
-      a_dyn = fast_mass;
-    }
-    const double q = a_static + a_dyn + a_birth;
-    const double rho_p = q > 0.0 ? o_up * a_dyn / q : 0.0,
-                 rho_b = q > 0.0 ? o_up * a_birth / q : 0.0;
-    const VF kp = hn::Set(df, static_cast<float>(sum_pos > 0.0 ? rho_p / sum_pos : 0.0));
-    const VF kv = hn::Set(df, static_cast<float>(sum_vel > 0.0 ? rho_p / sum_vel : 0.0));
-    VF sum = z;
-    for (std::int32_t i = lo; i < hi; i += static_cast<std::int32_t>(lanes)) {
-      const std::size_t valid = static_cast<std::size_t>(std::min<std::int64_t>(lanes, hi - i));
-      const VF np = hn::Mul(hn::LoadU(df, &s_.w_position[i]), kp);
-      const VF nv = hn::Mul(hn::LoadU(df, &s_.w_velocity[i]), kv);
-      const VF nw = hn::IfThenElseZero(hn::FirstN(df, valid), hn::Max(np, nv));
-      Put(nw, &s_.weight[i], valid);
-      Put(np, &s_.w_position[i], valid);
-      Put(nv, &s_.w_velocity[i], valid);
-      sum = hn::Add(sum, nw);
-    }
-    const double sum_res = LaneSum(sum);
-    const float k = sum_res > 0.0 ? static_cast<float>(rho_p / sum_res) : 0.0f;
-    for (std::int32_t i = lo; i < hi; ++i) s_.weight[i] *= k;
-    free_[c] = f_up;
-    static_[c] = q > 0.0 ? static_cast<float>(o_up * a_static / q) : 0.0f;
-    dynamic_[c] = static_cast<float>(rho_p);
-    born_[c] = static_cast<float>(rho_b);
+    if (start_[c] == start_[c + 1] && near_[c] < 0) continue;
+    const double rho_b = UpdateCell(c);
     if (rho_b > 0.0) {
       born_list_[c_lo + n_born++] = static_cast<std::int32_t>(c);
       born_sum += rho_b;
@@ -547,6 +583,43 @@ void FloorCycle::ResampleBlock(std::int64_t b, double total, double u0) {
   }
 }
 
+// Inside Run's parallel region, thread t of nt (after every thread's Predict): the counting
+// sort's cell starts and per-thread offsets in fixed blocks of cells, then each thread's stable
+// scatter of its chunk (orphaned worksharing: the barriers are the region's).
+void FloorCycle::Sort(int t, int nt) {
+  const std::int64_t c1 = cells_ + 1, cblocks = (c1 + kCellChunk - 1) / kCellChunk;
+#pragma omp for schedule(static)
+  for (std::int64_t b = 0; b < cblocks; ++b) {
+    std::int32_t sum = 0;
+    for (std::int64_t c = b * kCellChunk; c < std::min(c1, (b + 1) * kCellChunk); ++c)
+      for (int k = 0; k < nt; ++k) sum += hist_[k * c1 + c];
+    block_total_[b + 1] = sum;
+  }
+#pragma omp single
+  {
+    block_total_[0] = 0;
+    for (std::int64_t b = 0; b < cblocks; ++b) block_total_[b + 1] += block_total_[b];
+    start_[c1] = n_;
+  }
+#pragma omp for schedule(static)
+  for (std::int64_t b = 0; b < cblocks; ++b) {
+    std::int32_t run = block_total_[b];
+    for (std::int64_t c = b * kCellChunk; c < std::min(c1, (b + 1) * kCellChunk); ++c) {
+      start_[c] = run;
+      for (int k = 0; k < nt; ++k) {
+        const std::int32_t count = hist_[k * c1 + c];
+        hist_[k * c1 + c] = run;  // thread k's first slot in cell c
+        run += count;
+      }
+    }
+  }
+  // hist_ now holds each thread's write offsets: the stable scatter of its chunk.
+  for (std::int64_t i = static_cast<std::int64_t>(n_) * t / nt;
+       i < static_cast<std::int64_t>(n_) * (t + 1) / nt; ++i) {
+    filter::CopyParticle(p_, i, s_, hist_[t * c1 + cell_of_[i]]++);
+  }
+}
+
 void FloorCycle::Run(const Position& centre, std::span<const filter::Measurement> z,
                      std::span<const filter::SensorCoverage> coverage, double dt) {
   ThreadCpu(&mark_);
@@ -556,7 +629,6 @@ void FloorCycle::Run(const Position& centre, std::span<const filter::Measurement
     hist_.resize(static_cast<std::size_t>(threads) * (cells_ + 1));
     hist_threads_ = threads;
   }
-  const std::int64_t c1 = cells_ + 1, cblocks = (c1 + kCellChunk - 1) / kCellChunk;
   const std::int64_t chunks = (cells_ + kCellChunk - 1) / kCellChunk;
   const std::int64_t in = n_ + nb_, sblocks = (in + kSumBlock - 1) / kSumBlock;
   std::uint32_t u[4];
@@ -572,36 +644,7 @@ void FloorCycle::Run(const Position& centre, std::span<const filter::Measurement
     Predict(t, nt, static_cast<float>(dt));
     Mark(t, 1);  // prediction
 #pragma omp barrier
-#pragma omp for schedule(static)
-    for (std::int64_t b = 0; b < cblocks; ++b) {
-      std::int32_t sum = 0;
-      for (std::int64_t c = b * kCellChunk; c < std::min(c1, (b + 1) * kCellChunk); ++c)
-        for (int k = 0; k < nt; ++k) sum += hist_[k * c1 + c];
-      block_total_[b + 1] = sum;
-    }
-#pragma omp single
-    {
-      block_total_[0] = 0;
-      for (std::int64_t b = 0; b < cblocks; ++b) block_total_[b + 1] += block_total_[b];
-      start_[c1] = n_;
-    }
-#pragma omp for schedule(static)
-    for (std::int64_t b = 0; b < cblocks; ++b) {
-      std::int32_t run = block_total_[b];
-      for (std::int64_t c = b * kCellChunk; c < std::min(c1, (b + 1) * kCellChunk); ++c) {
-        start_[c] = run;
-        for (int k = 0; k < nt; ++k) {
-          const std::int32_t count = hist_[k * c1 + c];
-          hist_[k * c1 + c] = run;  // thread k's first slot in cell c
-          run += count;
-        }
-      }
-    }
-    // hist_ now holds each thread's write offsets: the stable scatter of its chunk.
-    for (std::int64_t i = static_cast<std::int64_t>(n_) * t / nt;
-         i < static_cast<std::int64_t>(n_) * (t + 1) / nt; ++i) {
-      filter::CopyParticle(p_, i, s_, hist_[t * c1 + cell_of_[i]]++);
-    }
+    Sort(t, nt);
     Mark(t, 2);  // sort
 #pragma omp barrier
 #pragma omp for schedule(static, 1)

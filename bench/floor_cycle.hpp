@@ -59,8 +59,18 @@ class FloorCycle {
   void Inputs(const Position& centre, std::span<const filter::Measurement> z,
               std::span<const filter::SensorCoverage> coverage);
   void MeasurementRows(int y_lo, int y_hi);
+  void ViewRows(int y_lo, int y_hi);
+  void Sort(int t, int nt);
   void Predict(int t, int threads, float dt);
+  struct CellSums {  // a cell's particle sums (WeighCell)
+    double slow, fast, pos, vel, dyn;
+  };
   void CellChunk(std::int64_t ch);
+  void QuietCells(std::int64_t c_lo, std::int64_t c_hi);
+  double UpdateCell(std::int64_t c);
+  CellSums WeighCell(std::int32_t lo, std::int32_t hi, float cap, bool observed);
+  void NormaliseCell(std::int32_t lo, std::int32_t hi, double rho_p, double sum_pos,
+                     double sum_vel);
   void BirthChunk(std::int64_t ch, double total, float u0);
   void ResampleBlock(std::int64_t b, double total, double u0);
   void Mark(int thread, int phase);
