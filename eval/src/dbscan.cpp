@@ -85,31 +85,32 @@ int Dbscan::CellTable::Find(std::int64_t x, std::int64_t y) const {
   return it == map.end() ? -1 : it->second;
 }
 
-template <typename F>
-void Dbscan::ForEachNearBucket(const Position& p, F&& f) const {
-  const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv_eps_));
-  const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv_eps_));
+void Dbscan::NearBuckets(int num_buckets) {
   // The point's own cell first: in a dense cluster the core test then stops after a few
   // distances instead of scanning the far corners of the neighbouring cells.
-  static constexpr int kOrder[9][2] = {{0, 0}, {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
-                                       {0, 1}, {1, -1},  {1, 0},  {1, 1}};
-  for (const auto& [dx, dy] : kOrder) {
-    const int b = buckets_.Find(ix + dx, iy + dy);
-    if (b >= 0 && !f(b)) return;
+  static constexpr int kOrder[kNear][2] = {{0, 0}, {-1, -1}, {-1, 0}, {-1, 1}, {0, -1},
+                                           {0, 1}, {1, -1},  {1, 0},  {1, 1}};
+  near_.resize(static_cast<std::size_t>(num_buckets) * kNear);
+  for (int b = 0; b < num_buckets; ++b) {
+    const int first = sorted_[start_[b]];  // any member: all share the bucket's coordinates
+    int* out = &near_[static_cast<std::size_t>(b) * kNear];
+    int k = 0;
+    for (const auto& [dx, dy] : kOrder) {
+      const int nb = buckets_.Find(ix_[first] + dx, iy_[first] + dy);
+      if (nb >= 0) out[k++] = nb;
+    }
+    for (; k < kNear; ++k) out[k] = -1;
   }
 }
 
 template <typename F>
-void Dbscan::ForEachNeighbour(std::span<const Position> points, int i, F&& f) const {
+void Dbscan::ForEachNeighbour(int b, int s, F&& f) const {
   const double eps2 = params_.eps * params_.eps;
-  const Position& p = points[i];
-  ForEachNearBucket(p, [&](int b) {
-    for (int s = start_[b]; s < start_[b + 1]; ++s) {
-      const int j = sorted_[s];
-      if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return false;
-    }
-    return true;
-  });
+  const Position p = sorted_pos_[s];
+  const int* near = &near_[static_cast<std::size_t>(b) * kNear];
+  for (int k = 0; k < kNear && near[k] >= 0; ++k)
+    for (int t = start_[near[k]]; t < start_[near[k] + 1]; ++t)
+      if ((sorted_pos_[t] - p).squaredNorm() <= eps2 && !f(t)) return;
 }
 
 int Dbscan::FindRoot(int c) {
@@ -216,25 +217,37 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
     for (int i = 0; i < n; ++i) sorted_[component_[bucket_[i]]++] = i;
   }
 
-  // Core points. Independent per point, so parallel; stops counting once both criteria hold.
-  core_.assign(n, 0);
+  // Positions (and weights) in bucket order: the neighbour scans below read them contiguously.
   const bool use_weights = !weights.empty() && params_.min_weight > 0.0;
+  sorted_pos_.resize(n);
+  sorted_weight_.resize(use_weights ? n : 0);
+  for (int s = 0; s < n; ++s) {
+    sorted_pos_[s] = points[sorted_[s]];
+    if (use_weights) sorted_weight_[s] = weights[sorted_[s]];
+  }
+  NearBuckets(num_buckets);
+
+  // Core points, bucket by bucket (a bucket's members share their neighbour buckets).
+  // Independent per point, so parallel; stops counting once both criteria hold.
+  core_.assign(n, 0);
   ParallelFor(
-      n, Schedule::kDynamic,
-      [&](std::int64_t i64) {
-        const int i = static_cast<int>(i64);
-        int count = 0;
-        double weight = 0.0;
-        ForEachNeighbour(points, i, [&](int j) {
-          ++count;
-          if (use_weights) weight += weights[j];
-          const bool done =
-              count >= params_.min_points && (!use_weights || weight >= params_.min_weight);
-          if (done) core_[i] = 1;
-          return !done;
-        });
+      num_buckets, Schedule::kDynamic,
+      [&](std::int64_t b64) {
+        const int b = static_cast<int>(b64);
+        for (int s = start_[b]; s < start_[b + 1]; ++s) {
+          int count = 0;
+          double weight = 0.0;
+          ForEachNeighbour(b, s, [&](int t) {
+            ++count;
+            if (use_weights) weight += sorted_weight_[t];
+            const bool done =
+                count >= params_.min_points && (!use_weights || weight >= params_.min_weight);
+            if (done) core_[sorted_[s]] = 1;
+            return !done;
+          });
+        }
       },
-      /*worth=*/true, /*chunk=*/256);
+      /*worth=*/true, /*chunk=*/8);
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);
@@ -242,24 +255,27 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
 
   // Border points join their nearest core neighbour's cluster (see class comment for ties).
   ParallelFor(
-      n, Schedule::kDynamic,
-      [&](std::int64_t i64) {
-        const int i = static_cast<int>(i64);
-        if (core_[i]) return;
-        double best_d2 = std::numeric_limits<double>::infinity();
-        int best = -1;
-        ForEachNeighbour(points, i, [&](int j) {
-          if (!core_[j]) return true;
-          const double d2 = (points[j] - points[i]).squaredNorm();
-          if (d2 < best_d2 || (d2 == best_d2 && LexLess(points[j], points[best]))) {
-            best_d2 = d2;
-            best = j;
-          }
-          return true;
-        });
-        component_[i] = best < 0 ? kNoise : component_[best];
+      num_buckets, Schedule::kDynamic,
+      [&](std::int64_t b64) {
+        const int b = static_cast<int>(b64);
+        for (int s = start_[b]; s < start_[b + 1]; ++s) {
+          const int i = sorted_[s];
+          if (core_[i]) continue;
+          double best_d2 = std::numeric_limits<double>::infinity();
+          int best = -1;  // a position in sorted order
+          ForEachNeighbour(b, s, [&](int t) {
+            if (!core_[sorted_[t]]) return true;
+            const double d2 = (sorted_pos_[t] - sorted_pos_[s]).squaredNorm();
+            if (d2 < best_d2 || (d2 == best_d2 && LexLess(sorted_pos_[t], sorted_pos_[best]))) {
+              best_d2 = d2;
+              best = t;
+            }
+            return true;
+          });
+          component_[i] = best < 0 ? kNoise : component_[sorted_[best]];
+        }
       },
-      /*worth=*/true, /*chunk=*/256);
+      /*worth=*/true, /*chunk=*/8);
 
   // Final labels numbered by each cluster's lowest input index.
   relabel_.assign(num_components, kNoise);

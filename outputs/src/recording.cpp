@@ -8,6 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 #include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/text.hpp"
@@ -96,7 +97,25 @@ Writer::Writer(const fs::path& dir, Header header) : dir_(dir), header_(std::mov
   if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
 }
 
-void Writer::Add(const Frame& f) {
+Writer::~Writer() {
+  try {
+    Wait();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): the owner gave up on this recording
+  }
+}
+
+void Writer::Wait() {
+  if (busy_.valid()) busy_.get();
+}
+
+void Writer::Add(Frame frame) {
+  Wait();
+  pending_ = std::move(frame);
+  ++added_;
+  busy_ = std::async(std::launch::async, [this] { Write(pending_); });
+}
+
+void Writer::Write(const Frame& f) {
   const std::size_t n = static_cast<std::size_t>(header_.cells_x) * header_.cells_y;
   raw_.clear();
   for (const ModeFrame& m : f.modes) {
@@ -154,6 +173,7 @@ void Writer::Add(const Frame& f) {
 }
 
 void Writer::Finish(const Header& final_header) {
+  Wait();
   bin_.close();
   if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
   json j = HeaderJson(final_header);

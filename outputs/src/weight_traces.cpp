@@ -1,8 +1,13 @@
 #include "dualgrid/outputs/weight_traces.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dualgrid::outputs {
+
+namespace {
+constexpr double kBoundsMargin = 1e-6;  // [m]
+}  // namespace
 
 void WeightTraces::Add(const cosim::Pipeline& pipeline, std::size_t mode) {
   const sim::Frame& f = pipeline.frame();
@@ -18,9 +23,18 @@ void WeightTraces::Add(const cosim::Pipeline& pipeline, std::size_t mode) {
     in_grid.insert(v.id);
     if (dropped.count(v.id)) continue;
     double wp = 0, wv = 0, w = 0, wp_good = 0, wv_good = 0;
-    const BoxTest grown({box.center, box.yaw, box.length + 1.0, box.width + 1.0});
+    const OrientedBox grown_box{box.center, box.yaw, box.length + 1.0, box.width + 1.0};
+    const BoxTest grown(grown_box);
+    // The box's axis-aligned bounds with a margin far above Contains' rounding: a cheap first
+    // test that passes every particle Contains accepts (so the sums below are unchanged).
+    Position lo = grown_box.center, hi = grown_box.center;
+    for (const Position& c : grown_box.Corners()) lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
+    lo -= Position::Constant(kBoundsMargin);
+    hi += Position::Constant(kBoundsMargin);
     for (std::size_t i = 0; i < p.size(); ++i) {
-      if (!grown.Contains(Position(p.x[i], p.y[i]))) continue;
+      const double x = p.x[i], y = p.y[i];
+      if (x < lo.x() || x > hi.x() || y < lo.y() || y > hi.y()) continue;
+      if (!grown.Contains(Position(x, y))) continue;
       wp += p.w_position[i];
       wv += p.w_velocity[i];
       w += p.weight[i];

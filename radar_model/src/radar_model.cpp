@@ -4,7 +4,6 @@
 #include <array>
 #include <cassert>
 #include <cmath>
-#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -23,6 +22,29 @@ struct SensorGeometry {
   Pose2 pose;
   Velocity velocity;  // over ground, including the yaw-rate lever arm
 };
+
+struct RailPiece {
+  int polyline;
+  Position a, b;
+  int segment;
+};
+
+// One thread's working memory for the scans of one sensor at a time, kept between calls so that
+// a scan allocates nothing once warmed up (a step's sensors run on several threads, each with
+// its own). Every user clears what it takes.
+struct ScanScratch {
+  std::vector<Occluder> occluders;
+  std::vector<int> candidate_targets;
+  std::vector<RailPiece> rail_pieces;
+  std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
+  std::vector<FaceSample> samples;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
+};
+
+ScanScratch& Scratch() {
+  thread_local ScanScratch scratch;
+  return scratch;
+}
 
 }  // namespace
 
@@ -88,8 +110,11 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   };
 
   // 1. Occluders and candidate sources within range and field of view, culled cheaply first.
-  std::vector<Occluder> occluders;
-  std::vector<int> candidate_targets;
+  ScanScratch& scratch = Scratch();
+  std::vector<Occluder>& occluders = scratch.occluders;
+  std::vector<int>& candidate_targets = scratch.candidate_targets;
+  occluders.clear();
+  candidate_targets.clear();
   for (std::size_t ti = 0; ti < scene.targets.size(); ++ti) {
     const OrientedBox& box = scene.targets[ti].box;
     const double half_diag = 0.5 * std::hypot(box.length, box.width);
@@ -113,12 +138,8 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
     o.half_width = 0.5 * box.width;
     occluders.push_back(o);
   }
-  struct RailPiece {
-    int polyline;
-    Position a, b;
-    int segment;
-  };
-  std::vector<RailPiece> rail_pieces;
+  std::vector<RailPiece>& rail_pieces = scratch.rail_pieces;
+  rail_pieces.clear();
   int segment_index = 0;
   for (std::size_t li = 0; li < scene.polylines.size(); ++li) {
     const std::vector<Position>& pts = scene.polylines[li].points;
@@ -145,10 +166,11 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   }
 
   // Azimuth bins over the field of view listing the occluders whose interval overlaps them.
-  std::vector<std::vector<int>> bins;
+  std::vector<std::vector<int>>& bins = scratch.bins;
   const double bin_width = p.fov / kAzimuthBins;
   if (options_.occlusion) {
     bins.resize(kAzimuthBins);
+    for (std::vector<int>& bin : bins) bin.clear();
     for (std::size_t k = 0; k < occluders.size(); ++k) {
       const Occluder& o = occluders[k];
       const double c = std::atan2(o.center_dir.y(), o.center_dir.x());
@@ -208,7 +230,7 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   };
 
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
-  std::vector<FaceSample> samples;
+  std::vector<FaceSample>& samples = scratch.samples;
   for (const int ti : candidate_targets) {
     const Target& t = scene.targets[ti];
     BoxScatterers(t.box.Corners(), std::pow(10.0, 0.1 * t.rcs_dbsm), s, p.range_resolution,
@@ -257,6 +279,9 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
   const Pose2 pose = SensorWorldPose(p, ego.pose);
   const Velocity vs =
       RigidPointVelocity(ego.velocity, ego.yaw_rate, ego.pose.position, pose.position);
+  // Pose2's ToParent / ToLocal with their rotations made once (the same products).
+  const Matrix2 mount_rotation = Rotation(p.mount.yaw), pose_rotation = Rotation(pose.yaw);
+  const Matrix2 to_local = pose_rotation.transpose();
 
   const auto make_detection = [&](const Polar& m, double snr_db, int source, bool clutter) {
     Detection d;
@@ -266,8 +291,8 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
     d.range_rate = m.range_rate;
     d.snr_db = snr_db;
     const Position in_sensor = m.range * UnitVector(m.azimuth);
-    d.position_ego = p.mount.ToParent(in_sensor);
-    d.position_world = pose.ToParent(in_sensor);
+    d.position_ego = p.mount.position + mount_rotation * in_sensor;
+    d.position_world = pose.position + pose_rotation * in_sensor;
     // Compensation as a real stack does it: add back the sensor's own motion along the
     // measured line of sight.
     const Vector2 los = UnitVector(pose.yaw + m.azimuth);
@@ -279,35 +304,36 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
     return d;
   };
 
-  // Resolution cells: range, azimuth and range-rate bins packed into one key.
-  std::vector<std::uint64_t> keys(scatterers.size());
+  // Resolution cells: range, azimuth and range-rate bins packed into one key, sorted with the
+  // scatterers' indices as the tie-break (the order of a stable sort by key, without its buffer).
+  std::vector<std::pair<std::uint64_t, std::uint32_t>>& cells = Scratch().cells;
+  assert(scatterers.size() <= UINT32_MAX);
+  cells.resize(scatterers.size());
   for (std::size_t i = 0; i < scatterers.size(); ++i) {
     const Polar& t = scatterers[i].truth;
     const auto bin = [](double v, double res) {
       return static_cast<std::uint64_t>(std::max(0.0, std::floor(v / res)));
     };
-    keys[i] = (bin(t.range, p.range_resolution) << (2 * kCellBits)) |
-              (model.AzimuthCell(t.azimuth) << kCellBits) |
-              bin(t.range_rate - p.min_range_rate, p.range_rate_resolution);
+    cells[i] = {(bin(t.range, p.range_resolution) << (2 * kCellBits)) |
+                    (model.AzimuthCell(t.azimuth) << kCellBits) |
+                    bin(t.range_rate - p.min_range_rate, p.range_rate_resolution),
+                static_cast<std::uint32_t>(i)};
   }
-  std::vector<std::size_t> order(scatterers.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+  std::sort(cells.begin(), cells.end());
 
   std::vector<Detection> out;
   // Random streams per cell: cells holding a direct scatterer are numbered among themselves (so
   // with multipath off nothing changes, and on, a cell without ghosts draws what it drew
   // without them); cells of ghosts alone have their own purpose and numbering.
   std::uint32_t cell = 0, ghost_cell = 0;
-  for (std::size_t begin = 0; begin < order.size();) {
+  for (std::size_t begin = 0; begin < cells.size();) {
     std::size_t end = begin;
     double snr = 0.0, best = -1.0, rr = 0.0;
     Position centroid = Position::Zero();
     const Scatterer* strongest = nullptr;
     bool has_direct = false;
-    for (; end < order.size() && keys[order[end]] == keys[order[begin]]; ++end) {
-      const Scatterer& sc = scatterers[order[end]];
+    for (; end < cells.size() && cells[end].first == cells[begin].first; ++end) {
+      const Scatterer& sc = scatterers[cells[end].second];
       const double si = model.SnrLinear(sc.rcs_m2, sc.truth.range);
       snr += si;
       centroid += si * sc.position;
@@ -322,7 +348,7 @@ std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, 
     const std::uint32_t ordinal = has_direct ? cell++ : ghost_cell++;
     if (!(snr > 0.0)) continue;
     centroid /= snr;
-    const Position local = pose.ToLocal(centroid);
+    const Position local = to_local * (centroid - pose.position);
     const Polar truth{local.norm(), std::atan2(local.y(), local.x()), rr / snr};
     assert(ordinal < (1u << kCellBits));
     CounterRng rng(seed_, has_direct ? RngPurpose::kRadarScatter : RngPurpose::kRadarGhost, step,

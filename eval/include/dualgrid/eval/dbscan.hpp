@@ -66,12 +66,14 @@ class Dbscan {
   const DbscanParams& params() const { return params_; }
 
  private:
-  // Calls f(j) for every point j within eps of points[i] (i itself included).
+  static constexpr int kNear = 9;  // the 3 x 3 hash cells around a point's own
+  // near_[kNear b ...]: the existing buckets among the 3 x 3 hash cells around bucket b, in the
+  // search order (own cell first), padded with -1.
+  void NearBuckets(int num_buckets);
+  // Calls f(t) for every sorted position t within eps of sorted position s of bucket b (s itself
+  // included) until f returns false.
   template <typename F>
-  void ForEachNeighbour(std::span<const Position> points, int i, F&& f) const;
-  // Calls f(bucket) for the existing buckets of the 3 x 3 hash cells around p until f is false.
-  template <typename F>
-  void ForEachNearBucket(const Position& p, F&& f) const;
+  void ForEachNeighbour(int b, int s, F&& f) const;
 
   DbscanParams params_;
   double inv_eps_ = 1.0;
@@ -99,6 +101,9 @@ class Dbscan {
   std::vector<int> bucket_;
   std::vector<int> start_;
   std::vector<int> sorted_;
+  std::vector<Position> sorted_pos_;   // points[sorted_[s]]
+  std::vector<double> sorted_weight_;  // weights[sorted_[s]] when weighted
+  std::vector<int> near_;
   std::vector<std::uint8_t> core_;
   // Fine grid of the core points: cell c holds fine_sorted_[fine_start_[c] .. fine_start_[c + 1]).
   CellTable fine_;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -112,25 +113,43 @@ struct Header {
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).
 double ParticleUnit(double extent_x, double extent_y);
 
-/// Writes a recording frame by frame. Inputs are copied; throws std::runtime_error naming the file
-/// when a write fails.
+/// Writes a recording frame by frame. Add takes the frame over and returns at once: one worker
+/// thread at a time packs, compresses (zlib, the run's largest output cost) and appends it while
+/// the run goes on, in the order added, so the files are the same bytes as written in line. At
+/// most one frame waits (bounded memory). A failed write throws std::runtime_error naming the
+/// file, from the next Add or from Finish; the destructor waits for the worker and drops its error.
 class Writer {
  public:
   Writer(const std::filesystem::path& dir, Header header);
-  void Add(const Frame& frame);
-  /// Writes index.json (header with `complete`, `status`, `metrics` and `names` as given now).
+  ~Writer();
+  Writer(const Writer&) = delete;
+  Writer& operator=(const Writer&) = delete;
+  void Add(Frame frame);
+  /// Waits for the last frame, then writes index.json (header with `complete`, `status`,
+  /// `metrics` and `names` as given now).
   void Finish(const Header& final_header);
-  std::size_t frames() const { return index_.size(); }
+  /// Frames added so far.
+  std::size_t frames() const { return added_; }
 
  private:
+  /// Packs, compresses and appends one frame and its index entry (on the worker thread).
+  void Write(const Frame& frame);
+  /// Waits for the frame in flight, if any; rethrows its error.
+  void Wait();
+
   std::filesystem::path dir_;
   Header header_;
   std::ofstream bin_;
   std::uint64_t offset_ = 0;
+  std::size_t added_ = 0;
   /// Each frame's index entry, already serialised: a JSON tree of a long run's detections would
   /// take ~6x the memory of its text.
   std::vector<std::string> index_;
   std::vector<std::uint8_t> raw_, packed_;
+  /// The frame in flight and its worker's result; only the worker touches the members above
+  /// while it is valid.
+  Frame pending_;
+  std::future<void> busy_;
 };
 
 /// A finished recording, read back through the checked reader (read_back.hpp). The constructor
