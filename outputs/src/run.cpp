@@ -281,7 +281,10 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
                                const Callbacks& callbacks) {
   o.Validate();
   SnapshotTimes(o.snapshots, config);  // bad --snapshots: before anything is written
-  PrepareOutputFolder(o.out);
+  InputSet inputs = o.inputs;
+  inputs.AddScenario(config, o.network_dir);
+  CheckOutputApart(o.out, inputs);
+  PrepareOutputFolder(o.out, {.force = o.force});
   std::filesystem::create_directories(o.out / "figures");
   if (!recorded || !config.file.empty()) CopyScenario(config, o.out);
   WriteTextFile(o.out / "config.json", ConfigJson(config, cosim.mode_names()).dump(2) + "\n");
@@ -318,6 +321,7 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   // Written last: a run folder without summary.json did not finish.
   AddSummary(cosim, config, r, observers, recorded, &summary);
   summary["digests"] = OutputDigests(o.out);
+  SealOutputFolder(o.out);
   WriteTextFile(o.out / "summary.json", summary.dump(2) + "\n");
   return r;
 }

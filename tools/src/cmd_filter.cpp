@@ -94,6 +94,28 @@ void NuScenesInput(const recorded::NuScenesScene& n, const recorded::RecordedSeq
                        std::to_string(n.empty_clouds) + " empty cloud(s).");
 }
 
+// What `dualgrid filter` reads besides the scenario: the data, the sensors file (given, or a
+// RadarScenes root's), the scenario that travelled with an export.
+outputs::InputSet RecordedInputs(const FilterInputOptions& o, const recorded::RecordedInput& in) {
+  outputs::InputSet inputs;
+  inputs.Add(o.input, "recorded data");
+  if (o.sensors) inputs.Add(*o.sensors, "sensors file");
+  if (in.radarscenes && !o.sensors)
+    inputs.Add(o.input.parent_path().parent_path() / "sensors.json", "sensors file");
+  if (in.scenario) inputs.Add(*in.scenario, "scenario");
+  return inputs;
+}
+
+// The file `dualgrid export --allow-incomplete` leaves at a dataset's root, if the input has one.
+std::optional<std::filesystem::path> IncompleteMark(const FilterInputOptions& o, bool radarscenes) {
+  const std::filesystem::path root =
+      radarscenes ? o.input.lexically_normal().parent_path().parent_path() : o.input;
+  const auto mark = root / "INCOMPLETE.txt";
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(mark, ec)) return mark;
+  return std::nullopt;
+}
+
 }  // namespace
 
 int RunFilterCommand(FilterInputOptions o) {
@@ -146,6 +168,14 @@ int RunFilterCommand(FilterInputOptions o) {
     r.input["reference_velocity"] =
         "estimated from each track's labelled points (docs/recorded-data.md, \"Track velocity\")";
   if (in.nuscenes) NuScenesInput(*in.nuscenes, in.sequence, &r);
+  if (const auto mark = IncompleteMark(o, in.radarscenes)) {
+    r.input["source_incomplete"] = true;
+    r.notes.push_back("The data were exported from a run that did not finish (" + mark->string() +
+                      ").");
+    std::cerr << "dualgrid: warning: " << o.input.string()
+              << " was exported from a run that did not finish (" << mark->string() << ")\n";
+  }
+  o.run.folder.inputs = RecordedInputs(o, in);
   return WriteRunFolderAndReport(cosim, config, o.run.FolderOptions(), &r);
 }
 

@@ -108,7 +108,10 @@ int RunSim(const SimOptions& sim_options) {
   DetectionPath(options.out, sim_options.detections);  // a bad --detections: before SUMO
   const sim::ScenarioSpec& spec = config.sim;
   cosim::CoSimulation cosim(config, {.modes = {}});  // SUMO and the radar, no filter
-  PrepareOutputFolder(options.out);
+  outputs::InputSet inputs;
+  inputs.AddScenario(config, options.network_dir);
+  outputs::CheckOutputApart(options.out, inputs);
+  PrepareOutputFolder(options.out, {.force = options.force});
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -135,6 +138,7 @@ int RunSim(const SimOptions& sim_options) {
   std::string status;
   nlohmann::json summary = SimSummary(cosim, config, tally, wall, &status);
   summary["digests"] = OutputDigests(options.out);
+  SealOutputFolder(options.out);
   // Written last: a folder without summary.json did not finish.
   WriteTextFile(options.out / "summary.json", summary.dump(2) + "\n");
   const int steps = tally.steps;
