@@ -225,6 +225,7 @@ Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
       "scan alone)")
       ->check(Number(0.0, 1.0, false));
   cmd->add_flag("--quiet,-q", o->run.run.quiet, "No progress or summary output");
+  AddForceFlag(cmd, &o->run.run.force);
   AddFilterOptions(cmd, &o->run, no_figures.get());
   cmd->add_flag("--no-record", *no_record, "Do not record the replay frames (RUN_DIR/replay/)");
   cmd->add_flag("--viewer", o->run.folder.viewer,
