@@ -9,6 +9,7 @@
 
 #include "dualgrid/core/input_file.hpp"
 #include "dualgrid/outputs/output_file.hpp"
+#include "dualgrid/outputs/read_results.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 
 namespace dualgrid::outputs {
@@ -269,6 +270,26 @@ void SealOutputFolder(const fs::path& out) {
   m.ours.insert("summary.json");  // written after the seal
   m.sealed = true;
   WriteMarker(out, m);
+}
+
+std::string CheckRunFinished(const fs::path& run_dir, bool allow_incomplete,
+                             const std::string& option) {
+  const RunState state = ReadRunState(run_dir);
+  if (state.complete) return "";
+  const std::string why = state.why == "not run"      ? "no summary.json"
+                          : state.why == "incomplete" ? "summary.json says complete: false"
+                                                      : state.why;
+  if (!allow_incomplete)
+    throw std::invalid_argument(run_dir.string() + " is not a finished run (" + why +
+                                "): its export would look complete; finish the run, or add " +
+                                option + " (the dataset is then marked by " + kIncompleteMark +
+                                ")");
+  return why;
+}
+
+void MarkIncomplete(const fs::path& out, const fs::path& run_dir, const std::string& why) {
+  WriteTextFile(out / kIncompleteMark, "Exported from a run that did not finish (" + why +
+                                           "): " + fs::absolute(run_dir).string() + "\n");
 }
 
 bool OwnEntryName(const std::string& name) {

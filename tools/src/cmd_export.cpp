@@ -8,7 +8,6 @@
 #include "commands.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
-#include "dualgrid/outputs/read_results.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
@@ -29,21 +28,6 @@ struct ExportOptions {
   bool quiet = false;
 };
 
-// "" for a run that finished; else why not (refused unless --allow-incomplete).
-std::string IncompleteReason(const ExportOptions& o) {
-  const outputs::RunState state = outputs::ReadRunState(o.run_dir);
-  if (state.complete) return "";
-  const std::string why = state.why == "not run"      ? "no summary.json"
-                          : state.why == "incomplete" ? "summary.json says complete: false"
-                                                      : state.why;
-  if (!o.allow_incomplete)
-    throw std::invalid_argument(
-        o.run_dir.string() + " is not a finished run (" + why +
-        "): its export would look complete; finish the run, or add --allow-incomplete (the "
-        "dataset is then marked by INCOMPLETE.txt)");
-  return why;
-}
-
 int RunExport(const ExportOptions& o) {
   SafeName(o.sequence, "--sequence");
   SafeName(o.nuscenes.scene, "--scene");
@@ -52,16 +36,15 @@ int RunExport(const ExportOptions& o) {
   inputs.Add(o.run_dir, "run folder");
   outputs::CheckOutputApart(o.out, inputs);
   recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
-  const std::string incomplete = IncompleteReason(o);  // after the data: a damaged file first
+  // After the data: a damaged file is named first.
+  const std::string incomplete = outputs::CheckRunFinished(o.run_dir, o.allow_incomplete);
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
   if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))
     scenario = o.run_dir / "scenario.yaml";
   PrepareOutputFolder(o.out, {.force = o.force});
   if (!incomplete.empty())  // first: a reader sees it even if the export stops midway
-    WriteTextFile(o.out / "INCOMPLETE.txt",
-                  "Exported from a run that did not finish (" + incomplete +
-                      "): " + std::filesystem::absolute(o.run_dir).string() + "\n");
+    outputs::MarkIncomplete(o.out, o.run_dir, incomplete);
   std::filesystem::path written;
   if (o.format == "nuscenes") {
     const auto keys = recorded::ReadKeyFrames(o.run_dir, seq, 0.5);
@@ -87,7 +70,8 @@ int RunExport(const ExportOptions& o) {
   SealOutputFolder(o.out);
   if (!incomplete.empty())
     std::cerr << "dualgrid: warning: exported an incomplete run (" << incomplete
-              << "); the dataset is marked by " << (o.out / "INCOMPLETE.txt").string() << "\n";
+              << "); the dataset is marked by " << (o.out / outputs::kIncompleteMark).string()
+              << "\n";
   if (!o.quiet)
     std::cout << "exported " << seq.scans.size() << " scans, " << seq.points.size()
               << " detections, " << seq.track_names.size() << " tracks of " << o.run_dir.string()

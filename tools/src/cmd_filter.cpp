@@ -6,6 +6,7 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/outputs/output_guard.hpp"
 #include "dualgrid/outputs/run.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 
@@ -110,7 +111,7 @@ outputs::InputSet RecordedInputs(const FilterInputOptions& o, const recorded::Re
 std::optional<std::filesystem::path> IncompleteMark(const FilterInputOptions& o, bool radarscenes) {
   const std::filesystem::path root =
       radarscenes ? o.input.lexically_normal().parent_path().parent_path() : o.input;
-  const auto mark = root / "INCOMPLETE.txt";
+  const auto mark = root / outputs::kIncompleteMark;
   std::error_code ec;
   if (std::filesystem::is_regular_file(mark, ec)) return mark;
   return std::nullopt;

@@ -84,6 +84,19 @@ void PrepareOutputFolder(const std::filesystem::path& out, const OutputFolderOpt
 /// what it wrote.
 void SealOutputFolder(const std::filesystem::path& out);
 
+/// The file that marks an export of a run that did not finish, at the dataset's root.
+inline constexpr const char* kIncompleteMark = "INCOMPLETE.txt";
+
+/// Before exporting `run_dir`: "" when its summary.json says complete; otherwise why not ("no
+/// summary.json", "summary.json says complete: false", its status), which throws
+/// std::invalid_argument naming `run_dir` unless `allow_incomplete` (`option` names the flag).
+std::string CheckRunFinished(const std::filesystem::path& run_dir, bool allow_incomplete,
+                             const std::string& option = "--allow-incomplete");
+
+/// Writes `out`/kIncompleteMark saying why `run_dir` did not finish (CheckRunFinished's reason).
+void MarkIncomplete(const std::filesystem::path& out, const std::filesystem::path& run_dir,
+                    const std::string& why);
+
 /// True for the names dualgrid writes at the top of an output folder (docs/output.md), used by
 /// --force on a folder whose marker lists nothing (an output that did not finish, or one of an
 /// earlier version): the run, experiment, regression, sweep and export files, `*.log`.
