@@ -256,7 +256,13 @@ void PrepareOutputFolder(const fs::path& out, const OutputFolderOptions& o) {
                                   "'); --force replaces only dualgrid's own: choose a new folder");
     marker.kept = ClearOwnEntries(out, o.option);
   }
-  fs::create_directories(out);
+  if (!fs::exists(st) && fs::is_symlink(fs::symlink_status(out, ec)))
+    throw std::invalid_argument(o.option + ": " + out.string() +
+                                " is a symbolic link to a missing folder; give a real folder");
+  fs::create_directories(out, ec);
+  if (ec)  // a parent that is a file, a folder without write permission: nothing written yet
+    throw std::invalid_argument(o.option + ": cannot create the folder " + out.string() + ": " +
+                                ec.message());
   WriteMarker(out, marker);
 }
 

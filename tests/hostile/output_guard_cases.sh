@@ -117,6 +117,9 @@ for d in X abs v; do [ -e "$work/$d" ] && fail "a name left --out: $work/$d exis
 # --- Folders: never emptied unless created by this command, or with --force of our own. ---
 refused not_empty "is not empty" "$dualgrid" run "$S" --out "$in" "${run_args[@]}"
 refused foreign_force "not a dualgrid output" "$dualgrid" run "$S" --out "$in/exp" --force "${run_args[@]}"
+ln -s "$work/nowhere/x" "$work/dangling"
+refused out_dangling_link "symbolic link to a missing folder" "$dualgrid" run "$S" --out "$work/dangling" "${run_args[@]}"
+refused out_under_a_file "cannot create the folder" "$dualgrid" run "$S" --out "$in/thesis.tex/run" "${run_args[@]}"
 refused out_is_a_file "not a folder" "$dualgrid" run "$S" --out "$in/thesis.tex" --force "${run_args[@]}"
 out=$work/rerun
 works first_run "$dualgrid" run "$S" "${run_args[@]}" --detections csv --out "$out"
@@ -128,6 +131,14 @@ works rerun_force "$dualgrid" run "$S" "${run_args[@]}" --out "$out" --force
 [ -e "$out/detections.csv" ] && fail "rerun_force: the earlier run's detections.csv stayed"
 [ "$(cat "$out/notes.txt" 2>/dev/null)" = mine ] || fail "rerun_force: the user's notes.txt was removed"
 grep -q '"complete": true' "$out/summary.json" || fail "rerun_force: no complete summary.json"
+
+exp=$work/exp
+works experiment_first "$dualgrid" experiment "$S" --seeds 1 --duration 1 --no-figures -q --out "$exp"
+echo mine >"$exp/notes.txt"
+refused experiment_rerun "add --force" "$dualgrid" experiment "$S" --seeds 1 --duration 1 --no-figures -q --out "$exp"
+works experiment_force "$dualgrid" experiment "$S" --seeds 1 --duration 1 --no-figures -q --out "$exp" --force
+[ "$(cat "$exp/notes.txt" 2>/dev/null)" = mine ] || fail "experiment_force: the user's notes.txt was removed"
+grep -q '"complete": true' "$exp/summary.json" || fail "experiment_force: no complete summary.json"
 
 # --- Export of a run that did not finish. ---
 cp -r "$R" "$in/killed"
