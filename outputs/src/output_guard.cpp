@@ -242,9 +242,11 @@ void PrepareOutputFolder(const fs::path& out, const OutputFolderOptions& o) {
     const std::string first = FirstEntry(out);
     const bool marked = fs::is_regular_file(fs::symlink_status(out / kRunMarker, ec));
     if (!o.force && marked)
-      throw std::invalid_argument(o.option + ": " + out.string() +
-                                  " holds an earlier dualgrid output; add --force to replace it "
-                                  "(only dualgrid's own files are removed) or choose a new folder");
+      throw std::invalid_argument(
+          o.option + ": " + out.string() + " holds an earlier dualgrid output" +
+          (fs::exists(out / "summary.json", ec) ? "" : " (one that did not finish)") +
+          "; add --force to replace it (only dualgrid's own files are removed) or choose a new "
+          "folder");
     if (!o.force)
       throw std::invalid_argument(
           o.option + ": " + out.string() + " is not empty (e.g. '" + first +

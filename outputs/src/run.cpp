@@ -16,6 +16,7 @@
 #include "dualgrid/outputs/run_observers.hpp"
 #include "dualgrid/outputs/video.hpp"
 #include "dualgrid/outputs/viewer.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
 
 namespace dualgrid::outputs {
 
@@ -281,6 +282,8 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
                                const Callbacks& callbacks) {
   o.Validate();
   SnapshotTimes(o.snapshots, config);  // bad --snapshots: before anything is written
+  // A missing network is found before the folder is made: the next attempt needs no --force.
+  if (!recorded) sim::ResolveNetwork(config.sim.network, o.network_dir);
   InputSet inputs = o.inputs;
   inputs.AddScenario(config, o.network_dir);
   CheckOutputApart(o.out, inputs);

@@ -16,6 +16,7 @@
 #include "dualgrid/outputs/run_config.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
 
@@ -107,7 +108,8 @@ int RunSim(const SimOptions& sim_options) {
   scenario::ScenarioConfig config = LoadConfig(options);
   DetectionPath(options.out, sim_options.detections);  // a bad --detections: before SUMO
   const sim::ScenarioSpec& spec = config.sim;
-  cosim::CoSimulation cosim(config, {.modes = {}});  // SUMO and the radar, no filter
+  cosim::CoSimulation cosim(config, {.modes = {}});        // SUMO and the radar, no filter
+  sim::ResolveNetwork(spec.network, options.network_dir);  // before the folder is made
   outputs::InputSet inputs;
   inputs.AddScenario(config, options.network_dir);
   outputs::CheckOutputApart(options.out, inputs);
