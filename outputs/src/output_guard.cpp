@@ -244,7 +244,7 @@ void PrepareOutputFolder(const fs::path& out, const OutputFolderOptions& o) {
     if (!o.force && marked)
       throw std::invalid_argument(
           o.option + ": " + out.string() + " holds an earlier dualgrid output" +
-          (fs::exists(out / "summary.json", ec) ? "" : " (one that did not finish)") +
+          (ReadMarker(out).sealed ? "" : " (one that did not finish)") +
           "; add --force to replace it (only dualgrid's own files are removed) or choose a new "
           "folder");
     if (!o.force)

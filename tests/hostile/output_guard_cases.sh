@@ -114,6 +114,11 @@ refused scene_slash "--scene: 'a/b'" "$dualgrid" export "$R" --format nuscenes -
 for d in X abs v; do [ -e "$work/$d" ] && fail "a name left --out: $work/$d exists"; done
 [ -e "$work/e1" ] && fail "sequence_up: --out was created before the name was checked"
 
+# --- A generator never overwrites a scenario or a network it did not write (without --force). ---
+echo "<net/>" >"$in/scen/mine.net.xml"
+refused tangential_over_scenario "exists; add --force" "$dualgrid" tangential --kind crossing --out "$in/scen/s.yaml" -q
+refused tangential_over_network "mine.net.xml exists" "$dualgrid" tangential --kind aspect --out "$in/scen/mine.yaml" -q
+
 # --- Folders: never emptied unless created by this command, or with --force of our own. ---
 refused not_empty "is not empty" "$dualgrid" run "$S" --out "$in" "${run_args[@]}"
 refused foreign_force "not a dualgrid output" "$dualgrid" run "$S" --out "$in/exp" --force "${run_args[@]}"

@@ -81,6 +81,7 @@ void PrepareCases(const RegressOptions& o, scenario::RegressionSuite* suite) {
       TangentialOptions gen;
       gen.kind = "aspect";
       gen.quiet = true;
+      gen.force = true;  // inside this command's own output folder
       std::vector<std::string> rest;
       try {
         for (const std::string& s : c.sets) {

@@ -302,6 +302,7 @@ void AddSetting(const SweepOptions& o, const std::vector<SweepAxis>& axes,
   TangentialOptions gen;
   gen.kind = "aspect";
   gen.quiet = true;
+  gen.force = true;  // inside the sweep's own folder (a resumed sweep writes it again)
   for (std::size_t k = 0; k < axes.size(); ++k) {
     if (axes[k].key.rfind("tangential.", 0) == 0)
       SetGeneratorOption(&gen, axes[k].key.substr(11), values[k]);

@@ -93,6 +93,7 @@ struct TangentialOptions {
   std::optional<double> spacing;
   std::uint64_t seed = 1;
   std::filesystem::path out;
+  bool force = false;  ///< replace existing files at `out` (and its network files beside it)
   bool quiet = false;
   // kind aspect:
   std::string sensor = "front";
