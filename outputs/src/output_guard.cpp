@@ -244,9 +244,8 @@ void PrepareOutputFolder(const fs::path& out, const OutputFolderOptions& o) {
     if (!o.force && marked)
       throw std::invalid_argument(
           o.option + ": " + out.string() + " holds an earlier dualgrid output" +
-          (ReadMarker(out).sealed ? "" : " (one that did not finish)") +
-          "; add --force to replace it (only dualgrid's own files are removed) or choose a new "
-          "folder");
+          (ReadMarker(out).sealed ? "" : " (one that did not finish)") + "; add " + o.force_flag +
+          " to replace it (only dualgrid's own files are removed) or choose a new folder");
     if (!o.force)
       throw std::invalid_argument(
           o.option + ": " + out.string() + " is not empty (e.g. '" + first +
@@ -254,8 +253,8 @@ void PrepareOutputFolder(const fs::path& out, const OutputFolderOptions& o) {
     if (!marked)
       throw std::invalid_argument(o.option + ": " + out.string() +
                                   " holds files that are not a dualgrid output (no " + kRunMarker +
-                                  "; e.g. '" + first +
-                                  "'); --force replaces only dualgrid's own: choose a new folder");
+                                  "; e.g. '" + first + "'); " + o.force_flag +
+                                  " replaces only dualgrid's own: choose a new folder");
     marker.kept = ClearOwnEntries(out, o.option);
   }
   if (!fs::exists(st) && fs::is_symlink(fs::symlink_status(out, ec)))

@@ -286,8 +286,9 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   if (!recorded) sim::ResolveNetwork(config.sim.network, o.network_dir);
   InputSet inputs = o.inputs;
   inputs.AddScenario(config, o.network_dir);
-  CheckOutputApart(o.out, inputs);
-  PrepareOutputFolder(o.out, {.force = o.force});
+  CheckOutputApart(o.out, inputs, o.out_option);
+  PrepareOutputFolder(o.out,
+                      {.force = o.force, .option = o.out_option, .force_flag = o.force_flag});
   std::filesystem::create_directories(o.out / "figures");
   if (!recorded || !config.file.empty()) CopyScenario(config, o.out);
   WriteTextFile(o.out / "config.json", ConfigJson(config, cosim.mode_names()).dump(2) + "\n");

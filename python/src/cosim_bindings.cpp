@@ -46,6 +46,8 @@ void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config
   outputs::RunFolderOptions folder;
   folder.out = out;
   folder.force = force;
+  folder.out_option = "run_scenario: out";
+  folder.force_flag = "force=True";
   folder.network_dir = network_dir;
   folder.quiet = true;
   py::gil_scoped_release release;

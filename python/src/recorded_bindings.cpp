@@ -160,7 +160,8 @@ std::string ExportRadarScenes(const fs::path& run_dir, const fs::path& out,
   cosim::RecordedSequence seq = recorded::ReadRunFolder(run_dir);
   const std::string incomplete =
       outputs::CheckRunFinished(run_dir, allow_incomplete, "allow_incomplete=True");
-  outputs::PrepareOutputFolder(out, {.force = force, .option = "export_radarscenes: out"});
+  outputs::PrepareOutputFolder(
+      out, {.force = force, .option = "export_radarscenes: out", .force_flag = "force=True"});
   if (!incomplete.empty()) outputs::MarkIncomplete(out, run_dir, incomplete);
   seq.name = sequence;
   // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end, as `dualgrid export`.

@@ -136,7 +136,7 @@ class ExportTest(unittest.TestCase):
                     self.assertTrue(np.array_equal(a[part][k], b[part][k]), (part, k))
             self.assertEqual(a["track_names"], b["track_names"])
             # The output guard (docs/reliability.md, "Output folders"), as on the command line.
-            with self.assertRaisesRegex(ValueError, "add --force"):
+            with self.assertRaisesRegex(ValueError, "add force=True"):
                 dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
             self.assertEqual(dualgrid.export_radarscenes(run, os.path.join(tmp, "py"), force=True),
                              seq)

@@ -68,7 +68,8 @@ struct OutputFolderOptions {
   /// Replace an earlier dualgrid output in the folder: remove its own entries (those its marker
   /// lists as `ours`, else the names dualgrid writes: OwnEntryName), keep every other entry.
   bool force = false;
-  std::string option = "--out";  ///< the option named in errors ("--out", "out=")
+  std::string option = "--out";        ///< the option named in errors ("--out", "out")
+  std::string force_flag = "--force";  ///< how errors tell to force ("--force", "force=True")
 };
 
 /// Makes `out` ready for a new output: creates it if missing (with its parents); uses it as it

@@ -29,6 +29,8 @@ struct RunFolderOptions {
   std::filesystem::path out;  ///< the run folder (made ready: PrepareOutputFolder)
   /// Replace an earlier dualgrid output in `out` (its own entries only; output_guard.hpp).
   bool force = false;
+  /// How errors name `out` and `force` (the Python module: "run_scenario: out", "force=True").
+  std::string out_option = "--out", force_flag = "--force";
   /// What the run reads besides the scenario's files (WriteRunFolder adds those): `out` must lie
   /// apart from all of them (CheckOutputApart), e.g. the recorded data of `dualgrid filter`.
   InputSet inputs;
