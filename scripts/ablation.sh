@@ -51,7 +51,7 @@ experiment() {
   [[ $figures == no ]] && fig=(--no-figures)
   echo "ablation: $scen/$name ($seeds seeds) $*"
   # Exit 3 (some seeds failed) keeps the finished seeds; the study goes on and the table says so.
-  "$B" experiment "$(scenario_file "$scen")" --seeds "$seeds" --out "$dir" -q "${fig[@]}" \
+  "$B" experiment "$(scenario_file "$scen")" --seeds "$seeds" --out "$dir" --force -q "${fig[@]}" \
     "${JOBS_ARG[@]}" "$@" || echo "ablation: $scen/$name exited $?" >&2
 }
 

@@ -37,7 +37,7 @@ case "${1:-run}" in
   run)
     scenario=${2:-scenarios/highway.yaml}
     # --video --viewer: the replay video and the interactive page beside the results.
-    "$BUILD_DIR/tools/dualgrid" run "$scenario" --out "run/$(basename "$scenario" .yaml)" --video --viewer
+    "$BUILD_DIR/tools/dualgrid" run "$scenario" --out "run/$(basename "$scenario" .yaml)" --force --video --viewer
     ;;
   test)
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$(nproc)"

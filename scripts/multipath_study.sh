@@ -59,7 +59,7 @@ stage_experiments() {
       echo "multipath study: $scen, multipath $mp ($SEEDS seeds)"
       local args=()
       mapfile -d '' args < <(scenario_args "$scen")
-      "$B" experiment "$(scenario_file "$scen")" --seeds "$SEEDS" --out "$dir" -q --no-figures \
+      "$B" experiment "$(scenario_file "$scen")" --seeds "$SEEDS" --out "$dir" --force -q --no-figures \
         "${JOBS_ARG[@]}" "${args[@]}" --set sensors.multipath=$mp "${EXTRA_ARGS[@]}" ||
         echo "multipath study: $scen/$mp exited $?" >&2
     done
@@ -74,7 +74,7 @@ stage_rates() {
       echo "multipath study: ghost rates, $scen seed $seed"
       local args=()
       mapfile -d '' args < <(scenario_args "$scen")
-      "$B" sim "$(scenario_file "$scen")" --seed "$seed" --detections csv.gz --out "$dir" -q \
+      "$B" sim "$(scenario_file "$scen")" --seed "$seed" --detections csv.gz --out "$dir" --force -q \
         "${args[@]}" --set sensors.multipath=on "${EXTRA_ARGS[@]}"
     done
   done
@@ -85,7 +85,7 @@ stage_loss() {
     local dir="$OUT/guardrail/multipath_on_loss$loss"
     if grep -q '"complete": *true' "$dir/summary.json" 2>/dev/null; then continue; fi
     echo "multipath study: guardrail, rail loss $loss dB ($SEEDS seeds)"
-    "$B" experiment "$(scenario_file guardrail)" --seeds "$SEEDS" --out "$dir" -q --no-figures \
+    "$B" experiment "$(scenario_file guardrail)" --seeds "$SEEDS" --out "$dir" --force -q --no-figures \
       "${JOBS_ARG[@]}" --set "sensors.multipath={rail_loss_db: $loss}" ||
       echo "multipath study: guardrail/loss$loss exited $?" >&2
   done

@@ -8,12 +8,12 @@
 #include <exception>
 #include <stdexcept>
 
+#include "dualgrid/core/write_file.hpp"
+
 namespace dualgrid::outputs {
 
 namespace {
 constexpr std::size_t kFlushBytes = 1 << 20;
-
-std::string Reason() { return errno ? std::strerror(errno) : "unknown error"; }
 }  // namespace
 
 OutputFile::OutputFile(const std::filesystem::path& path) : path_(path) {
@@ -34,7 +34,7 @@ OutputFile::~OutputFile() {
 }
 
 void OutputFile::Fail(const std::string& what) {
-  throw std::runtime_error(what + " " + path_.string() + ": " + Reason());
+  throw std::runtime_error(what + " " + path_.string() + ": " + SystemReason());
 }
 
 void OutputFile::MaybeFlush() {
@@ -75,7 +75,7 @@ TempDir::TempDir(const std::string& purpose) : exceptions_(std::uncaught_excepti
   std::string pattern =
       (std::filesystem::temp_directory_path() / ("dualgrid_" + purpose + "_XXXXXX")).string();
   if (!mkdtemp(pattern.data()))
-    throw std::runtime_error("cannot create a temporary folder " + pattern + ": " + Reason());
+    throw std::runtime_error("cannot create a temporary folder " + pattern + ": " + SystemReason());
   path_ = pattern;
 }
 

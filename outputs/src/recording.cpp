@@ -12,6 +12,7 @@
 
 #include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/text.hpp"
+#include "dualgrid/core/write_file.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 
 namespace dualgrid::outputs::replay {
@@ -94,7 +95,9 @@ Writer::Writer(const fs::path& dir, Header header) : dir_(dir), header_(std::mov
   // A stale index from an earlier run must not describe this run's frames.
   fs::remove(dir_ / "index.json");
   bin_.open(dir_ / "frames.bin", std::ios::binary | std::ios::trunc);
-  if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
+  if (!bin_)
+    throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string() + ": " +
+                             SystemReason());
 }
 
 Writer::~Writer() {
@@ -140,7 +143,9 @@ void Writer::Write(const Frame& f) {
                              " s failed");
   bin_.write(reinterpret_cast<const char*>(packed_.data()),
              static_cast<std::streamsize>(packed_size));
-  if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
+  if (!bin_)
+    throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string() + ": " +
+                             SystemReason());
 
   json j = {{"t", R(f.time * 10.0) / 10.0},
             {"yaw", f.yaw_deg},  // exact: positions far from the origin turn with it
@@ -175,7 +180,9 @@ void Writer::Write(const Frame& f) {
 void Writer::Finish(const Header& final_header) {
   Wait();
   bin_.close();
-  if (!bin_) throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string());
+  if (!bin_)
+    throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string() + ": " +
+                             SystemReason());
   json j = HeaderJson(final_header);
   j["frames"] = json::array();
   std::string text = j.dump();

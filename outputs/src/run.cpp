@@ -16,6 +16,7 @@
 #include "dualgrid/outputs/run_observers.hpp"
 #include "dualgrid/outputs/video.hpp"
 #include "dualgrid/outputs/viewer.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
 
 namespace dualgrid::outputs {
 
@@ -281,7 +282,13 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
                                const Callbacks& callbacks) {
   o.Validate();
   SnapshotTimes(o.snapshots, config);  // bad --snapshots: before anything is written
-  PrepareOutputFolder(o.out);
+  // A missing network is found before the folder is made: the next attempt needs no --force.
+  if (!recorded) sim::ResolveNetwork(config.sim.network, o.network_dir);
+  InputSet inputs = o.inputs;
+  inputs.AddScenario(config, o.network_dir);
+  CheckOutputApart(o.out, inputs, o.out_option);
+  PrepareOutputFolder(o.out,
+                      {.force = o.force, .option = o.out_option, .force_flag = o.force_flag});
   std::filesystem::create_directories(o.out / "figures");
   if (!recorded || !config.file.empty()) CopyScenario(config, o.out);
   WriteTextFile(o.out / "config.json", ConfigJson(config, cosim.mode_names()).dump(2) + "\n");
@@ -318,6 +325,7 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   // Written last: a run folder without summary.json did not finish.
   AddSummary(cosim, config, r, observers, recorded, &summary);
   summary["digests"] = OutputDigests(o.out);
+  SealOutputFolder(o.out);
   WriteTextFile(o.out / "summary.json", summary.dump(2) + "\n");
   return r;
 }

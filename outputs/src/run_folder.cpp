@@ -46,35 +46,6 @@ nlohmann::json OutputDigests(const std::filesystem::path& dir) {
   return digests;
 }
 
-void PrepareOutputFolder(const std::filesystem::path& out) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(out, ec) && !fs::is_directory(out))
-    throw std::invalid_argument("--out: " + out.string() + " exists and is not a folder");
-  if (fs::exists(out, ec) && !fs::is_empty(out)) {
-    if (!fs::exists(out / kRunMarker) && !fs::exists(out / "summary.json") &&
-        !fs::exists(out / "config.json")) {
-      const std::string first = fs::directory_iterator(out)->path().filename().string();
-      throw std::invalid_argument("--out: " + out.string() +
-                                  " holds files that are not a dualgrid run (e.g. '" + first +
-                                  "'); give a new or empty folder");
-    }
-    fs::remove(out / "summary.json", ec);  // first: from here on the folder is not a finished run
-    if (ec)
-      throw std::runtime_error("cannot remove the earlier " + (out / "summary.json").string() +
-                               ": " + ec.message());
-    for (const auto& e : fs::directory_iterator(out)) {
-      fs::remove_all(e.path(), ec);
-      if (ec)
-        throw std::runtime_error("cannot clear the earlier run's " + e.path().string() + ": " +
-                                 ec.message());
-    }
-  }
-  fs::create_directories(out);
-  WriteTextFile(out / kRunMarker,
-                "This folder is written by dualgrid; a new run with this --out empties it.\n");
-}
-
 bool FaultInjected(const std::string& what) {
   const char* env = std::getenv("DUALGRID_FAULT");
   if (!env) return false;

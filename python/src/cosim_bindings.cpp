@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 // SUMO's route file and log go to `work_dir`, or a temporary folder removed afterwards.
 void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
               const std::optional<fs::path>& work_dir) {
-  WorkDir work = WorkDir::Make(work_dir, cs.config().sim.name);
+  WorkDir work = WorkDir::Make(work_dir, cs.config(), network_dir);
   {
     py::gil_scoped_release release;  // the run is C++ only; other Python threads go on
     cs.Start(network_dir, work.path);
@@ -42,9 +42,12 @@ void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
 
 // The run folder `out`, as `dualgrid run` writes it with its default options.
 void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config,
-                 const fs::path& network_dir, const fs::path& out) {
+                 const fs::path& network_dir, const fs::path& out, bool force) {
   outputs::RunFolderOptions folder;
   folder.out = out;
+  folder.force = force;
+  folder.out_option = "run_scenario: out";
+  folder.force_flag = "force=True";
   folder.network_dir = network_dir;
   folder.quiet = true;
   py::gil_scoped_release release;
@@ -54,7 +57,8 @@ void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config
 py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
                      std::optional<double> duration, const std::vector<std::string>& modes,
                      const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
-                     std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out) {
+                     std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out,
+                     bool force) {
   const scenario::ScenarioConfig config =
       LoadRunConfig(path, seed, duration, overrides, "run_scenario");
   const cosim::CoSimOptions options = RunOptions(modes, threads, "run_scenario");
@@ -66,7 +70,7 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
   cs.AddObserver(&clusters);
   const fs::path networks = NetworkDir(network_dir);
   if (out)
-    RunToFolder(cs, config, networks, *out);
+    RunToFolder(cs, config, networks, *out, force);
   else
     RunToEnd(cs, networks, work_dir);
   return Results(cs, config, clusters);
@@ -88,6 +92,7 @@ void BindCosim(py::module_& m) {
         py::arg("modes") = std::vector<std::string>{"position", "velocity", "dual"},
         py::arg("overrides") = std::vector<std::string>{}, py::arg("network_dir") = py::none(),
         py::arg("work_dir") = py::none(), py::arg("threads") = 0, py::arg("out") = py::none(),
+        py::arg("force") = false,
         R"doc(Runs a scenario file as `dualgrid run` does (SUMO, radar, one filter per mode, the
 paper's scoring) and returns its results; the same scenario and seed give the CLI's numbers.
 
@@ -99,7 +104,9 @@ build tree's, or $DUALGRID_NETWORK_DIR). work_dir: where SUMO's route file and s
 depend on it). out: a folder to write the run folder to, as `dualgrid run --out DIR` with its
 default options does (metrics, tables, CSV files, figures, the replay recording, summary.json
 last; the same bytes as the command line's except the wall-clock times of summary.json; SUMO's
-files go there too, so not with work_dir). One run at a time per process (libsumo).
+files go there too, so not with work_dir). out must not exist or be empty, or, with force, hold
+an earlier dualgrid output (only its own files are removed, as `--force`); out and work_dir may
+not equal, contain or lie inside a file the run reads. One run at a time per process (libsumo).
 
 Returns a dict: scenario, seed, steps, simulated_s, requested_s, complete (False when the ego
 left the network early), detections_per_step, metrics ({mode: metrics.json's entry}),

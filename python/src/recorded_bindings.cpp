@@ -15,6 +15,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/outputs/output_guard.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
@@ -151,21 +152,24 @@ py::dict ReadRecorded(const fs::path& path, std::optional<fs::path> sensors) {
 // `dualgrid export`'s job: a run folder (recorded with --detections exact) as a RadarScenes
 // dataset root. Returns the sequence folder written.
 std::string ExportRadarScenes(const fs::path& run_dir, const fs::path& out,
-                              const std::string& sequence) {
-  if (sequence.empty() || sequence.find('/') != std::string::npos)
-    throw py::value_error("export_radarscenes: sequence must be a folder name, got '" + sequence +
-                          "'");
-  std::error_code ec;
-  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
-    throw py::value_error("export_radarscenes: out " + out.string() +
-                          " exists and is not an empty folder");
+                              const std::string& sequence, bool force, bool allow_incomplete) {
+  outputs::SafeName(sequence, "export_radarscenes: sequence");
+  outputs::InputSet inputs;
+  inputs.Add(run_dir, "run folder");
+  outputs::CheckOutputApart(out, inputs, "export_radarscenes: out");
   cosim::RecordedSequence seq = recorded::ReadRunFolder(run_dir);
+  const std::string incomplete =
+      outputs::CheckRunFinished(run_dir, allow_incomplete, "allow_incomplete=True");
+  outputs::PrepareOutputFolder(
+      out, {.force = force, .option = "export_radarscenes: out", .force_flag = "force=True"});
+  if (!incomplete.empty()) outputs::MarkIncomplete(out, run_dir, incomplete);
   seq.name = sequence;
   // The rear axle (RadarScenes' car origin) 1 m ahead of the ego's rear end, as `dualgrid export`.
   const double rear_axle = std::max(0.0, 0.5 * seq.ego_length - 1.0);
   {
     py::gil_scoped_release nogil;
     recorded::WriteRadarScenes(seq, out, rear_axle);
+    outputs::SealOutputFolder(out);
   }
   return (out / "data" / sequence).string();
 }
@@ -174,12 +178,17 @@ std::string ExportRadarScenes(const fs::path& run_dir, const fs::path& out,
 
 void BindRecorded(py::module_& m) {
   m.def("export_radarscenes", &ExportRadarScenes, py::arg("run_dir"), py::arg("out"),
-        py::arg("sequence") = "sequence_1",
+        py::arg("sequence") = "sequence_1", py::arg("force") = false,
+        py::arg("allow_incomplete") = false,
         R"doc(Writes a run folder (of `dualgrid run` or `sim` with --detections exact) as a
 RadarScenes dataset root `out` (sensors.json, sequences.json, data/<sequence>/scenes.json and
 radar_data.h5), as `dualgrid export` does; read_recorded() and run_recorded() read it back.
-`out` must not exist or be empty. Returns the sequence folder. ValueError for bad input (the
-file and field), RuntimeError naming the file when a write fails.)doc");
+`out` must not exist or be empty, or, with force, hold an earlier dualgrid output (only its own
+files are removed); it may not equal, contain or lie inside run_dir; sequence is one plain folder
+name. A run that did not finish (no summary.json, or complete: false) is refused unless
+allow_incomplete (the dataset is then marked by INCOMPLETE.txt). Returns the sequence folder.
+ValueError for bad input (the file and field), RuntimeError naming the file and the system's
+reason when a write fails.)doc");
   m.def("read_recorded", &ReadRecorded, py::arg("path"), py::arg("sensors") = py::none(),
         R"doc(Reads a recorded sequence without filtering it: a RadarScenes sequence folder
 (scenes.json, radar_data.h5; sensors: its sensors.json, default the dataset root's) or a run

@@ -1,5 +1,6 @@
 #include "run_setup.hpp"
 
+#include "dualgrid/outputs/output_guard.hpp"
 #include "dualgrid/outputs/run_config.hpp"
 
 #include <unistd.h>
@@ -105,9 +106,14 @@ void SumoClaim::Release() {
   held_ = false;
 }
 
-WorkDir WorkDir::Make(const std::optional<fs::path>& given, const std::string& name) {
+WorkDir WorkDir::Make(const std::optional<fs::path>& given, const scenario::ScenarioConfig& config,
+                      const fs::path& network_dir) {
+  const std::string& name = config.sim.name;
   WorkDir w;
   if (given) {
+    outputs::InputSet inputs;  // SUMO's route file and log go there: never onto an input
+    inputs.AddScenario(config, network_dir);
+    outputs::CheckOutputApart(*given, inputs, "work_dir");
     w.path = *given;
   } else {
     static std::atomic<int> counter{0};

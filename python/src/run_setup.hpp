@@ -66,7 +66,11 @@ class SumoClaim {
 struct WorkDir {
   std::filesystem::path path;
   bool owned = false;
-  static WorkDir Make(const std::optional<std::filesystem::path>& given, const std::string& name);
+  /// `given` (which may not equal, contain or lie inside a file `config` reads: ValueError), or a
+  /// new temporary folder named after the scenario.
+  static WorkDir Make(const std::optional<std::filesystem::path>& given,
+                      const scenario::ScenarioConfig& config,
+                      const std::filesystem::path& network_dir);
   void Remove();
 };
 

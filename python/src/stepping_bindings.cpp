@@ -32,7 +32,7 @@ class Simulation {
              bool velocities, const fs::path& networks, const std::optional<fs::path>& work_dir)
       : name_("CoSimulation"), config_(config), collector_(velocities) {
     sumo_ = std::make_unique<SumoClaim>(name_);
-    work_ = WorkDir::Make(work_dir, config.sim.name);
+    work_ = WorkDir::Make(work_dir, config, networks);
     cs_ = std::make_unique<cosim::CoSimulation>(config_, options);
     {
       py::gil_scoped_release nogil;

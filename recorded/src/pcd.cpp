@@ -1,6 +1,8 @@
 // PCD v0.7 binary files (docs/recorded-data.md, "nuScenes").
 #include "dualgrid/recorded/pcd.hpp"
 
+#include "dualgrid/core/write_file.hpp"
+
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -237,14 +239,10 @@ void WritePcd(const std::filesystem::path& file, const PcdCloud& cloud) {
       p += cloud.fields[f].size;
     }
   }
-  std::ofstream out(file, std::ios::binary);
   const std::string header = h.str();
-  out.write(header.data(), static_cast<std::streamsize>(header.size()));
-  out.write(reinterpret_cast<const char*>(bytes.data()),
-            static_cast<std::streamsize>(bytes.size()));
-  out.put('\n');
-  out.close();
-  if (!out) throw std::runtime_error(file.string() + ": write failed");
+  WriteFileChecked(
+      file,
+      {header, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), "\n"});
 }
 
 }  // namespace dualgrid::recorded

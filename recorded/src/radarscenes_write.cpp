@@ -183,7 +183,7 @@ void WriteRadarScenes(const RecordedSequence& seq, const std::filesystem::path& 
   o.WriteDoubles("yaw_rate", owz);
   o.WriteDoubles("dualgrid_lane_yaw", olane);
   if (H5Fflush(file.get(), H5F_SCOPE_GLOBAL) < 0)
-    throw std::runtime_error(h5_name + ": write failed");
+    throw std::runtime_error("cannot write " + h5_name + ": " + SystemReason());
 }
 
 }  // namespace dualgrid::recorded

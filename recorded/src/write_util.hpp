@@ -10,15 +10,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dualgrid/core/write_file.hpp"
+
 namespace dualgrid::recorded {
 
 /// Writes `j` (indented by `indent`, -1: one line) to `file`; throws std::runtime_error naming
-/// the file when the write fails.
+/// the file and the system's reason when the write fails.
 inline void WriteJson(const std::filesystem::path& file, const nlohmann::json& j, int indent = 1) {
-  std::ofstream out(file);
-  out << j.dump(indent) << "\n";
-  out.close();
-  if (!out) throw std::runtime_error(file.string() + ": write failed");
+  WriteFileChecked(file, {j.dump(indent), "\n"});
 }
 
 /// A deterministic 32-hex-digit id of `name` and `index` (FNV-1a 64, two seeds).

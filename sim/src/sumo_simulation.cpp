@@ -15,6 +15,7 @@
 #include "auto_ego_run.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/text.hpp"
+#include "dualgrid/core/write_file.hpp"
 #include "dualgrid/sim/conversions.hpp"
 #include "dualgrid/sim/random_trips.hpp"
 #include "dualgrid/sim/sumo_additional.hpp"
@@ -125,7 +126,8 @@ std::set<std::string> OwnTypes(const ScenarioSpec& spec) {
 
 void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path) {
   std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write route file " + path.string());
+  if (!out)
+    throw std::runtime_error("cannot write route file " + path.string() + ": " + SystemReason());
   // The name goes into an XML comment, where "--" is not allowed: escaped like an attribute, with
   // dashes spelled out.
   std::string name = XmlEscape(spec.name);
@@ -177,7 +179,8 @@ void WriteRouteFile(const ScenarioSpec& spec, const std::filesystem::path& path)
                    [](const Entry& a, const Entry& b) { return a.depart < b.depart; });
   for (const Entry& e : entries) out << e.xml;
   out << "</routes>\n";
-  if (!out) throw std::runtime_error("cannot write route file " + path.string());
+  if (!out)
+    throw std::runtime_error("cannot write route file " + path.string() + ": " + SystemReason());
 }
 
 namespace {

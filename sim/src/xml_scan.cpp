@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "dualgrid/core/input_file.hpp"
+#include "dualgrid/core/write_file.hpp"
 
 namespace dualgrid::sim {
 
@@ -202,7 +203,7 @@ std::size_t CopyXml(const std::filesystem::path& path, const std::string& what,
   const std::unique_ptr<XML_ParserStruct, ParserFree> parser(XML_ParserCreate(nullptr));
   if (!parser) throw std::runtime_error("out of memory (XML parser)");
   std::unique_ptr<std::FILE, FileClose> file(std::fopen(out.c_str(), "wb"));
-  if (!file) throw std::runtime_error("cannot write " + out.string());
+  if (!file) throw std::runtime_error("cannot write " + out.string() + ": " + SystemReason());
   s.parser = parser.get();
   s.out = file.get();
   s.edit = &edit;
@@ -217,9 +218,9 @@ std::size_t CopyXml(const std::filesystem::path& path, const std::string& what,
   try {
     if (s.error) std::rethrow_exception(s.error);
   } catch (const WriteFailed&) {
-    throw std::runtime_error("cannot write " + out.string());
+    throw std::runtime_error("cannot write " + out.string() + ": " + SystemReason());
   }
-  if (!closed) throw std::runtime_error("cannot write " + out.string());
+  if (!closed) throw std::runtime_error("cannot write " + out.string() + ": " + SystemReason());
   return s.changed;
 }
 

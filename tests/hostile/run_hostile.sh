@@ -231,6 +231,7 @@ mkdir -p "$work/onerun"
 printf 'step,time,sensor,sensor_name,ego_x,ego_y,ego_yaw,ego_vx,ego_vy,ego_yaw_rate,ego_length,ego_width,lane_yaw,mount_x,mount_y,mount_yaw,fov,min_range,max_range\n1,0.5,0,front,0,0,0,10,0,0,4.5,1.8,0,2.25,0,0,1,0.5,80\n' >"$work/onerun/scans.csv"
 printf 'step,time,sensor,sensor_name,range,azimuth,range_rate,snr_db,x_ego,y_ego,x,y,radial_speed,vrx,vry,sensor_x,sensor_y,source,is_clutter,vclass\n' >"$work/onerun/detections.csv"
 printf 'step,time,id,type,is_ego,x,y,yaw,vx,vy,speed,lateral_speed,yaw_rate,length,width,lane,x_ego,y_ego,vx_ego,vy_ego,rcs_dbsm\n1,0.5,ego,ego,1,0,0,0,10,0,10,0,0,4.5,1.8,l,0,0,0,0,10\n' >"$work/onerun/ground_truth.csv"
+echo '{"complete": true}' >"$work/onerun/summary.json"  # a finished run: only the radars are wrong
 check "nuscenes:export_not_five_radars" 2 "nuScenes has five channels" \
   "$dualgrid" export "$work/onerun" --format nuscenes --out "$work/nso_export"
 check "nuscenes:bad_states" 2 "--ambig-states: expected 'all' or whole numbers" \

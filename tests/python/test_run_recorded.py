@@ -7,6 +7,7 @@ Needs DUALGRID_EXE and DUALGRID_SOURCE_DIR; run against the installed package (t
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -134,8 +135,23 @@ class ExportTest(unittest.TestCase):
                 for k in a[part]:
                     self.assertTrue(np.array_equal(a[part][k], b[part][k]), (part, k))
             self.assertEqual(a["track_names"], b["track_names"])
-            with self.assertRaisesRegex(ValueError, "exists and is not an empty folder"):
+            # The output guard (docs/reliability.md, "Output folders"), as on the command line.
+            with self.assertRaisesRegex(ValueError, "add force=True"):
                 dualgrid.export_radarscenes(run, os.path.join(tmp, "py"))
+            self.assertEqual(dualgrid.export_radarscenes(run, os.path.join(tmp, "py"), force=True),
+                             seq)
+            for out in (run, os.path.join(run, "inside"), tmp):
+                with self.assertRaisesRegex(ValueError, re.escape("out '" + out)):
+                    dualgrid.export_radarscenes(run, out, force=True)
+            for name in ("../x", "/tmp/x", "..", "", "a\nb"):
+                with self.assertRaisesRegex(ValueError, "sequence"):
+                    dualgrid.export_radarscenes(run, os.path.join(tmp, "n"), sequence=name)
+            self.assertFalse(os.path.exists(os.path.join(tmp, "x")))
+            os.rename(os.path.join(run, "summary.json"), os.path.join(tmp, "summary.json"))
+            with self.assertRaisesRegex(ValueError, "not a finished run"):
+                dualgrid.export_radarscenes(run, os.path.join(tmp, "inc"))
+            dualgrid.export_radarscenes(run, os.path.join(tmp, "inc"), allow_incomplete=True)
+            self.assertTrue(os.path.isfile(os.path.join(tmp, "inc", "INCOMPLETE.txt")))
 
 
 if __name__ == "__main__":

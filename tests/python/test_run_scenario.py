@@ -126,6 +126,13 @@ class RunFolderTest(unittest.TestCase):
                     self.assertEqual(ja, jb)
                 elif f != "sumo.log":  # SUMO's own log, dated
                     self.assertEqual(ca, cb, f)
+            # A second run into the folder is refused before SUMO starts, unless force=True.
+            with self.assertRaisesRegex(ValueError, "run_scenario: out: .* add force=True"):
+                dualgrid.run_scenario(SCENARIO, seed=SEED, duration=4.0, out=py,
+                                      network_dir=networks)
+            with self.assertRaisesRegex(ValueError, "work_dir"):
+                dualgrid.run_scenario(SCENARIO, duration=0.5, work_dir=os.path.dirname(SCENARIO),
+                                      network_dir=networks)
 
 
 if __name__ == "__main__":

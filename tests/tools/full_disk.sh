@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # An experiment on a full disk (issue 26): each failed seed's line keeps its reason, though the
-# seed's own log cannot be written. A 256 KiB tmpfs holds the experiment folder; mounting needs
-# root (CI runs as root), otherwise the test is skipped (exit 77).
+# seed's own log cannot be written; an export (issue 42) names the file and the reason. A 256 KiB
+# tmpfs holds the outputs; mounting needs root (CI runs as root), otherwise the test is skipped
+# (exit 77).
 # Usage: full_disk.sh DUALGRID SCENARIO
 set -uo pipefail
 dualgrid=$1
@@ -25,5 +26,18 @@ if printf '%s\n' "$out" | grep '^dualgrid: seed [0-9]* failed: ' | grep -qv 'No 
   echo "FAIL: a per-seed line lost the reason (No space left on device)"
   fail=1
 fi
+# The dataset writers (issue 42): an export onto a full disk names the file and the system's reason.
+run=$(mktemp -d "${TMPDIR:-/tmp}/dualgrid_full_disk_run.XXXXXX")
+trap 'umount "$mnt"; rmdir "$mnt"; rm -rf "$run"' EXIT
+"$dualgrid" run "$scenario" --duration 2 --no-figures -q --detections exact --out "$run/r" ||
+  { echo "FAIL: cannot make the run to export"; fail=1; }
+for format in radarscenes nuscenes; do
+  out=$("$dualgrid" export "$run/r" --format "$format" --out "$mnt/export_$format" 2>&1)
+  code=$?
+  echo "$out"
+  [ "$code" -eq 1 ] || { echo "FAIL: export $format: exit code $code, expected 1"; fail=1; }
+  [[ "$out" == "dualgrid: error: cannot write $mnt/export_$format/"*": No space left on device" ]] ||
+    { echo "FAIL: export $format: the file or the reason is missing"; fail=1; }
+done
 [ "$fail" -eq 0 ] && echo "full disk: the reason is kept"
 exit "$fail"

@@ -172,13 +172,20 @@ TEST_CASE("An output folder never mixes two runs", "[cli][newcomer]") {
   const std::string run = "run scenarios/simple_road.yaml --duration 1 --no-figures -q --out ";
   REQUIRE(Run(run + dir.string() + " --detections csv").code == 0);
   REQUIRE(fs::exists(dir / "detections.csv"));
-  REQUIRE(Run(run + dir.string()).code == 0);  // an earlier run's folder is emptied first
+  // Without --force a folder that is not empty is never touched: the user is told what to do.
+  CheckOneLineError(Run(run + dir.string()), 2, "add --force");
+  CHECK(fs::exists(dir / "detections.csv"));
+  // With --force, the earlier run's own files go; a file the user put there stays.
+  std::ofstream(dir / "notes.txt") << "mine";
+  REQUIRE(Run(run + dir.string() + " --force").code == 0);
   CHECK_FALSE(fs::exists(dir / "detections.csv"));
   CHECK(fs::exists(dir / "summary.json"));
-  // A folder of other files is never cleared.
+  CHECK(Slurp(dir / "notes.txt") == "mine");
+  // A folder of other files is never cleared, not even with --force.
   const auto other = TempDir("other_folder");
   std::ofstream(other / "thesis.tex") << "precious";
-  CheckOneLineError(Run(run + other.string()), 2, "not a dualgrid run");
+  CheckOneLineError(Run(run + other.string()), 2, "is not empty");
+  CheckOneLineError(Run(run + other.string() + " --force"), 2, "not a dualgrid output");
   CHECK(Slurp(other / "thesis.tex") == "precious");
 }
 

@@ -150,9 +150,9 @@ TEST_CASE("A run killed in a folder of an earlier finished run does not look fin
                        dir.string())
                           .c_str()) == 0);
   REQUIRE(fs::exists(dir / "summary.json"));
-  const pid_t pid =
-      Start({"run", "scenarios/simple_road.yaml", "--no-figures", "-q", "--out", dir.string()},
-            dir.parent_path() / "reuse.log");
+  const pid_t pid = Start(
+      {"run", "scenarios/simple_road.yaml", "--no-figures", "-q", "--force", "--out", dir.string()},
+      dir.parent_path() / "reuse.log");
   // The earlier run's completion record goes before the new run writes anything.
   const auto end = std::chrono::steady_clock::now() + 60s;
   while (fs::exists(dir / "summary.json") && std::chrono::steady_clock::now() < end)

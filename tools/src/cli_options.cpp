@@ -12,6 +12,7 @@ scenario::ScenarioConfig LoadConfig(const RunOptions& o) {
 outputs::RunFolderOptions FilterRunOptions::FolderOptions() const {
   outputs::RunFolderOptions f = folder;
   f.out = run.out;
+  f.force = run.force;
   f.network_dir = run.network_dir;
   f.quiet = run.quiet;
   return f;
@@ -36,11 +37,18 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
       "Folder of the built networks named in scenarios (`network: highway`)")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress or summary output");
+  AddForceFlag(cmd, &o->force);
   cmd->add_option("--set", o->sets,
                   "Override a scenario key, KEY=VALUE (repeatable): e.g. --set filter.preset=paper "
                   "--set filter.num_particles=3000; a number in KEY indexes a list "
                   "(traffic.vehicles.0.speed=20). Validated like the file")
       ->check(OverrideSpec());
+}
+
+void AddForceFlag(CLI::App* cmd, bool* force) {
+  cmd->add_flag("--force", *force,
+                "--out may hold an earlier dualgrid output: remove its own files (never others) "
+                "and write anew (without it, a folder that is not empty is refused)");
 }
 
 void AddCaptionOption(CLI::App* cmd, bool* captions) {

@@ -55,6 +55,8 @@ void AddRunOptions(CLI::App* cmd, RunOptions* o, const std::string& out_help, bo
 void AddFilterOptions(CLI::App* cmd, FilterRunOptions* o, bool* no_figures);
 /// `--figure-captions on|off` into `*captions`.
 void AddCaptionOption(CLI::App* cmd, bool* captions);
+/// `--force` into `*force`: replace an earlier dualgrid output in --out (output_guard.hpp).
+void AddForceFlag(CLI::App* cmd, bool* force);
 /// none, csv or csv.gz.
 CLI::Validator DetectionFormat();
 

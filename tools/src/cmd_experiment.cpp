@@ -309,7 +309,10 @@ scenario::ScenarioConfig CheckExperiment(const ExperimentOptions& o) {
 int RunExperiment(const ExperimentOptions& o) {
   const scenario::ScenarioConfig config = CheckExperiment(o);
   const auto& out = o.run.run.out;
-  PrepareOutputFolder(out);
+  outputs::InputSet inputs;
+  inputs.AddScenario(config, o.run.run.network_dir);
+  outputs::CheckOutputApart(out, inputs);
+  PrepareOutputFolder(out, {.force = o.run.run.force});
   std::filesystem::create_directories(out / "figures");
   const CoreSplit split = SplitCores(o.jobs, o.run.threads, o.seeds);
   if (!o.run.run.quiet)
@@ -344,6 +347,7 @@ int RunExperiment(const ExperimentOptions& o) {
                             {"warnings", warnings}};
   for (const auto& [seed, why] : s.failed)
     summary["seeds_failed"].push_back({{"seed", seed}, {"error", why}});
+  SealOutputFolder(out);
   WriteTextFile(out / "summary.json", summary.dump(2) + "\n");
   if (!o.run.run.quiet)
     std::cout << s.finished.size() << " of " << o.seeds << " seeds (" << FormatFixed(a.wall, 0)

@@ -23,16 +23,28 @@ struct ExportOptions {
   std::string format = "radarscenes";
   std::string sequence = "sequence_1";
   recorded::NuScenesWriteOptions nuscenes;
+  bool force = false;             ///< --force: replace an earlier dualgrid output in `out`
+  bool allow_incomplete = false;  ///< --allow-incomplete: export a run that did not finish
   bool quiet = false;
 };
 
 int RunExport(const ExportOptions& o) {
+  SafeName(o.sequence, "--sequence");
+  SafeName(o.nuscenes.scene, "--scene");
+  SafeName(o.nuscenes.version, "--version");
+  outputs::InputSet inputs;
+  inputs.Add(o.run_dir, "run folder");
+  outputs::CheckOutputApart(o.out, inputs);
   recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
+  // After the data: a damaged file is named first.
+  const std::string incomplete = outputs::CheckRunFinished(o.run_dir, o.allow_incomplete);
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
   if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))
     scenario = o.run_dir / "scenario.yaml";
-  PrepareOutputFolder(o.out);
+  PrepareOutputFolder(o.out, {.force = o.force});
+  if (!incomplete.empty())  // first: a reader sees it even if the export stops midway
+    outputs::MarkIncomplete(o.out, o.run_dir, incomplete);
   std::filesystem::path written;
   if (o.format == "nuscenes") {
     const auto keys = recorded::ReadKeyFrames(o.run_dir, seq, 0.5);
@@ -55,6 +67,11 @@ int RunExport(const ExportOptions& o) {
     }
     written = o.out / "data" / seq.name;
   }
+  SealOutputFolder(o.out);
+  if (!incomplete.empty())
+    std::cerr << "dualgrid: warning: exported an incomplete run (" << incomplete
+              << "); the dataset is marked by " << (o.out / outputs::kIncompleteMark).string()
+              << "\n";
   if (!o.quiet)
     std::cout << "exported " << seq.scans.size() << " scans, " << seq.points.size()
               << " detections, " << seq.track_names.size() << " tracks of " << o.run_dir.string()
@@ -86,6 +103,10 @@ Command AddExportCommand(CLI::App& app, const CliContext&) {
                 "nuScenes: positions and velocities as float64 in the PCD files (the published "
                 "files have float32, which round the run's values)");
   cmd->add_flag("--quiet,-q", o->quiet, "No summary output");
+  AddForceFlag(cmd, &o->force);
+  cmd->add_flag("--allow-incomplete", o->allow_incomplete,
+                "Export a run that did not finish (no summary.json, or complete: false); the "
+                "dataset is marked by INCOMPLETE.txt at its root");
   return {cmd, [o] { return RunExport(*o); }};
 }
 

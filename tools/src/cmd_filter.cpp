@@ -6,6 +6,7 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
+#include "dualgrid/outputs/output_guard.hpp"
 #include "dualgrid/outputs/run.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
 
@@ -94,6 +95,28 @@ void NuScenesInput(const recorded::NuScenesScene& n, const recorded::RecordedSeq
                        std::to_string(n.empty_clouds) + " empty cloud(s).");
 }
 
+// What `dualgrid filter` reads besides the scenario: the data, the sensors file (given, or a
+// RadarScenes root's), the scenario that travelled with an export.
+outputs::InputSet RecordedInputs(const FilterInputOptions& o, const recorded::RecordedInput& in) {
+  outputs::InputSet inputs;
+  inputs.Add(o.input, "recorded data");
+  if (o.sensors) inputs.Add(*o.sensors, "sensors file");
+  if (in.radarscenes && !o.sensors)
+    inputs.Add(o.input.parent_path().parent_path() / "sensors.json", "sensors file");
+  if (in.scenario) inputs.Add(*in.scenario, "scenario");
+  return inputs;
+}
+
+// The file `dualgrid export --allow-incomplete` leaves at a dataset's root, if the input has one.
+std::optional<std::filesystem::path> IncompleteMark(const FilterInputOptions& o, bool radarscenes) {
+  const std::filesystem::path root =
+      radarscenes ? o.input.lexically_normal().parent_path().parent_path() : o.input;
+  const auto mark = root / outputs::kIncompleteMark;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(mark, ec)) return mark;
+  return std::nullopt;
+}
+
 }  // namespace
 
 int RunFilterCommand(FilterInputOptions o) {
@@ -146,6 +169,14 @@ int RunFilterCommand(FilterInputOptions o) {
     r.input["reference_velocity"] =
         "estimated from each track's labelled points (docs/recorded-data.md, \"Track velocity\")";
   if (in.nuscenes) NuScenesInput(*in.nuscenes, in.sequence, &r);
+  if (const auto mark = IncompleteMark(o, in.radarscenes)) {
+    r.input["source_incomplete"] = true;
+    r.notes.push_back("The data were exported from a run that did not finish (" + mark->string() +
+                      ").");
+    std::cerr << "dualgrid: warning: " << o.input.string()
+              << " was exported from a run that did not finish (" << mark->string() << ")\n";
+  }
+  o.run.folder.inputs = RecordedInputs(o, in);
   return WriteRunFolderAndReport(cosim, config, o.run.FolderOptions(), &r);
 }
 
@@ -195,6 +226,7 @@ Command AddFilterCommand(CLI::App& app, const CliContext& ctx) {
       "scan alone)")
       ->check(Number(0.0, 1.0, false));
   cmd->add_flag("--quiet,-q", o->run.run.quiet, "No progress or summary output");
+  AddForceFlag(cmd, &o->run.run.force);
   AddFilterOptions(cmd, &o->run, no_figures.get());
   cmd->add_flag("--no-record", *no_record, "Do not record the replay frames (RUN_DIR/replay/)");
   cmd->add_flag("--viewer", o->run.folder.viewer,

@@ -81,6 +81,7 @@ void PrepareCases(const RegressOptions& o, scenario::RegressionSuite* suite) {
       TangentialOptions gen;
       gen.kind = "aspect";
       gen.quiet = true;
+      gen.force = true;  // inside this command's own output folder
       std::vector<std::string> rest;
       try {
         for (const std::string& s : c.sets) {
@@ -343,7 +344,14 @@ int RunRegress(const RegressOptions& o) {
         "the overrides into the cases' `set` lists instead");
   scenario::RegressionSuite suite = scenario::LoadSuite(o.suite);
   const scenario::RegressionSuite as_written = suite;  // what --record writes back
-  PrepareOutputFolder(o.out);
+  outputs::InputSet inputs;
+  inputs.Add(o.suite, "suite");
+  for (const scenario::RegressionCase& c : suite.cases) {
+    SafeName(c.name, o.suite.string() + ": case name");  // its folder: --out/NAME
+    if (!c.IsGenerator()) inputs.Add(c.scenario, "scenario of case '" + c.name + "'");
+  }
+  outputs::CheckOutputApart(o.out, inputs);
+  PrepareOutputFolder(o.out, {.force = o.force});
   PrepareCases(o, &suite);
   eval::Measured measured;
   std::vector<CaseResult> results = RunCases(o, suite, &measured);
@@ -354,6 +362,7 @@ int RunRegress(const RegressOptions& o) {
   WriteTextFile(o.out / "report.md", md);
   WriteTextFile(o.out / "report.json", ReportJson(o, suite, r).dump(2) + "\n");
   WriteTextFile(o.out / "junit.xml", ReportJunit(suite, r));
+  SealOutputFolder(o.out);
 
   if (!o.record.empty() && !r.stopped) {
     if (r.failed_runs > 0) {
@@ -381,7 +390,10 @@ Command AddRegressCommand(CLI::App& app, const CliContext& ctx) {
   cmd->add_option("suite", o->suite, "Suite file (e.g. tests/regression/suite.yaml)")
       ->required()
       ->check(CLI::ExistingFile);
-  Opt(cmd, "--out,-o", &o->out, "Folder for the case runs and the reports")->check(NonEmptyPath());
+  auto* out = Opt(cmd, "--out,-o", &o->out,
+                  "Folder for the case runs and the reports (the default folder is replaced as "
+                  "with --force; a folder you name needs --force to be replaced)")
+                  ->check(NonEmptyPath());
   cmd->add_option("--record", o->record,
                   "Also write the suite with bands recorded from this run (mean ± max(3 CI, "
                   "floor)) and the digests to this file")
@@ -396,7 +408,11 @@ Command AddRegressCommand(CLI::App& app, const CliContext& ctx) {
   Opt(cmd, "--network-dir", &o->network_dir, "Folder of the built networks")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
-  return {cmd, [o] { return RunRegress(*o); }};
+  AddForceFlag(cmd, &o->force);
+  return {cmd, [o, out] {
+            if (out->count() == 0) o->force = true;  // the default folder is dualgrid's own
+            return RunRegress(*o);
+          }};
 }
 
 }  // namespace dualgrid::tools

@@ -16,6 +16,7 @@
 #include "dualgrid/outputs/run_config.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/scenario/loader.hpp"
+#include "dualgrid/sim/sumo_simulation.hpp"
 #include "progress.hpp"
 #include "signals.hpp"
 
@@ -107,8 +108,12 @@ int RunSim(const SimOptions& sim_options) {
   scenario::ScenarioConfig config = LoadConfig(options);
   DetectionPath(options.out, sim_options.detections);  // a bad --detections: before SUMO
   const sim::ScenarioSpec& spec = config.sim;
-  cosim::CoSimulation cosim(config, {.modes = {}});  // SUMO and the radar, no filter
-  PrepareOutputFolder(options.out);
+  cosim::CoSimulation cosim(config, {.modes = {}});        // SUMO and the radar, no filter
+  sim::ResolveNetwork(spec.network, options.network_dir);  // before the folder is made
+  outputs::InputSet inputs;
+  inputs.AddScenario(config, options.network_dir);
+  outputs::CheckOutputApart(options.out, inputs);
+  PrepareOutputFolder(options.out, {.force = options.force});
   CopyScenario(config, options.out);
 
   const auto wall_start = std::chrono::steady_clock::now();
@@ -135,6 +140,7 @@ int RunSim(const SimOptions& sim_options) {
   std::string status;
   nlohmann::json summary = SimSummary(cosim, config, tally, wall, &status);
   summary["digests"] = OutputDigests(options.out);
+  SealOutputFolder(options.out);
   // Written last: a folder without summary.json did not finish.
   WriteTextFile(options.out / "summary.json", summary.dump(2) + "\n");
   const int steps = tally.steps;

@@ -233,22 +233,28 @@ SweepPlan OpenSweep(const SweepOptions& o, const std::vector<SweepAxis>& axes,
   plan.first_seed = o.first_seed;
   plan.modes = o.modes;
   plan.duration = o.duration;
+  if (o.scenario != kGenerator) {
+    outputs::InputSet inputs;
+    inputs.Add(o.scenario, "scenario");
+    outputs::CheckOutputApart(out, inputs);
+  }
   const fs::path plan_file = out / "plan.json";
-  if (!fs::exists(plan_file)) {
-    PrepareOutputFolder(out);
+  if (!fs::exists(plan_file) || o.force) {
+    PrepareOutputFolder(out, {.force = o.force});
     return plan;
   }
   SweepPlan old;
   try {
     old = ReadSweepPlan(plan_file);
   } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(std::string(e.what()) +
-                                " (an earlier sweep's plan; use a new --out or remove it)");
+    throw std::invalid_argument(
+        std::string(e.what()) +
+        " (an earlier sweep's plan; use a new --out, or --force to replace it)");
   }
   if (SweepPlanIdentity(old) != SweepPlanIdentity(plan))
     throw std::invalid_argument(out.string() +
                                 " holds a sweep of another plan (plan.json differs); use a new "
-                                "--out or remove it");
+                                "--out, or --force to replace it");
   return plan;
 }
 
@@ -264,6 +270,7 @@ std::vector<std::string> SweepRunArgs(const SweepOptions& o, const fs::path& sce
                                    scenario.string(),
                                    "--out",
                                    folder.string(),
+                                   "--force",  // the sweep's own folder: a resumed run replaces it
                                    "--seed",
                                    std::to_string(seed),
                                    "-q",
@@ -295,6 +302,7 @@ void AddSetting(const SweepOptions& o, const std::vector<SweepAxis>& axes,
   TangentialOptions gen;
   gen.kind = "aspect";
   gen.quiet = true;
+  gen.force = true;  // inside the sweep's own folder (a resumed sweep writes it again)
   for (std::size_t k = 0; k < axes.size(); ++k) {
     if (axes[k].key.rfind("tangential.", 0) == 0)
       SetGeneratorOption(&gen, axes[k].key.substr(11), values[k]);
@@ -685,6 +693,9 @@ Command AddSweepCommand(CLI::App& app, const CliContext& ctx) {
   Opt(cmd, "--network-dir", &o->network_dir, "Folder of the built networks")
       ->check(CLI::ExistingDirectory);
   cmd->add_flag("--quiet,-q", o->quiet, "No progress output");
+  cmd->add_flag("--force", o->force,
+                "Replace an earlier dualgrid output in --out (its own files only) instead of "
+                "resuming it");
   AddCaptionOption(cmd, &o->figure_captions);
   return {cmd, [o] { return RunSweep(*o); }};
 }

@@ -18,6 +18,22 @@
 namespace dualgrid::tools {
 namespace {
 
+// The files the generator writes: the scenario, and for --kind aspect its network beside it.
+// One that exists already is refused without --force (it may be the user's own scenario).
+void CheckGeneratorFiles(const TangentialOptions& o) {
+  if (o.force) return;
+  std::vector<std::filesystem::path> files = {o.out};
+  const std::filesystem::path base = o.out.parent_path() / o.out.stem();
+  if (o.kind == "aspect")
+    for (const char* ext : {".net.xml", ".nod.xml", ".edg.xml"})
+      files.push_back(base.string() + ext);
+  std::error_code ec;
+  for (const auto& f : files)
+    if (std::filesystem::exists(std::filesystem::symlink_status(f, ec)))
+      throw std::invalid_argument("--out: " + f.string() +
+                                  " exists; add --force to replace it, or choose another name");
+}
+
 void WriteAspect(const TangentialOptions& o) {
   scenario::AspectCase c;
   c.sensor = o.sensor;
@@ -31,6 +47,7 @@ void WriteAspect(const TangentialOptions& o) {
   c.grid_width = o.grid_width.value_or(25.0);
   c.auto_grid_width = !o.grid_width;
   c.seed = o.seed;
+  CheckGeneratorFiles(o);
   if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
   const std::string what = WriteAspectCase(c, o.out);
   scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
@@ -70,6 +87,7 @@ void WriteGuardRail(const TangentialOptions& o) {
   c.spacing = t.Spacing();
   c.seed = o.seed;
   const std::string text = scenario::GuardRailScenario(c);
+  CheckGeneratorFiles(o);
   if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
   WriteTextFile(o.out, text);
   scenario::LoadScenario(o.out);  // must load like any scenario; a failure is a generator bug
@@ -92,6 +110,7 @@ int RunTangential(const TangentialOptions& o) {
     return 0;
   }
   const std::string text = scenario::TangentialScenario(Case(o));
+  CheckGeneratorFiles(o);
   if (o.out.has_parent_path()) std::filesystem::create_directories(o.out.parent_path());
   WriteTextFile(o.out, text);
   // The generated file must load like any scenario; a failure here is a generator bug.
@@ -160,6 +179,8 @@ Command AddTangentialCommand(CLI::App& app, const CliContext&) {
       ->required()
       ->check(NonEmptyPath());
   cmd->add_flag("--quiet,-q", o->quiet, "No summary");
+  cmd->add_flag("--force", o->force,
+                "Replace the scenario file (and an aspect case's network files) if they exist");
   return {cmd, [o, cmd] {
             // The aspect options imply --kind aspect; with another kind they would be ignored.
             bool aspect_options = false;

@@ -28,6 +28,7 @@ struct RunOptions {
   std::optional<double> begin;  ///< [s, SUMO time] --begin: where SUMO starts
   std::filesystem::path network_dir;
   bool quiet = false;
+  bool force = false;  ///< --force: replace an earlier dualgrid output in `out`
   /// `--set KEY=VALUE` overrides of scenario keys, in order (scenario::Override).
   std::vector<std::string> sets;
 };
@@ -92,6 +93,7 @@ struct TangentialOptions {
   std::optional<double> spacing;
   std::uint64_t seed = 1;
   std::filesystem::path out;
+  bool force = false;  ///< replace existing files at `out` (and its network files beside it)
   bool quiet = false;
   // kind aspect:
   std::string sensor = "front";
@@ -110,6 +112,7 @@ struct TangentialOptions {
 struct RegressOptions {
   std::filesystem::path suite;
   std::filesystem::path out = "run/regress";
+  bool force = false;  ///< --force (implied when --out is not given: the default is ours)
   std::filesystem::path network_dir;
   std::vector<std::string> sets;  ///< --set overrides applied to every case
   std::filesystem::path record;   ///< --record: write the suite with measured bands here
@@ -123,6 +126,7 @@ struct RegressOptions {
 struct SweepOptions {
   std::string scenario;  ///< a scenario file, or "tangential" (the generator)
   std::filesystem::path out;
+  bool force = false;             ///< --force: replace an earlier dualgrid output in `out`
   std::vector<std::string> sets;  ///< KEY=LIST axes (sweep_spec.hpp)
   int seeds = 3;
   std::uint64_t first_seed = 1;

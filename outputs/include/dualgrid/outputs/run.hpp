@@ -19,13 +19,21 @@
 #include "dualgrid/cosim/cosimulation.hpp"
 #include "dualgrid/eval/aggregate.hpp"
 #include "dualgrid/outputs/callbacks.hpp"
+#include "dualgrid/outputs/output_guard.hpp"
 
 namespace dualgrid::outputs {
 
 /// What goes into a run folder besides the files every run writes. Errors name the command-line
 /// option of a field.
 struct RunFolderOptions {
-  std::filesystem::path out;          ///< the run folder (made empty: PrepareOutputFolder)
+  std::filesystem::path out;  ///< the run folder (made ready: PrepareOutputFolder)
+  /// Replace an earlier dualgrid output in `out` (its own entries only; output_guard.hpp).
+  bool force = false;
+  /// How errors name `out` and `force` (the Python module: "run_scenario: out", "force=True").
+  std::string out_option = "--out", force_flag = "--force";
+  /// What the run reads besides the scenario's files (WriteRunFolder adds those): `out` must lie
+  /// apart from all of them (CheckOutputApart), e.g. the recorded data of `dualgrid filter`.
+  InputSet inputs;
   std::filesystem::path network_dir;  ///< the built networks, for SUMO (CoSimulation::Start)
   std::vector<double> snapshots;      ///< grid picture times [s]; empty: from the scenario
   bool figures = true;

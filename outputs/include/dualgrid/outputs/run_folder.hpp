@@ -8,19 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "dualgrid/cosim/cosimulation.hpp"
+#include "dualgrid/outputs/output_guard.hpp"
 
 namespace dualgrid::outputs {
-
-/// Marks a folder as dualgrid's own, written first into every output folder.
-inline constexpr const char* kRunMarker = ".dualgrid-run";
-
-/// Makes `out` an empty folder for a new run, so that no folder ever mixes two runs' files:
-/// creates it if missing; keeps it if empty; empties it if it holds an earlier dualgrid output
-/// (it has the marker kRunMarker, a summary.json or a config.json); otherwise throws
-/// std::invalid_argument (a folder of other files is never cleared). The earlier completion
-/// record goes first, so a run killed while clearing never looks finished. Then writes the
-/// marker.
-void PrepareOutputFolder(const std::filesystem::path& out);
 
 /// Test hook (docs/reliability.md): true when the environment variable DUALGRID_FAULT lists
 /// `what` (comma-separated), e.g. DUALGRID_FAULT=figure:tracked_share.png,run-seed:2. Lets the
