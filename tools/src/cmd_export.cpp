@@ -6,6 +6,7 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
@@ -30,8 +31,10 @@ int RunExport(const ExportOptions& o) {
   recorded::RecordedSequence seq = recorded::ReadRunFolder(o.run_dir);
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
-  if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))
-    scenario = o.run_dir / "scenario.yaml";
+  if (const auto copy = o.run_dir / "scenario.yaml"; InputExists(copy)) {
+    CheckInputFile(copy, "run's scenario copy");  // a FIFO or a loop: refused by name
+    scenario = copy;
+  }
   PrepareOutputFolder(o.out);
   std::filesystem::path written;
   if (o.format == "nuscenes") {

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_options.hpp"
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 #include "exit_codes.hpp"
@@ -125,6 +126,9 @@ int main(int argc, char** argv) {
   try {
     for (const Command& c : commands)
       if (c.app->parsed()) return c.run();
+  } catch (const dualgrid::InputStopped& e) {
+    std::cerr << "dualgrid: " << OneLine(e.what()) << "\n";
+    return StopExitCode();
   } catch (const dualgrid::scenario::ConfigError& e) {
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
     return kExitBadInput;
