@@ -1,8 +1,9 @@
 #include "dualgrid/core/json_input.hpp"
 
-#include <algorithm>
+#include <istream>
 #include <set>
 #include <stdexcept>
+#include <streambuf>
 #include <vector>
 
 namespace dualgrid {
@@ -10,28 +11,24 @@ namespace {
 
 using Json = nlohmann::json;
 
-// The deepest nesting of `text` (strings skipped), found before parsing.
-std::size_t MaxDepth(const std::string& text) {
-  std::size_t depth = 0, max_depth = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      max_depth = std::max(max_depth, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
+// An std::streambuf over an InputStream: JSON is parsed as it is read, so that a file that is
+// not JSON (zeros, a binary) is refused at its first bytes, not after reading up to the cap.
+class InputBuffer : public std::streambuf {
+ public:
+  explicit InputBuffer(InputStream& in) : in_(in) {}
+
+ protected:
+  int_type underflow() override {
+    const std::size_t n = in_.Read(buffer_, sizeof buffer_);
+    if (n == 0) return traits_type::eof();
+    setg(buffer_, buffer_, buffer_ + n);
+    return traits_type::to_int_type(buffer_[0]);
   }
-  return max_depth;
-}
+
+ private:
+  InputStream& in_;
+  char buffer_[1 << 16];
+};
 
 // Refuses a key given twice in one object, naming its path ("scenes.123"; "[]" for a list).
 class DuplicateKeys {
@@ -40,10 +37,12 @@ class DuplicateKeys {
   bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed) {
     switch (event) {
       case Json::parse_event_t::object_start:
-        levels_.push_back({{}, Key(), ""});
-        break;
       case Json::parse_event_t::array_start:
-        levels_.push_back({{}, Key() + "[]", ""});
+        if (levels_.size() >= static_cast<std::size_t>(kMaxJsonDepth))
+          throw std::invalid_argument(file_ + ": lists or objects nested more than " +
+                                      std::to_string(kMaxJsonDepth) + " deep");
+        levels_.push_back(
+            {{}, Key() + (event == Json::parse_event_t::array_start ? "[]" : ""), ""});
         break;
       case Json::parse_event_t::object_end:
       case Json::parse_event_t::array_end:
@@ -85,27 +84,34 @@ class DuplicateKeys {
   std::vector<Level> levels_;
 };
 
-}  // namespace
-
-Json ParseJsonInput(const std::string& text, const std::string& file) {
-  const std::size_t depth = MaxDepth(text);
-  if (depth > static_cast<std::size_t>(kMaxJsonDepth))
-    throw std::invalid_argument(file + ": lists or objects nested " + std::to_string(depth) +
-                                " deep, expected at most " + std::to_string(kMaxJsonDepth));
+// Parses what `parse(callback)` reads, naming `file` in every error; `size` for the message.
+template <class Parse>
+Json Parsed(const std::string& file, const std::string& size, Parse&& parse) {
   try {
-    return Json::parse(text, DuplicateKeys(file));
+    return parse(DuplicateKeys(file));
   } catch (const Json::parse_error& e) {
     throw std::invalid_argument(file + ": not valid JSON (at byte " + std::to_string(e.byte) +
-                                " of " + std::to_string(text.size()) + "; truncated or damaged?)");
+                                size + "; truncated or damaged?)");
   } catch (const Json::exception&) {
     throw std::invalid_argument(file + ": not valid JSON (truncated or damaged?)");
   }
 }
 
+}  // namespace
+
+Json ParseJsonInput(const std::string& text, const std::string& file) {
+  return Parsed(file, " of " + std::to_string(text.size()),
+                [&](DuplicateKeys keys) { return Json::parse(text, std::move(keys)); });
+}
+
 Json ReadJsonInput(const std::filesystem::path& path, const std::string& what,
                    std::uint64_t max_bytes) {
   return NamingInputOnFailure(path, what, [&] {
-    return ParseJsonInput(ReadInputText(path, what, max_bytes), path.string());
+    InputStream in(path, what, max_bytes);
+    InputBuffer buffer(in);
+    std::istream stream(&buffer);
+    return Parsed(path.string(), "",
+                  [&](DuplicateKeys keys) { return Json::parse(stream, std::move(keys)); });
   });
 }
 

@@ -155,13 +155,7 @@ JsonFile ParseJsonText(const std::string& text, const std::string& file) {
 
 JsonFile ReadJsonFile(const std::filesystem::path& path, const std::string& what,
                       std::uint64_t max_bytes) {
-  std::string text;
-  try {
-    text = ReadInputText(path, what, max_bytes);
-  } catch (const std::bad_alloc&) {
-    throw std::invalid_argument(path.string() + ": " + what + " too large to read (out of memory)");
-  }
-  return ParseJsonText(text, path.string());
+  return JsonFile(ReadJsonInput(path, what, max_bytes), path.string());
 }
 
 }  // namespace dualgrid::outputs

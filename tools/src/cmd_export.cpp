@@ -7,6 +7,7 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/core/input_file.hpp"
+#include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
@@ -32,7 +33,8 @@ int RunExport(const ExportOptions& o) {
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
   if (const auto copy = o.run_dir / "scenario.yaml"; InputExists(copy)) {
-    CheckInputFile(copy, "run's scenario copy");  // a FIFO or a loop: refused by name
+    // It travels with the export and is loaded by `filter`: refused now if it would be then.
+    scenario::LoadScenario(copy);
     scenario = copy;
   }
   PrepareOutputFolder(o.out);

@@ -1,6 +1,7 @@
 // dualgrid: SUMO traffic -> radar detections -> dynamic occupancy grid, scored against truth.
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 
 #include <filesystem>
@@ -141,6 +142,13 @@ int main(int argc, char** argv) {
     return kExitRunFailed;
   } catch (const std::filesystem::filesystem_error& e) {
     std::cerr << "dualgrid: error: " << OneLine(FilesystemMessage(e)) << "\n";
+    // A path that cannot name a file (a symbolic link loop, a too long name, a file where a
+    // folder should be) is bad input wherever it is met; anything else (a full disk) is not.
+    const int code = e.code().value();
+    const bool bad_path = e.code().category() == std::generic_category() ||
+                          e.code().category() == std::system_category();
+    if (bad_path && (code == ELOOP || code == ENAMETOOLONG || code == ENOTDIR))
+      return kExitBadInput;
     return kExitRunFailed;
   } catch (const nlohmann::json::exception& e) {
     // Every file read back goes through the checked reader: this is a bug, not bad input.

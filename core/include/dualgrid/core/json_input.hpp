@@ -14,16 +14,17 @@
 
 namespace dualgrid {
 
-/// Deepest nesting of lists and objects accepted (a million '[' would exhaust the stack).
+/// Deepest nesting of lists and objects accepted (a million [ would exhaust the stack).
 inline constexpr int kMaxJsonDepth = 64;
 
 /// Parses `text`, the content of `file` (named in errors). Throws std::invalid_argument
 /// "<file>: not valid JSON (at byte N of M; truncated or damaged?)", "<file>: key 'a.b' given
-/// twice" or "<file>: lists or objects nested N deep, expected at most 64".
+/// twice" or "<file>: lists or objects nested more than 64 deep".
 nlohmann::json ParseJsonInput(const std::string& text, const std::string& file);
 
-/// ReadInputText (regular files only, at most `max_bytes`, `what` naming its role) then
-/// ParseJsonInput; std::bad_alloc is reported naming the file.
+/// The same for the file `path`, parsed as it is read through InputStream (regular files only,
+/// at most `max_bytes`, `what` naming its role): a file that is not JSON is refused at its first
+/// bytes. std::bad_alloc is reported naming the file.
 nlohmann::json ReadJsonInput(const std::filesystem::path& path, const std::string& what,
                              std::uint64_t max_bytes = kMaxTextInputBytes);
 
