@@ -142,12 +142,11 @@ int main(int argc, char** argv) {
     return kExitRunFailed;
   } catch (const std::filesystem::filesystem_error& e) {
     std::cerr << "dualgrid: error: " << OneLine(FilesystemMessage(e)) << "\n";
-    // A path that cannot name a file (a symbolic link loop, a too long name, a file where a
-    // folder should be) is bad input wherever it is met; anything else (a full disk) is not.
-    const int code = e.code().value();
-    const bool bad_path = e.code().category() == std::generic_category() ||
-                          e.code().category() == std::system_category();
-    if (bad_path && (code == ELOOP || code == ENAMETOOLONG || code == ENOTDIR))
+    // A path that cannot name a file at all (a symbolic link loop, a name too long) is bad input
+    // wherever it is met; anything else (a full disk, an --out under a file) is not.
+    const bool system = e.code().category() == std::generic_category() ||
+                        e.code().category() == std::system_category();
+    if (system && (e.code().value() == ELOOP || e.code().value() == ENAMETOOLONG))
       return kExitBadInput;
     return kExitRunFailed;
   } catch (const nlohmann::json::exception& e) {
