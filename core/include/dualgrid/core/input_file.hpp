@@ -37,9 +37,10 @@ class InputStopped : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The flag a signal handler sets (nonzero: stop). Readers check it every chunk (64 KiB) and
-/// throw InputStopped, so that no read of a long or endless input outlives a SIGTERM. `flag` must
-/// outlive every read; nullptr (the default) disables the check.
+/// The flag a signal handler sets (nonzero: stop). Past the first 16 MiB of an input, readers
+/// check it every chunk (64 KiB) and throw InputStopped, so that no long or endless read outlives
+/// a SIGTERM, while the short reads a stopped command still does (an experiment's finished seeds)
+/// complete. `flag` must outlive every read; nullptr (the default) disables the check.
 void SetInputStopFlag(const volatile std::sig_atomic_t* flag);
 
 /// Throws std::invalid_argument "<path>: <what> <why>".
