@@ -131,10 +131,31 @@ def make_fixtures(work, dualgrid, networks, fixture_python):
     for net in glob.glob(os.path.join(networks, "*.net.xml")):
         shutil.copy(net, os.path.join(scen, "networks"))
     shutil.copytree(os.path.join(fx, "rs"), os.path.join(scen, "rs"))
+    make_sumo_fixture(os.path.join(fx, "sumo"), networks)
     subprocess.run([dualgrid, "sweep", highway, "--set", "filter.sigma_v=1,2", "--seeds", "1",
                     "--duration", "0.1", "--emit", "list", "-q", "--network-dir", networks,
                     "--out", os.path.join(fx, "sweep")], check=True, capture_output=True)
     return fx
+
+
+def make_sumo_fixture(sumo, networks):
+    """A user's own SUMO files: a network, a route file, an additional file and a .sumocfg, with
+    a scenario on each way of giving them (traffic.route_files, sumo_config)."""
+    os.makedirs(sumo)
+    shutil.copy(os.path.join(networks, "highway.net.xml"), sumo)
+    files = {
+        "ok.rou.xml": '<routes>\n<vehicle id="v0" depart="0" departLane="1" departPos="300">\n'
+                      '  <route edges="east_1 east_2"/>\n</vehicle>\n</routes>\n',
+        "ok.add.xml": "<additional>\n</additional>\n",
+        "ok.sumocfg": '<configuration>\n  <input>\n    <net-file value="highway.net.xml"/>\n'
+                      '    <route-files value="ok.rou.xml"/>\n  </input>\n</configuration>\n',
+        "routes.yaml": "name: routes\nnetwork: highway.net.xml\nego: {from_routes: v0}\n"
+                       "traffic: {route_files: [ok.rou.xml], additional_files: [ok.add.xml]}\n",
+        "config.yaml": "name: config\nsumo_config: ok.sumocfg\nego: {from_routes: v0}\n",
+    }
+    for name, text in files.items():
+        with open(os.path.join(sumo, name), "w") as f:
+            f.write(text)
 
 
 def make_hostile(path, kind, good):
