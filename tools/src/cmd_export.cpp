@@ -7,13 +7,13 @@
 #include "cli_options.hpp"
 #include "commands.hpp"
 #include "dualgrid/core/input_file.hpp"
-#include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
+#include "dualgrid/scenario/loader.hpp"
 
 namespace dualgrid::tools {
 
