@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Fuzzes the scenario loader, the regression-suite reader, the replay reader and the sweep readers
-# (plan.json, table.json, summary.json) with libFuzzer, each for a bounded time (default 600 s):
+# Fuzzes the scenario loader, the regression-suite reader, the replay reader, the sweep readers
+# (plan.json, table.json, summary.json) and the readers of recorded data (RadarScenes JSON, run
+# folders, nuScenes tables and PCD) with libFuzzer, each for a bounded time (default 600 s):
 #   scripts/fuzz.sh [SECONDS] [TARGET...]   (targets: scenario_loader suite_reader replay_reader
-#                                            sweep_reader; default all)
+#                                            sweep_reader radarscenes_reader run_folder_reader
+#                                            nuscenes_reader; default all)
 # Installs clang and its libFuzzer runtime if missing (Debian packages), builds build-fuzz/ with
 # clang, coverage instrumentation and ASan + UBSan, and runs the ctest label `fuzz`. A crash
 # leaves its input in build-fuzz/tests/fuzz/TARGET-crash-*; make it a case of tests/hostile/.
@@ -17,7 +19,8 @@ CXX=clang++ CC=clang cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -D
   -DDUALGRID_BUILD_BENCHMARKS=OFF -DDUALGRID_FUZZ_SECONDS="$seconds" >/dev/null
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scenario_loader suite_reader replay_reader sweep_reader)
+[ ${#targets[@]} -gt 0 ] || targets=(scenario_loader suite_reader replay_reader sweep_reader
+                                     radarscenes_reader run_folder_reader nuscenes_reader)
 for t in "${targets[@]}"; do
   cmake --build "$build" -j "$(nproc)" --target "fuzz_$t"
 done

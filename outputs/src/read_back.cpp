@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "dualgrid/core/input_file.hpp"
+#include "dualgrid/core/json_input.hpp"
 #include "dualgrid/core/text.hpp"
 
 namespace dualgrid::outputs {
@@ -149,56 +150,12 @@ JsonFile::JsonFile(json doc, std::string file)
       file_(std::make_shared<const std::string>(std::move(file))) {}
 
 JsonFile ParseJsonText(const std::string& text, const std::string& file) {
-  // No exceptions from the parser: its messages are the library's, not ours. A depth bound keeps
-  // a document of a million '[' from exhausting the stack when it is destroyed.
-  std::size_t depth = 0, max_depth = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped)
-        escaped = false;
-      else if (c == '\\')
-        escaped = true;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      max_depth = std::max(max_depth, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  if (max_depth > 64)
-    throw std::invalid_argument(file + ": not a file dualgrid wrote (lists or objects nested " +
-                                std::to_string(max_depth) + " deep, expected at most 64)");
-  json doc = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (doc.is_discarded()) {
-    // Where it breaks, from a second pass that reports the byte (the text of its exception is
-    // not shown).
-    std::size_t byte = 0;
-    try {
-      const json again = json::parse(text);
-      (void)again;
-    } catch (const json::parse_error& e) {
-      byte = e.byte;
-    } catch (const std::exception&) {
-    }
-    throw std::invalid_argument(file + ": not valid JSON (at byte " + std::to_string(byte) +
-                                " of " + std::to_string(text.size()) + "; truncated or damaged?)");
-  }
-  return JsonFile(std::move(doc), file);
+  return JsonFile(ParseJsonInput(text, file), file);
 }
 
 JsonFile ReadJsonFile(const std::filesystem::path& path, const std::string& what,
                       std::uint64_t max_bytes) {
-  std::string text;
-  try {
-    text = ReadInputText(path, what, max_bytes);
-  } catch (const std::bad_alloc&) {
-    throw std::invalid_argument(path.string() + ": " + what + " too large to read (out of memory)");
-  }
-  return ParseJsonText(text, path.string());
+  return JsonFile(ReadJsonInput(path, what, max_bytes), path.string());
 }
 
 }  // namespace dualgrid::outputs

@@ -1,10 +1,10 @@
 #include "dualgrid/outputs/run_config.hpp"
 
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 
 namespace dualgrid::outputs {
@@ -34,14 +34,15 @@ scenario::ScenarioConfig LoadRunConfig(const std::filesystem::path& scenario,
 }
 
 void CopyScenario(const scenario::ScenarioConfig& config, const std::filesystem::path& out) {
-  std::ifstream in(config.file);
+  // Read again through the checked reader: the file may have changed since it was loaded.
+  const std::string text = ReadInputText(config.file, "scenario file");
   std::ostringstream copy;
   copy << "# Copy of " << config.file.string() << " as used for this run; command-line overrides:\n"
        << "#   seed: " << config.sim.seed << ", duration: " << config.sim.duration
        << " s, begin: " << config.sim.begin << " s (SUMO time; " << config.sim.begin_source
        << ")\n";
   for (const std::string& set : config.overrides) copy << "#   --set " << set << "\n";
-  copy << "# network as resolved: " << config.sim.network << "\n" << in.rdbuf();
+  copy << "# network as resolved: " << config.sim.network << "\n" << text;
   WriteTextFile(out / "scenario.yaml", copy.str());
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -76,15 +77,44 @@ py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
   return Results(cs, config, clusters);
 }
 
+// `text` as valid UTF-8 (Python's exception text must be): each byte of an invalid sequence
+// becomes '?'. A message may quote a file's bytes, and those may be anything.
+std::string ValidUtf8(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const std::size_t n = c < 0x80           ? 1
+                          : (c >> 5) == 0x6  ? 2
+                          : (c >> 4) == 0xe  ? 3
+                          : (c >> 3) == 0x1e ? 4
+                                             : 0;
+    bool ok = n > 0 && i + n <= text.size();
+    for (std::size_t k = 1; ok && k < n; ++k)
+      ok = (static_cast<unsigned char>(text[i + k]) >> 6) == 0x2;
+    if (ok) {
+      out.append(text, i, n);
+      i += n;
+    } else {
+      out += '?';
+      ++i;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void BindCosim(py::module_& m) {
-  // A bad scenario file or key is the caller's input: ValueError, with the loader's one line.
+  // A bad scenario file or key, or a bad input file, is the caller's input: ValueError, with the
+  // loader's or reader's one line (valid UTF-8: it may quote the file's bytes).
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const scenario::ConfigError& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
+      PyErr_SetString(PyExc_ValueError, ValidUtf8(e.what()).c_str());
+    } catch (const std::invalid_argument& e) {
+      PyErr_SetString(PyExc_ValueError, ValidUtf8(e.what()).c_str());
     }
   });
   m.def("run_scenario", &RunScenario, py::arg("path"), py::arg("seed") = py::none(),

@@ -12,15 +12,46 @@ namespace {
 // Resolution-cell indices are packed 20 bits per dimension (radar_model.cpp).
 constexpr double kMaxBins = 1 << 20;
 
+// Farthest a sensor may sit from the ego's box centre [m], along x and along y: on the car.
+constexpr double kMaxMountOffset = 50.0;
+
+// Longest sensor name [bytes]: names are CSV fields, folder-free labels and figure legends.
+constexpr std::size_t kMaxNameBytes = 64;
+
+// A name that every CSV we write holds as one unquoted field: printable (UTF-8 allowed), no
+// comma, no double quote, no control character (newline, tab, NUL, DEL).
+bool IsPlainName(const std::string& name) {
+  if (name.empty() || name.size() > kMaxNameBytes) return false;
+  for (const char ch : name) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f || c == ',' || c == '"') return false;
+  }
+  return true;
+}
+
+// `name` as a message can show it on one line: control characters as '?', at most 80 bytes.
+std::string Shown(const std::string& name) {
+  std::string out = "'";
+  for (const char ch : name.substr(0, 80)) {
+    const auto c = static_cast<unsigned char>(ch);
+    out += c < 0x20 || c == 0x7f ? '?' : ch;
+  }
+  return out + (name.size() > 80 ? "...'" : "'");
+}
+
 }  // namespace
 
 bool SensorParams::IsValid(std::string* error) const {
   using std::isfinite;
   FieldCheck c;
-  c.Expect(!name.empty(), "name", "''", "a non-empty name");
-  c.Expect(mount.position.allFinite() && isfinite(mount.yaw), "mount",
-           FormatTuple({mount.position.x(), mount.position.y(), mount.yaw}),
-           "finite (x, y [m], yaw [rad])");
+  c.Expect(IsPlainName(name), "name", Shown(name),
+           "a name of 1 to 64 bytes without comma, double quote or control characters (it is a "
+           "CSV field)");
+  c.Expect(mount.position.allFinite() && isfinite(mount.yaw) &&
+               mount.position.cwiseAbs().maxCoeff() <= kMaxMountOffset &&
+               std::abs(mount.yaw) <= 2.0 * kPi,
+           "mount", FormatTuple({mount.position.x(), mount.position.y(), mount.yaw}),
+           "x, y within +-50 m of the ego's centre, yaw within +-2 pi rad");
   c.Expect(fov > 0.0 && fov <= 2.0 * kPi, "fov", fov,
            "in (0, 2 pi] rad (the full azimuth field of view)");
   c.NonNegative("min_range", min_range, "m");

@@ -1,5 +1,6 @@
 #include "h5.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -47,7 +48,29 @@ CompoundReader::CompoundReader(hid_t file, const std::string& file_name, const s
     throw std::invalid_argument(where_ + ": expected a one-dimensional array");
   hsize_t dims[1] = {0};
   H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  CheckDeclaredRows(file, dims[0]);
   n_ = static_cast<std::size_t>(dims[0]);
+}
+
+void CompoundReader::CheckDeclaredRows(hid_t file, hsize_t rows) const {
+  // The rows a dataset declares are allocated before they are read: bounded by what the file
+  // can hold, rows x row size <= the file's size, times kMaxCompressionRatio when filters
+  // (deflate) are on; a dataset of fill values never written is refused with them.
+  hsize_t file_size = 0;
+  if (H5Fget_filesize(file, &file_size) < 0) throw std::invalid_argument(where_ + ": unreadable");
+  const Id dcpl(H5Dget_create_plist(dataset_.get()), H5Pclose);
+  const bool filtered = dcpl.valid() && H5Pget_nfilters(dcpl.get()) > 0;
+  const double row_bytes = static_cast<double>(std::max<std::size_t>(1, H5Tget_size(type_.get())));
+  const double cap = static_cast<double>(file_size) * (filtered ? kMaxCompressionRatio : 1.0);
+  if (static_cast<double>(rows) * row_bytes > cap)
+    throw std::invalid_argument(
+        where_ + ": declares " + std::to_string(rows) + " rows of " +
+        std::to_string(static_cast<std::size_t>(row_bytes)) + " bytes, more than the file's " +
+        std::to_string(file_size) + " bytes can hold" +
+        (filtered ? " at a compression ratio of " +
+                        std::to_string(static_cast<int>(kMaxCompressionRatio))
+                  : std::string(" (uncompressed)")) +
+        " (truncated or damaged?)");
 }
 
 void CompoundReader::Fail(const std::string& field, const std::string& what) const {

@@ -40,6 +40,10 @@ class Id {
   herr_t (*close_)(hid_t) = nullptr;
 };
 
+/// The largest ratio of decompressed to stored bytes a filtered (compressed) dataset may claim:
+/// deflate's own maximum is about 1032:1.
+inline constexpr double kMaxCompressionRatio = 1100.0;
+
 /// HDF5 prints its error stack on every failed call unless told not to: we report our own line.
 void Silence();
 
@@ -58,6 +62,8 @@ class CompoundReader {
 
  private:
   int Member(const std::string& field, bool numeric) const;
+  /// Throws when `rows` could not fit in the file (see kMaxCompressionRatio).
+  void CheckDeclaredRows(hid_t file, hsize_t rows) const;
   [[noreturn]] void Fail(const std::string& field, const std::string& what) const;
 
   std::string where_;  // "file: dataset 'name'"

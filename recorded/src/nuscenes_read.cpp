@@ -1,11 +1,11 @@
 // Reading one scene of a nuScenes-layout dataset (docs/recorded-data.md, "nuScenes").
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
 #include <stdexcept>
 
+#include "dualgrid/core/json_input.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/pcd.hpp"
 #include "nuscenes_annotations.hpp"
@@ -37,14 +37,9 @@ struct Extension {
 Extension ReadExtension(const std::filesystem::path& dir) {
   Extension e;
   const std::filesystem::path file = dir / "dualgrid.json";
-  if (!std::filesystem::exists(file)) return e;
-  std::ifstream in(file);
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const Json::parse_error& x) {
-    throw std::invalid_argument(file.string() + ": not valid JSON (" + x.what() + ")");
-  }
+  if (!InputExists(file)) return e;
+  const Json j = ReadJsonInput(file, "nuScenes dualgrid extension");
+  if (!j.is_object()) throw std::invalid_argument(file.string() + ": expected a JSON object");
   auto num = [&](const Json& o, const char* key, const std::string& where) {
     const auto it = o.find(key);
     if (it == o.end() || !it->is_number() || !std::isfinite(it->get<double>()))
@@ -56,8 +51,8 @@ Extension ReadExtension(const std::filesystem::path& dir) {
   e.length = num(ego, "length", "ego.");
   e.width = num(ego, "width", "ego.");
   e.rear_axle_to_centre = num(ego, "rear_axle_to_centre", "ego.");
-  if (!(e.length > 0.0 && e.width > 0.0))
-    throw std::invalid_argument(file.string() + ": key 'ego': length and width must be > 0");
+  if (const std::string error = EgoSizeError(e.length, e.width); !error.empty())
+    throw std::invalid_argument(file.string() + ": key 'ego': " + error);
   for (const Json& s : j.value("sensors", Json::array())) {
     const auto c = s.find("channel");
     if (c == s.end() || !c->is_string() || ChannelIndex(c->get<std::string>()) < 0)
@@ -343,12 +338,14 @@ void NuScenesOptions::Validate() const {
   if (min_annotations < 1) throw std::invalid_argument("min_annotations: must be >= 1");
 }
 
-NuScenesScene ReadNuScenes(const std::filesystem::path& root, const NuScenesOptions& o) {
+// ReadNuScenes without the guard that names the folder for out-of-memory and type errors.
+static NuScenesScene ReadScene(const std::filesystem::path& root, const NuScenesOptions& o) {
   o.Validate();
   const std::filesystem::path dir = root / o.version;
-  if (!std::filesystem::is_directory(dir))
+  if (!InputExists(dir))
     throw std::invalid_argument(dir.string() + ": missing: no version folder '" + o.version +
                                 "' (--version)");
+  CheckInputFolder(dir, "nuScenes version folder");
   Tables tables(dir);
   const Extension ext = ReadExtension(dir);
   NuScenesScene out;
@@ -437,6 +434,10 @@ int LabelOfCategory(const std::string& c) {
   if (c == "vehicle.motorcycle") return 6;
   if (c.rfind("vehicle.", 0) == 0) return 10;
   return -1;
+}
+
+NuScenesScene ReadNuScenes(const std::filesystem::path& root, const NuScenesOptions& o) {
+  return ReadingJsonInput(root, "nuScenes data set", [&] { return ReadScene(root, o); });
 }
 
 }  // namespace dualgrid::recorded

@@ -1,7 +1,8 @@
 #include "nuscenes_tables.hpp"
 
+#include "dualgrid/core/json_input.hpp"
+
 #include <cmath>
-#include <fstream>
 #include <stdexcept>
 
 namespace dualgrid::recorded::nuscenes {
@@ -23,14 +24,11 @@ std::string Where(const Table& table, const Json& record, const std::string& key
 const Table& Tables::Get(const std::string& name) {
   if (const auto it = tables_.find(name); it != tables_.end()) return it->second;
   const std::filesystem::path file = dir_ / (name + ".json");
-  std::ifstream in(file);
-  if (!in) Bad(file, "missing: table '" + name + "' is needed (a nuScenes version folder?)");
+  if (!InputExists(file))
+    Bad(file, "missing: table '" + name + "' is needed (a nuScenes version folder?)");
+  // nuScenes' largest tables (sample_data.json of v1.0-trainval) pass 64 MiB: the streamed cap.
   Json& j = json_[name];
-  try {
-    j = Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    Bad(file, std::string("not valid JSON (") + e.what() + ")");
-  }
+  j = ReadJsonInput(file, "nuScenes table", kMaxStreamedInputBytes);
   if (!j.is_array()) Bad(file, "expected a JSON array of records");
   Table t;
   t.file = file;

@@ -1,6 +1,7 @@
 // PCD v0.7 binary files (docs/recorded-data.md, "nuScenes").
 #include "dualgrid/recorded/pcd.hpp"
 
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/write_file.hpp"
 
 #include <bit>
@@ -16,6 +17,9 @@ namespace dualgrid::recorded {
 static_assert(std::endian::native == std::endian::little, "PCD binary data are little-endian");
 
 namespace {
+
+// Longest PCD header line [bytes]: a header line names at most a few dozen fields.
+constexpr std::uint64_t kMaxHeaderLine = 4096;
 
 [[noreturn]] void Bad(const std::filesystem::path& file, const std::string& what) {
   throw std::invalid_argument(file.string() + ": " + what);
@@ -88,11 +92,10 @@ void Encode(const PcdField& field, double v, unsigned char* p) {
 
 // The header's lines up to and including DATA, as key -> the words after it.
 std::map<std::string, std::vector<std::string>> ReadHeader(const std::filesystem::path& file,
-                                                           std::istream& in) {
+                                                           InputStream& in) {
   std::map<std::string, std::vector<std::string>> keys;
   std::string line;
-  while (std::getline(in, line)) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+  while (in.ReadLine(&line, kMaxHeaderLine)) {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream words(line);
     std::string key, w;
@@ -100,7 +103,7 @@ std::map<std::string, std::vector<std::string>> ReadHeader(const std::filesystem
     std::vector<std::string>& v = keys[key];
     while (words >> w) v.push_back(w);
     if (key == "DATA") return keys;
-    if (keys.size() > 32 || line.size() > 4096) break;
+    if (keys.size() > 32) break;
   }
   Bad(file, "header key 'DATA' is missing (not a PCD file?)");
 }
@@ -172,8 +175,8 @@ const std::vector<double>* PcdCloud::Column(const std::string& name) const {
 }
 
 PcdCloud ReadPcd(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) Bad(file, "cannot be read (missing?)");
+  const std::uint64_t file_size = CheckInputFile(file, "PCD file");
+  InputStream in(file, "PCD file");
   const auto keys = ReadHeader(file, in);
   PcdCloud cloud;
   cloud.fields = ParseFields(file, keys);
@@ -190,13 +193,17 @@ PcdCloud ReadPcd(const std::filesystem::path& file) {
                   "' (only binary is read)");
   std::size_t row = 0;
   for (const PcdField& f : cloud.fields) row += static_cast<std::size_t>(f.size);
-  if (points > (1LL << 40) / static_cast<long long>(row))
-    Bad(file, "header key 'POINTS': " + std::to_string(points) + " is implausibly large");
+  if (row == 0) Bad(file, "header key 'FIELDS': no fields");
+  // Declared points are allocated before they are read: no more than the file holds.
+  if (static_cast<std::uint64_t>(points) > file_size / row)
+    Bad(file, "header key 'POINTS': " + std::to_string(points) + " points of " +
+                  std::to_string(row) + " bytes do not fit in the file's " +
+                  std::to_string(file_size) + " bytes (truncated or damaged?)");
   const std::size_t need = row * static_cast<std::size_t>(points);
   std::vector<unsigned char> bytes(need);
-  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(need));
-  if (static_cast<std::size_t>(in.gcount()) != need)
-    Bad(file, "data: " + std::to_string(in.gcount()) + " bytes after the header, fewer than its " +
+  const std::size_t got = in.ReadExactly(reinterpret_cast<char*>(bytes.data()), need);
+  if (got != need)
+    Bad(file, "data: " + std::to_string(got) + " bytes after the header, fewer than its " +
                   "POINTS x row size (" + std::to_string(points) + " x " + std::to_string(row) +
                   " = " + std::to_string(need) + ")");
   cloud.columns.assign(cloud.fields.size(), std::vector<double>(static_cast<std::size_t>(points)));

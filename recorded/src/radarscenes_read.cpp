@@ -1,12 +1,14 @@
 // Reading a RadarScenes sequence (docs/recorded-data.md, "The schema as read").
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
+#include "dualgrid/core/input_file.hpp"
+#include "dualgrid/core/json_input.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "h5.hpp"
 
@@ -20,14 +22,15 @@ using Json = nlohmann::json;
   throw std::invalid_argument(file.string() + ": " + what);
 }
 
-Json ReadJson(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) Bad(file, "cannot be read (missing?)");
-  try {
-    return Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    Bad(file, std::string("not valid JSON (") + e.what() + ")");
-  }
+// `what` names the file's role in errors ("RadarScenes sensors file").
+Json ReadJson(const std::filesystem::path& file, const std::string& what) {
+  return ReadJsonInput(file, what);
+}
+
+// A value as a message shows it: its JSON text, at most 40 bytes.
+std::string Shown(const Json& value) {
+  const std::string text = value.dump(-1, ' ', true, Json::error_handler_t::replace);
+  return text.size() > 40 ? text.substr(0, 40) + "..." : text;
 }
 
 double Number(const std::filesystem::path& file, const Json& obj, const std::string& key,
@@ -35,7 +38,7 @@ double Number(const std::filesystem::path& file, const Json& obj, const std::str
   const auto it = obj.find(key);
   if (it == obj.end()) Bad(file, "key '" + where + key + "' is missing");
   if (!it->is_number() || !std::isfinite(it->get<double>()))
-    Bad(file, "key '" + where + key + "': expected a finite number, got " + it->dump());
+    Bad(file, "key '" + where + key + "': expected a finite number, got " + Shown(*it));
   return it->get<double>();
 }
 
@@ -43,8 +46,10 @@ std::int64_t Integer(const std::filesystem::path& file, const Json& obj, const s
                      const std::string& where) {
   const auto it = obj.find(key);
   if (it == obj.end()) Bad(file, "key '" + where + key + "' is missing");
-  if (!it->is_number_integer())
-    Bad(file, "key '" + where + key + "': expected an integer, got " + it->dump());
+  if (!it->is_number_integer() ||
+      (it->is_number_unsigned() &&
+       it->get<std::uint64_t>() > std::uint64_t{std::numeric_limits<std::int64_t>::max()}))
+    Bad(file, "key '" + where + key + "': expected an integer below 2^63, got " + Shown(*it));
   return it->get<std::int64_t>();
 }
 
@@ -57,7 +62,7 @@ struct Rig {
 // sensors.json: radar_1 .. radar_N (consecutive), each {x, y, yaw} in car coordinates (rear
 // axle); dualgrid's own keys (dualgrid_ego, dualgrid_fov, ...) are optional.
 Rig ReadSensors(const std::filesystem::path& file) {
-  const Json j = ReadJson(file);
+  const Json j = ReadJson(file, "RadarScenes sensors file");
   if (!j.is_object()) Bad(file, "expected a JSON object of radar_1, radar_2, ...");
   Rig rig;
   if (const auto e = j.find("dualgrid_ego"); e != j.end()) {
@@ -65,8 +70,11 @@ Rig ReadSensors(const std::filesystem::path& file) {
     rig.length = Number(file, *e, "length", "dualgrid_ego.");
     rig.width = Number(file, *e, "width", "dualgrid_ego.");
     rig.rear_axle_to_centre = Number(file, *e, "rear_axle_to_centre", "dualgrid_ego.");
-    if (!(rig.length > 0.0 && rig.width > 0.0))
-      Bad(file, "key 'dualgrid_ego': length and width must be > 0");
+    if (const std::string e = EgoSizeError(rig.length, rig.width); !e.empty())
+      Bad(file, "key 'dualgrid_ego': " + e);
+    if (std::abs(rig.rear_axle_to_centre) > rig.length)
+      Bad(file, "key 'dualgrid_ego.rear_axle_to_centre': expected within +-length (" +
+                    std::to_string(rig.length) + " m)");
   }
   for (int k = 1;; ++k) {
     const std::string name = "radar_" + std::to_string(k);
@@ -74,7 +82,11 @@ Rig ReadSensors(const std::filesystem::path& file) {
     if (it == j.end()) break;
     if (!it->is_object()) Bad(file, "key '" + name + "': expected an object {x, y, yaw}");
     radar::SensorParams s;
-    s.name = it->value("dualgrid_name", name);
+    s.name = name;
+    if (const auto n = it->find("dualgrid_name"); n != it->end()) {
+      if (!n->is_string()) Bad(file, "key '" + name + ".dualgrid_name': expected a string");
+      s.name = n->get<std::string>();
+    }
     const std::string w = name + ".";
     s.mount.position = {Number(file, *it, "x", w) - rig.rear_axle_to_centre,
                         Number(file, *it, "y", w)};
@@ -102,7 +114,7 @@ struct SceneEntry {
 
 std::vector<SceneEntry> ReadScenes(const std::filesystem::path& file, std::string* name,
                                    std::size_t sensors) {
-  const Json j = ReadJson(file);
+  const Json j = ReadJson(file, "RadarScenes scenes file");
   if (!j.is_object()) Bad(file, "expected a JSON object with sequence_name and scenes");
   const auto seq = j.find("sequence_name");
   if (seq == j.end() || !seq->is_string()) Bad(file, "key 'sequence_name': expected a string");
@@ -149,15 +161,11 @@ std::vector<SceneEntry> ReadScenes(const std::filesystem::path& file, std::strin
   return out;
 }
 
-}  // namespace
-
-RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
-                                 const std::optional<std::filesystem::path>& sensors_json) {
-  h5::Silence();
+RecordedSequence ReadSequence(const std::filesystem::path& sequence_dir,
+                              const std::optional<std::filesystem::path>& sensors_json) {
   std::filesystem::path dir = sequence_dir.lexically_normal();
   if (dir.filename().empty()) dir = dir.parent_path();  // a trailing '/'
-  if (!std::filesystem::is_directory(dir))
-    throw std::invalid_argument(sequence_dir.string() + ": not a folder");
+  CheckInputFolder(dir, "RadarScenes sequence");
   const std::filesystem::path sensors_file =
       sensors_json ? *sensors_json
                    : std::filesystem::absolute(dir).parent_path().parent_path() / "sensors.json";
@@ -171,7 +179,7 @@ RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
 
   const std::filesystem::path h5_file = dir / "radar_data.h5";
   const std::string h5_name = h5_file.string();
-  if (!std::filesystem::is_regular_file(h5_file)) Bad(h5_file, "missing");
+  CheckInputFile(h5_file, "RadarScenes radar data");
   if (H5Fis_hdf5(h5_name.c_str()) <= 0) Bad(h5_file, "not an HDF5 file (truncated or damaged?)");
   const h5::Id file(H5Fopen(h5_name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!file.valid()) Bad(h5_file, "cannot be opened as HDF5 (truncated or damaged?)");
@@ -289,6 +297,15 @@ RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
   const std::int64_t t0 = seq.scans.front().timestamp_us;
   seq.time_origin_us = t0 - t0 % 1000000;
   return seq;
+}
+
+}  // namespace
+
+RecordedSequence ReadRadarScenes(const std::filesystem::path& sequence_dir,
+                                 const std::optional<std::filesystem::path>& sensors_json) {
+  h5::Silence();
+  return ReadingJsonInput(sequence_dir, "RadarScenes sequence",
+                          [&] { return ReadSequence(sequence_dir, sensors_json); });
 }
 
 }  // namespace dualgrid::recorded

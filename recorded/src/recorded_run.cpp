@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "dualgrid/core/input_file.hpp"
+
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
 
@@ -20,19 +22,22 @@ RecordedInput ReadRecordedInput(const std::filesystem::path& input,
     r.scenario = r.nuscenes->scenario;
     return r;
   }
-  r.radarscenes = std::filesystem::exists(input / "scenes.json");
-  if (!r.radarscenes && !std::filesystem::exists(input / "scans.csv") &&
-      std::filesystem::is_directory(input))
-    for (const auto& e : std::filesystem::directory_iterator(input))
-      if (std::filesystem::exists(e.path() / "scene.json"))
+  // What the folder holds decides how it is read; a name present but unusable (a loop, a FIFO)
+  // counts as present, so that its reader names the reason.
+  CheckInputFolder(input, "recorded input folder");
+  r.radarscenes = InputExists(input / "scenes.json");
+  const bool run_folder = InputExists(input / "scans.csv") || InputExists(input / "summary.json");
+  if (!r.radarscenes && !run_folder) {
+    std::error_code ec;
+    for (std::filesystem::directory_iterator it(input, ec), end; !ec && it != end; it.increment(ec))
+      if (InputExists(it->path() / "scene.json"))
         throw std::invalid_argument(input.string() + ": a nuScenes root (" +
-                                    e.path().filename().string() +
+                                    it->path().filename().string() +
                                     "/scene.json): give --scene NAME_OR_TOKEN");
-  if (!r.radarscenes && !std::filesystem::exists(input / "scans.csv") &&
-      !std::filesystem::exists(input / "summary.json"))
     throw std::invalid_argument(input.string() +
                                 ": neither a RadarScenes sequence folder (scenes.json) nor a "
                                 "dualgrid run folder (scans.csv)");
+  }
   if (sensors && !r.radarscenes)
     throw std::invalid_argument("--sensors: only for a RadarScenes sequence");
   r.sequence = r.radarscenes ? ReadRadarScenes(input, sensors) : ReadRunFolder(input);
@@ -42,7 +47,7 @@ RecordedInput ReadRecordedInput(const std::filesystem::path& input,
     std::filesystem::path dir = std::filesystem::absolute(input).lexically_normal();
     if (dir.filename().empty()) dir = dir.parent_path();  // a trailing '/'
     const std::filesystem::path travelled = dir.parent_path().parent_path() / kTravellingScenario;
-    if (std::filesystem::is_regular_file(travelled)) r.scenario = travelled;
+    if (InputExists(travelled)) r.scenario = travelled;  // checked when it is read
   }
   return r;
 }

@@ -1,12 +1,12 @@
 // A run folder recorded with --detections exact, read as a recorded sequence.
 #include "dualgrid/recorded/run_folder.hpp"
 
-#include <zlib.h>
-
 #include <cmath>
 #include <map>
 #include <stdexcept>
 
+#include "dualgrid/core/input_file.hpp"
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder_columns.hpp"
 
@@ -14,21 +14,21 @@ namespace dualgrid::recorded {
 
 namespace {
 
-// A CSV file (plain or gzip: zlib reads both) with a header row, read row by row.
+// Bounds of the numbers of a run folder: coordinates and speeds [m, m/s, rad, rad/s] far beyond
+// any road network, times [s] beyond any run.
+constexpr double kMaxCoordinate = 1e7;
+constexpr double kMaxTime = 1e9;
+
+// A CSV file (plain or gzip) with a header row, read row by row through the checked reader:
+// regular files only, at most kMaxStreamedInputBytes, lines of at most kMaxInputLineBytes.
 class CsvReader {
  public:
-  explicit CsvReader(const std::filesystem::path& path) : path_(path) {
-    file_ = gzopen(path.string().c_str(), "rb");
-    if (!file_) throw std::invalid_argument(path.string() + ": cannot be read");
+  explicit CsvReader(const std::filesystem::path& path)
+      : path_(path), in_(path, "run folder table") {
     if (!Next()) Fail("empty (no header row)");
     header_ = row_;
     line_ = 1;
   }
-  ~CsvReader() {
-    if (file_) gzclose(file_);
-  }
-  CsvReader(const CsvReader&) = delete;
-  CsvReader& operator=(const CsvReader&) = delete;
 
   /// The index of `column`; throws naming the file when it is missing.
   std::size_t Column(const std::string& column) const {
@@ -39,19 +39,7 @@ class CsvReader {
   }
   bool Next() {
     std::string line;
-    char buf[4096];
-    for (;;) {
-      if (!gzgets(file_, buf, sizeof buf)) {
-        int err = 0;
-        gzerror(file_, &err);
-        if (err != Z_OK && err != Z_STREAM_END) Fail("read failed (truncated or damaged?)");
-        if (line.empty()) return false;
-        break;
-      }
-      line += buf;
-      if (!line.empty() && line.back() == '\n') break;
-    }
-    while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) line.pop_back();
+    if (!in_.ReadLine(&line)) return false;
     row_.clear();
     std::size_t start = 0;
     for (;;) {
@@ -68,7 +56,8 @@ class CsvReader {
     return true;
   }
   const std::string& Text(std::size_t column) const { return row_[column]; }
-  double Number(std::size_t column) const {
+  /// A finite number in [lo, hi] (the column's plausible range; the bound is named).
+  double Number(std::size_t column, double lo = -kMaxCoordinate, double hi = kMaxCoordinate) const {
     const std::string& s = row_[column];
     std::size_t used = 0;
     double v = 0.0;
@@ -79,14 +68,17 @@ class CsvReader {
     }
     if (used == 0 || used != s.size() || !std::isfinite(v))
       Fail("row " + std::to_string(line_) + ", column '" + header_[column] +
-           "': expected a finite number, got '" + s + "'");
+           "': expected a finite number, got '" + Shown(s) + "'");
+    if (v < lo || v > hi)
+      Fail("row " + std::to_string(line_) + ", column '" + header_[column] + "': " + Shown(s) +
+           " is outside [" + FormatShort(lo) + ", " + FormatShort(hi) + "]");
     return v;
   }
   long Int(std::size_t column) const {
     const double v = Number(column);
     if (v != std::floor(v) || std::abs(v) > 1e9)
       Fail("row " + std::to_string(line_) + ", column '" + header_[column] +
-           "': expected a whole number, got '" + row_[column] + "'");
+           "': expected a whole number, got '" + Shown(row_[column]) + "'");
     return static_cast<long>(v);
   }
   [[noreturn]] void Fail(const std::string& what) const {
@@ -95,22 +87,26 @@ class CsvReader {
   int line() const { return line_; }
 
  private:
+  // A field as a message shows it: at most 40 bytes.
+  static std::string Shown(const std::string& s) {
+    return s.size() > 40 ? s.substr(0, 40) + "..." : s;
+  }
+
   std::filesystem::path path_;
-  gzFile file_ = nullptr;
+  InputStream in_;
   std::vector<std::string> header_, row_;
   int line_ = 0;
 };
 
-}  // namespace
-
-RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
+RecordedSequence ReadRun(const std::filesystem::path& run_dir) {
   std::filesystem::path dir = run_dir.lexically_normal();
   if (dir.filename().empty()) dir = dir.parent_path();
+  CheckInputFolder(dir, "run folder");
   RecordedSequence seq;
   seq.name = std::filesystem::absolute(dir).filename().string();
   seq.has_labels = true;
   const std::filesystem::path scans_file = dir / "scans.csv";
-  if (!std::filesystem::exists(scans_file))
+  if (!InputExists(scans_file))
     throw std::invalid_argument(scans_file.string() +
                                 ": missing: `filter` and `export` read a run recorded with "
                                 "--detections exact (docs/recorded-data.md)");
@@ -127,19 +123,25 @@ RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
                       c_fov = col(kScanFov), c_rmin = col(kScanMinRange),
                       c_rmax = col(kScanMaxRange);
     std::int64_t last_t = -1;
+    std::map<long, std::string> name_of;  // sensor -> its name in the first row
     while (in.Next()) {
       const long step = in.Int(c_step), sensor = in.Int(c_sensor);
       if (sensor < 0 || sensor > 63)
         in.Fail("row " + std::to_string(in.line()) + ", column 'sensor': out of range");
       if (static_cast<std::size_t>(sensor) >= seq.sensors.size()) seq.sensors.resize(sensor + 1);
       radar::SensorParams& s = seq.sensors[sensor];
+      if (const auto [it, first] = name_of.try_emplace(sensor, in.Text(c_name));
+          !first && it->second != in.Text(c_name))
+        in.Fail("row " + std::to_string(in.line()) + ", column 'sensor_name': sensor " +
+                std::to_string(sensor) + " was named '" + it->second +
+                "' before (one name per sensor)");
       s.name = in.Text(c_name);
       s.mount = {{in.Number(c_mx), in.Number(c_my)}, in.Number(c_myaw)};
       s.fov = in.Number(c_fov);
       s.min_range = in.Number(c_rmin);
       s.max_range = in.Number(c_rmax);
       RecordedScan scan;
-      scan.timestamp_us = std::llround(in.Number(c_time) * 1e6);
+      scan.timestamp_us = std::llround(in.Number(c_time, 0.0, kMaxTime) * 1e6);
       if (scan.timestamp_us < last_t)
         in.Fail("row " + std::to_string(in.line()) + ", column 'time': not increasing");
       last_t = scan.timestamp_us;
@@ -150,6 +152,8 @@ RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
       scan.lane_yaw = in.Number(c_lane);
       seq.ego_length = in.Number(c_len);
       seq.ego_width = in.Number(c_wid);
+      if (const std::string e = EgoSizeError(seq.ego_length, seq.ego_width); !e.empty())
+        in.Fail("row " + std::to_string(in.line()) + ", ego " + e);
       if (!scan_of.try_emplace({step, sensor}, seq.scans.size()).second)
         in.Fail("row " + std::to_string(in.line()) + ": step " + std::to_string(step) +
                 " and sensor " + std::to_string(sensor) + " given twice");
@@ -166,7 +170,7 @@ RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   }
 
   std::filesystem::path det_file = dir / "detections.csv";
-  if (!std::filesystem::exists(det_file)) det_file = dir / "detections.csv.gz";
+  if (!InputExists(det_file)) det_file = dir / "detections.csv.gz";
   CsvReader in(det_file);
   const auto col = [&in](DetectionColumn c) {
     return in.Column(std::string(kDetectionColumns[c]));
@@ -216,13 +220,19 @@ RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
   return seq;
 }
 
+}  // namespace
+
+RecordedSequence ReadRunFolder(const std::filesystem::path& run_dir) {
+  return NamingInputOnFailure(run_dir, "run folder", [&] { return ReadRun(run_dir); });
+}
+
 std::vector<NuScenesKeyFrame> ReadKeyFrames(const std::filesystem::path& run_dir,
                                             const RecordedSequence& seq, double period) {
   std::map<std::string, std::string> category;  // track -> category
   for (const RecordedPoint& p : seq.points)
     if (p.track >= 0) category.try_emplace(seq.track_names[p.track], CategoryOfLabel(p.label));
   std::filesystem::path file = run_dir / "ground_truth.csv";
-  if (!std::filesystem::exists(file)) file = run_dir / "ground_truth.csv.gz";
+  if (!InputExists(file)) file = run_dir / "ground_truth.csv.gz";
   CsvReader in(file);
   const std::size_t c_step = in.Column("step"), c_time = in.Column("time"), c_id = in.Column("id"),
                     c_ego = in.Column("is_ego"), c_x = in.Column("x"), c_y = in.Column("y"),
@@ -231,7 +241,7 @@ std::vector<NuScenesKeyFrame> ReadKeyFrames(const std::filesystem::path& run_dir
   std::vector<NuScenesKeyFrame> out;
   long last_step = -1;
   while (in.Next()) {
-    const double t = in.Number(c_time);
+    const double t = in.Number(c_time, 0.0, kMaxTime);
     const double k = t / period;
     if (std::abs(k - std::round(k)) > 1e-6) continue;
     const long step = in.Int(c_step);
@@ -246,6 +256,8 @@ std::vector<NuScenesKeyFrame> ReadKeyFrames(const std::filesystem::path& run_dir
     v.type = c != category.end() ? c->second : "vehicle.car";
     v.box = {
         {in.Number(c_x), in.Number(c_y)}, in.Number(c_yaw), in.Number(c_len), in.Number(c_wid)};
+    if (const std::string e = EgoSizeError(v.box.length, v.box.width); !e.empty())
+      in.Fail("row " + std::to_string(in.line()) + ", vehicle '" + v.id + "' " + e);
     v.velocity = {in.Number(c_vx), in.Number(c_vy)};
     out.back().vehicles.push_back(std::move(v));
   }

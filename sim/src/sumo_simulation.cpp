@@ -13,6 +13,7 @@
 #include <libsumo/libsumo.h>
 
 #include "auto_ego_run.hpp"
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/core/write_file.hpp"
@@ -91,7 +92,8 @@ std::filesystem::path ResolveNetwork(const std::string& network,
                                      const std::filesystem::path& network_dir) {
   std::filesystem::path p = network;
   if (!IsNetworkPath(network)) p = network_dir / (network + ".net.xml");
-  if (std::filesystem::is_regular_file(p)) return p;
+  // Present but unusable (a folder, a FIFO, a link loop): refused naming why, not "not found".
+  if (InputExists(p)) return CheckInputFile(p, "network file"), p;
   if (IsNetworkPath(network))
     throw std::invalid_argument("network '" + network + "' not found: no file " + p.string() +
                                 " (a path in a scenario is read relative to the scenario file)");

@@ -6,12 +6,14 @@
 
 #include "cli_options.hpp"
 #include "commands.hpp"
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/output_file.hpp"
 #include "dualgrid/outputs/run_folder.hpp"
 #include "dualgrid/recorded/nuscenes.hpp"
 #include "dualgrid/recorded/radarscenes.hpp"
 #include "dualgrid/recorded/run_folder.hpp"
+#include "dualgrid/scenario/loader.hpp"
 
 namespace dualgrid::tools {
 
@@ -40,8 +42,11 @@ int RunExport(const ExportOptions& o) {
   const std::string incomplete = outputs::CheckRunFinished(o.run_dir, o.allow_incomplete);
   // The run's settings travel with the export (docs/recorded-data.md, "Export").
   std::optional<std::filesystem::path> scenario;
-  if (std::filesystem::is_regular_file(o.run_dir / "scenario.yaml"))
-    scenario = o.run_dir / "scenario.yaml";
+  if (const auto copy = o.run_dir / "scenario.yaml"; InputExists(copy)) {
+    // It travels with the export and is loaded by `filter`: refused now if it would be then.
+    scenario::LoadScenario(copy);
+    scenario = copy;
+  }
   PrepareOutputFolder(o.out, {.force = o.force});
   if (!incomplete.empty())  // first: a reader sees it even if the export stops midway
     outputs::MarkIncomplete(o.out, o.run_dir, incomplete);

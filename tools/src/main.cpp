@@ -1,6 +1,7 @@
 // dualgrid: SUMO traffic -> radar detections -> dynamic occupancy grid, scored against truth.
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
 
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_options.hpp"
+#include "dualgrid/core/input_file.hpp"
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 #include "exit_codes.hpp"
@@ -125,6 +127,9 @@ int main(int argc, char** argv) {
   try {
     for (const Command& c : commands)
       if (c.app->parsed()) return c.run();
+  } catch (const dualgrid::InputStopped& e) {
+    std::cerr << "dualgrid: " << OneLine(e.what()) << "\n";
+    return StopExitCode();
   } catch (const dualgrid::scenario::ConfigError& e) {
     std::cerr << "dualgrid: error: " << OneLine(e.what()) << "\n";
     return kExitBadInput;
@@ -137,6 +142,12 @@ int main(int argc, char** argv) {
     return kExitRunFailed;
   } catch (const std::filesystem::filesystem_error& e) {
     std::cerr << "dualgrid: error: " << OneLine(FilesystemMessage(e)) << "\n";
+    // A path that cannot name a file at all (a symbolic link loop, a name too long) is bad input
+    // wherever it is met; anything else (a full disk, an --out under a file) is not.
+    const bool system = e.code().category() == std::generic_category() ||
+                        e.code().category() == std::system_category();
+    if (system && (e.code().value() == ELOOP || e.code().value() == ENAMETOOLONG))
+      return kExitBadInput;
     return kExitRunFailed;
   } catch (const nlohmann::json::exception& e) {
     // Every file read back goes through the checked reader: this is a bug, not bad input.

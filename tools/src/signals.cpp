@@ -2,6 +2,8 @@
 
 #include <csignal>
 
+#include "dualgrid/core/input_file.hpp"
+
 namespace dualgrid::tools {
 namespace {
 
@@ -25,6 +27,7 @@ void InstallStopHandlers() {
   sa.sa_flags = 0;  // no SA_RESTART: experiment's wait() must wake up to forward the signal
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  SetInputStopFlag(&g_stop);  // a long read of an input ends at the signal too
 }
 
 int StopSignal() { return static_cast<int>(g_stop); }

@@ -74,6 +74,19 @@ struct RecordedSequence {
   }
 };
 
+/// The ego's size every recorded reader accepts (sensors.json, dualgrid.json, a run folder's
+/// scans.csv): the ranges of a scenario's vehicle types (sim/scenario.cpp), length in (0, 30] m and
+/// width in (0, 4] m. Returns "" when valid, else what was expected, for the reader's message.
+inline constexpr double kMaxEgoLength = 30.0;  ///< [m]
+inline constexpr double kMaxEgoWidth = 4.0;    ///< [m]
+inline std::string EgoSizeError(double length, double width) {
+  if (!(length > 0.0 && length <= kMaxEgoLength))
+    return "length " + std::to_string(length) + ": expected in (0, 30] m";
+  if (!(width > 0.0 && width <= kMaxEgoWidth))
+    return "width " + std::to_string(width) + ": expected in (0, 4] m";
+  return "";
+}
+
 /// Labels 0-10 are road users that move (RadarScenes' dynamic classes); 11 is static.
 inline constexpr int kStaticLabel = 11;
 inline bool IsMovingLabel(int label) { return label >= 0 && label < kStaticLabel; }
