@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "dualgrid/core/limits.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/core/validation.hpp"
 #include "dualgrid/sim/vehicle_ranges.hpp"
@@ -106,6 +107,8 @@ double VClassRcs(const std::string& vclass) {
 bool ScenarioSpec::IsValid(std::string* error) const {
   FieldCheck c;
   c.Expect(!network.empty(), "network", "''", "the name or path of a network");
+  c.Expect(seed <= kMaxSeed, "seed", std::to_string(seed),
+           "a whole number in [0, " + std::to_string(kMaxSeed) + "] (as --seed)");
   CheckTimes(c, *this);
   c.InRange("step_length", step_length, 0.001, 1.0, Interval::kClosed, "s");
   c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6, "step_length",
