@@ -98,7 +98,9 @@ int FilterParams::CellsY() const {
 }
 
 double FilterParams::MemoryBytes() const {
-  const double cells = static_cast<double>(CellsX()) * CellsY();
+  // Counted in double: also meaningful (huge) for sizes IsValid refuses, where int would overflow.
+  const double cells = std::max(1.0, std::round(length_x / resolution)) *
+                       std::max(1.0, std::round(width_y / resolution));
   return 94.0 * cells + 68.0 * num_particles + 36.0 * num_birth;
 }
 
