@@ -182,7 +182,7 @@ namespace {
 void CheckNumbers(const std::string& file, const XmlElement& e) {
   const std::string_view tag = e.tag();
   const bool type = tag == "vType" || tag.rfind("carFollowing-", 0) == 0;
-  const bool vehicle = tag == "vehicle" || tag == "trip" || tag == "flow";
+  const bool vehicle = tag == "vehicle" || tag == "trip" || tag == "flow" || tag == "stop";
   if (!type && !vehicle) return;
   const auto where = [&](std::string_view attribute, const char* value) {
     const char* id = e.Attribute("id");

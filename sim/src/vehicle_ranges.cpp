@@ -57,6 +57,13 @@ const Table& VehicleTable() {
       {"departPosLat", {-100.0, 100.0, Interval::kClosed, "m"}},
       {"arrivalPosLat", {-100.0, 100.0, Interval::kClosed, "m"}},
       {"speedFactor", {0.0, 10.0, Interval::kLeftOpen, ""}},
+      // <stop> (inside a vehicle, trip, flow or route)
+      {"duration", {0.0, kMaxSumoTime, Interval::kClosed, "s"}},
+      {"until", {0.0, kMaxSumoTime, Interval::kClosed, "s"}},
+      {"extension", {0.0, kMaxSumoTime, Interval::kClosed, "s"}},
+      {"startPos", {-kMaxPosition, kMaxPosition, Interval::kClosed, "m"}},
+      {"endPos", {-kMaxPosition, kMaxPosition, Interval::kClosed, "m"}},
+      {"posLat", {-100.0, 100.0, Interval::kClosed, "m"}},
   };
   return kTable;
 }

@@ -60,6 +60,8 @@ route_case vclass '<vType id="t" vClass="spaceship"/>' 'expected a SUMO vehicle 
 route_case distribution '<vType id="t" speedFactor="norm(nan,0.1)"/>' 'arguments are finite'
 route_case depart_speed '<vType id="t"/><vehicle id="v" type="t" depart="0" departSpeed="1e9"><route edges="east_1"/></vehicle>' \
   'departSpeed="1e9": expected in [0, 70] m/s'
+route_case stop_duration '<vType id="t"/><vehicle id="s" type="t" depart="0"><route edges="east_1 east_2"/><stop lane="east_2_0" duration="nan"/></vehicle>' \
+  '<stop> duration="nan": expected in [0,'
 route_case flow_period '<vType id="t"/><flow id="f" type="t" begin="0" end="10" period="nan" from="east_1" to="east_2"/>' \
   'period="nan"'
 

@@ -41,7 +41,8 @@ const std::vector<std::string> kVTypeAttributes = {"length",
 const std::vector<std::string> kVehicleAttributes = {
     "depart",      "begin",        "end",           "period",       "vehsPerHour",
     "probability", "number",       "departSpeed",   "arrivalSpeed", "departPos",
-    "arrivalPos",  "departPosLat", "arrivalPosLat", "speedFactor"};
+    "arrivalPos",  "departPosLat", "arrivalPosLat", "speedFactor",  "duration",
+    "until",       "extension",    "startPos",      "endPos",       "posLat"};
 
 bool OpenLo(const NumberRange& r) {
   return r.ends == Interval::kOpen || r.ends == Interval::kLeftOpen;

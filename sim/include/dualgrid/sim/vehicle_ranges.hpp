@@ -30,9 +30,9 @@ struct NumberRange {
 /// not plain numbers or not checked (ids, colours, model names).
 std::optional<NumberRange> VTypeAttributeRange(std::string_view attribute);
 
-/// The range of a numeric attribute of <vehicle>, <trip> and <flow> ("depart", "departSpeed",
-/// "period", "probability", ...); std::nullopt as above. SUMO's words ("max", "random", ...) are
-/// not numbers: CheckSumoNumber leaves them to SUMO.
+/// The range of a numeric attribute of <vehicle>, <trip>, <flow> and <stop> ("depart",
+/// "departSpeed", "period", "probability", "duration", "endPos", ...); std::nullopt as above.
+/// SUMO's words ("max", "random", ...) are not numbers: CheckSumoNumber leaves them to SUMO.
 std::optional<NumberRange> VehicleAttributeRange(std::string_view attribute);
 
 /// Why the text of a SUMO numeric attribute is refused, in words that fit after
