@@ -19,6 +19,9 @@ using namespace detail;
 namespace {
 
 constexpr int kMaxNeighbours = 64;  // nearest-first is not needed: the first 64 in bucket order
+// Candidates looked at per detection at most (docs/algorithm.md, step 4a): bounds a fit's cost
+// when thousands of detections crowd its buckets, so that a cycle's cost stays linear in them.
+constexpr int kMaxCandidates = 8 * kMaxNeighbours;
 constexpr int kIterations = 6;
 constexpr double kTukey = 4.685;  // 95 % efficiency at Gaussian noise
 constexpr double kMadToSigma = 1.4826;
@@ -76,6 +79,17 @@ bool RobustFit(const double* ux, const double* uy, const double* y, int n, doubl
 
 }  // namespace
 
+double MeasurementGrid::BucketDistance2(const Position& p, int bx, int by) const {
+  const double edge = 1.0 / bucket_inv_;
+  const double x0 = static_cast<double>(origin_gx_) * params_.resolution + bx * edge;
+  const double y0 = static_cast<double>(origin_gy_) * params_.resolution + by * edge;
+  const double lo_x = bx == 0 ? -kInf : x0, hi_x = bx == nbx_ - 1 ? kInf : x0 + edge;
+  const double lo_y = by == 0 ? -kInf : y0, hi_y = by == nby_ - 1 ? kInf : y0 + edge;
+  const double dx = std::max({lo_x - p.x(), 0.0, p.x() - hi_x});
+  const double dy = std::max({lo_y - p.y(), 0.0, p.y() - hi_y});
+  return dx * dx + dy * dy;
+}
+
 void MeasurementGrid::FitDetectionVelocities() {
   const std::span<const Measurement> z = z_;
   const int nz = static_cast<int>(z.size());
@@ -96,14 +110,19 @@ void MeasurementGrid::FitDetectionVelocities() {
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
     double ux[kMaxNeighbours], uy[kMaxNeighbours], y[kMaxNeighbours];
-    int n = 0;
+    int n = 0, looked = 0;
     for (int cy = std::max(0, by - reach); cy <= std::min(nby_ - 1, by + reach); ++cy) {
       for (int cx = std::max(0, bx - reach); cx <= std::min(nbx_ - 1, bx + reach); ++cx) {
+        // No neighbour can lie there (a relative margin for the rounding of BucketOf's edges).
+        if (BucketDistance2(p, cx, cy) > radius2 * (1.0 + 1e-9)) continue;
         const std::int64_t b = static_cast<std::int64_t>(cy) * nbx_ + cx;
-        for (std::int64_t k = bucket_start_[b]; k < bucket_start_[b + 1] && n < kMaxNeighbours;
-             ++k) {
+        for (std::int64_t k = bucket_start_[b];
+             k < bucket_start_[b + 1] && n < kMaxNeighbours && looked < kMaxCandidates;
+             ++k, ++looked) {
+          // det_x_/det_y_: the positions in bucket order (contiguous, unlike z[i]).
+          const double ex = det_x_[k] - p.x(), ey = det_y_[k] - p.y();
+          if (ex * ex + ey * ey > radius2) continue;
           const int i = bucket_items_[k];
-          if ((z[i].position - p).squaredNorm() > radius2) continue;
           ux[n] = los[3 * i];
           uy[n] = los[3 * i + 1];
           y[n] = los[3 * i + 2];

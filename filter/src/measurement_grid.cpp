@@ -78,11 +78,13 @@ void MeasurementGrid::Build(const Position& centre, std::span<const Measurement>
   if (!centre.allFinite())
     throw std::invalid_argument("MeasurementGrid::Build: the grid centre is not finite");
   for (const SensorCoverage& c : coverage) {
+    // half_fov <= pi: the angle bins (2 half_fov / free_angle_bin) stay bounded.
     if (!c.origin.allFinite() || !std::isfinite(c.boresight) || !(c.half_fov >= 0.0) ||
-        !(c.min_range >= 0.0) || !(c.max_range >= c.min_range) || !std::isfinite(c.max_range)) {
+        !(c.half_fov <= kPi) || !(c.min_range >= 0.0) || !(c.max_range >= c.min_range) ||
+        !std::isfinite(c.max_range)) {
       throw std::invalid_argument(
-          "MeasurementGrid::Build: SensorCoverage needs a finite origin/boresight, half_fov >= 0 "
-          "and 0 <= min_range <= max_range < inf");
+          "MeasurementGrid::Build: SensorCoverage needs a finite origin/boresight, "
+          "0 <= half_fov <= pi and 0 <= min_range <= max_range < inf");
     }
   }
   // DynamicGrid's origin for this centre: the same cells, the same storage.

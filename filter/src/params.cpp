@@ -98,7 +98,9 @@ int FilterParams::CellsY() const {
 }
 
 double FilterParams::MemoryBytes() const {
-  const double cells = static_cast<double>(CellsX()) * CellsY();
+  // Counted in double: also meaningful (huge) for sizes IsValid refuses, where int would overflow.
+  const double cells = std::max(1.0, std::round(length_x / resolution)) *
+                       std::max(1.0, std::round(width_y / resolution));
   return 94.0 * cells + 68.0 * num_particles + 36.0 * num_birth;
 }
 
@@ -123,11 +125,21 @@ bool FilterParams::IsValid(std::string* error) const {
   c.Expect(std::isfinite(width_y) && width_y >= resolution, "width_y", width_y,
            "finite and >= resolution = " + FormatShort(resolution) + " m");
   if (c.ok()) {
-    const double cells = static_cast<double>(CellsX()) * CellsY();
-    c.Expect(cells <= 2.0e8, "length_x/width_y/resolution",
+    // Counted in double before CellsX/CellsY round to int (1e300 / 0.1 would overflow it); each
+    // side names its key, the product all three.
+    const double nx = std::round(length_x / resolution), ny = std::round(width_y / resolution);
+    const std::string per_cell = " / resolution = " + FormatShort(resolution) + " m: ";
+    c.Expect(nx <= kMaxCells, "length_x", length_x,
+             "at most " + FormatShort(kMaxCells) + " cells along x (length_x" + per_cell +
+                 FormatShort(nx) + " cells)");
+    c.Expect(ny <= kMaxCells, "width_y", width_y,
+             "at most " + FormatShort(kMaxCells) + " cells along y (width_y" + per_cell +
+                 FormatShort(ny) + " cells)");
+    c.Expect(nx * ny <= kMaxCells, "length_x/width_y/resolution",
              FormatShort(length_x) + "/" + FormatShort(width_y) + "/" + FormatShort(resolution) +
-                 " m (" + FormatShort(cells) + " cells)",
-             "at most 2e8 cells");
+                 " m (" + FormatShort(nx * ny) + " cells)",
+             "at most " + FormatShort(kMaxCells) + " cells (about " +
+                 FormatShort(kMaxCells * 94.0 / 1e9) + " GB)");
   }
   c.AtLeast("num_particles", num_particles, 1);
   c.AtLeast("num_birth", num_birth, 0);

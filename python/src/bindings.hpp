@@ -29,4 +29,8 @@ void BindStepping(py::module_& m);
 /// C++ stage (grid update, radar scan) applies it first, on the thread doing the work.
 void ApplyThreadCount();
 
+/// `n` when it is a thread count the command line accepts ([0, 4 per core]: core/limits.hpp);
+/// otherwise ValueError "<fn>: <key> must be >= 0 and <= N (...), got n".
+int CheckThreads(int n, const char* fn, const char* key);
+
 }  // namespace dualgrid::python

@@ -14,6 +14,8 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "dualgrid/core/text.hpp"
+#include "dualgrid/core/types.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "dualgrid/filter/params.hpp"
 #include "grid_holder.hpp"
@@ -212,9 +214,15 @@ void Update(Grid& g, PoseArg ego_pose, Vector2Arg ego_velocity, TableArg detecti
   std::vector<filter::SensorCoverage> cov(c.rows);
   for (std::size_t i = 0; i < c.rows; ++i) {
     cov[i] = {{c.at(i, 0), c.at(i, 1)}, c.at(i, 2), c.at(i, 3), c.at(i, 4), c.at(i, 5)};
-    if (cov[i].half_fov < 0.0 || cov[i].min_range < 0.0 || cov[i].max_range < cov[i].min_range)
+    // As the filter (MeasurementGrid::Build) and a sensor's fov (0, 2 pi]: at most a full circle.
+    if (!(cov[i].half_fov >= 0.0 && cov[i].half_fov <= kPi) || cov[i].min_range < 0.0 ||
+        cov[i].max_range < cov[i].min_range)
       throw py::value_error("coverage: row " + std::to_string(i) +
-                            " needs half_fov >= 0 [rad] and 0 <= min_range <= max_range [m]");
+                            " (half_fov = " + FormatShort(cov[i].half_fov) +
+                            ", min_range = " + FormatShort(cov[i].min_range) +
+                            ", max_range = " + FormatShort(cov[i].max_range) +
+                            ") needs 0 <= half_fov <= pi [rad] (a field of view of at most 360 "
+                            "deg) and 0 <= min_range <= max_range [m]");
   }
   Locked(g, [&](DynamicGrid& grid) {
     ApplyThreadCount();

@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.hpp"
+#include "dualgrid/core/limits.hpp"
 
 namespace dualgrid::python {
 namespace {
@@ -16,6 +17,16 @@ namespace {
 std::atomic<int> g_num_threads{0};
 
 }  // namespace
+
+int CheckThreads(int n, const char* fn, const char* key) {
+  // The command line's bound (--threads: core/limits.hpp); a huge team exhausts the stacks of
+  // OpenMP's thread pool and ends the interpreter.
+  if (n < 0 || n > MaxThreads())
+    throw py::value_error(std::string(fn) + ": " + key + " must be >= 0 and <= " +
+                          std::to_string(MaxThreads()) + " (" + std::to_string(kMaxThreadsPerCore) +
+                          " per core, as --threads), got " + std::to_string(n));
+  return n;
+}
 
 void ApplyThreadCount() {
   const int n = g_num_threads.load();
@@ -33,15 +44,11 @@ PYBIND11_MODULE(_dualgrid, m) {
   m.attr("__version__") = DUALGRID_VERSION;
 
   m.def(
-      "set_num_threads",
-      [](int n) {
-        if (n < 0)
-          throw py::value_error("set_num_threads: n must be >= 0, got " + std::to_string(n));
-        g_num_threads = n;
-      },
+      "set_num_threads", [](int n) { g_num_threads = CheckThreads(n, "set_num_threads", "n"); },
       py::arg("n"),
       "Threads of the parallel C++ stages (grid update, radar scan) for every later call from any "
-      "Python thread; 0 restores OpenMP's default (OMP_NUM_THREADS or all cores). Results do not "
+      "Python thread, at most 4 per core (as --threads; ValueError beyond); 0 restores OpenMP's "
+      "default (OMP_NUM_THREADS or all cores). Results do not "
       "depend on it.");
   m.def(
       "get_num_threads",

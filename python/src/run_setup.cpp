@@ -39,8 +39,7 @@ cosim::CoSimOptions RunOptions(const std::vector<std::string>& modes, int thread
     options.modes.push_back(*m);
   }
   if (options.modes.empty()) throw py::value_error(std::string(fn) + ": modes must not be empty");
-  if (threads < 0) throw py::value_error(std::string(fn) + ": threads must be >= 0");
-  options.threads = threads;
+  options.threads = CheckThreads(threads, fn, "threads");
   return options;
 }
 

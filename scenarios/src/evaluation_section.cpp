@@ -22,7 +22,12 @@ void ReadEvaluation(MapReader& root, EvaluationConfig* e) {
   r->Read("snapshot_times", &e->snapshot_times);
   r->Finish();
   std::string error;
-  if (!e->IsValid(&error)) Invalid(root.file(), "evaluation", error);
+  // The validators' names of the keys above that differ from them.
+  static const KeyAlias kKeys[] = {{"association.box_margin", "gate_box_margin"},
+                                   {"association.center_gate", "gate_center"},
+                                   {"required", "consistent_required"},
+                                   {"window", "consistent_window"}};
+  if (!e->IsValid(&error)) Invalid(root.file(), "evaluation", error, kKeys);
 }
 
 }  // namespace detail

@@ -4,11 +4,13 @@
 
 #include <cstddef>
 #include <type_traits>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/radar_model/radar_model.hpp"
+#include "sections.hpp"
 #include "yaml_reader.hpp"
 
 namespace dualgrid::scenario::detail {
@@ -99,6 +101,19 @@ void WriteFields(const Field<S, T> (&fields)[N], const S& in, nlohmann::json* j)
       (*j)[f.key] = in.*f.member;
     }
   }
+}
+
+// The aliases of a parameter table's degree rows: the validator's field is the key without
+// "_deg" ("fov" -> "fov_deg").
+template <typename S, typename T, std::size_t N>
+std::vector<KeyAlias> DegreeAliases(const Field<S, T> (&fields)[N]) {
+  std::vector<KeyAlias> out;
+  for (const auto& f : fields) {
+    const std::string_view key = f.key;
+    if (f.degrees && key.ends_with("_deg"))
+      out.push_back({key.substr(0, key.size() - 4), key, true});
+  }
+  return out;
 }
 
 }  // namespace dualgrid::scenario::detail

@@ -101,7 +101,7 @@ void ReadFilter(MapReader& root, ScenarioConfig* config) {
   ReadGridPlacement(*r, *f, &config->grid);  // after length_x / width_y: it checks against them
   r->Finish();
   std::string error;
-  if (!f->IsValid(&error)) Invalid(root.file(), "filter", error);
+  if (!f->IsValid(&error)) Invalid(root.file(), "filter", error, DegreeAliases(kFilterDoubles));
 }
 
 }  // namespace dualgrid::scenario::detail

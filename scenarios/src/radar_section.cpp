@@ -127,7 +127,8 @@ void ReadRadar(MapReader& root, const sim::ScenarioSpec& spec, RadarConfig* rada
   section->Finish();
   for (const auto& s : radar->sensors) {
     std::string error;
-    if (!s.IsValid(&error)) Invalid(root.file(), "sensors.overrides." + s.name, error);
+    if (!s.IsValid(&error))
+      Invalid(root.file(), "sensors.overrides." + s.name, error, DegreeAliases(kSensorDoubles));
   }
 }
 

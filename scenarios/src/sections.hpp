@@ -3,7 +3,9 @@
 #pragma once
 
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 
 #include <yaml-cpp/yaml.h>
 
@@ -16,11 +18,20 @@ namespace dualgrid::scenario::detail {
 /// A number as printf's %g shows it.
 std::string Shown(double v);
 
+// A validator's field name and the key users write for it; `degrees`: the key is an angle in
+// degrees that the validator checks in radians.
+struct KeyAlias {
+  std::string_view field, key;
+  bool degrees = false;
+};
+
 // Turns an IsValid message into a ConfigError naming the key under `section`. FieldCheck
 // messages, "field = value: expected what", read as the parser's own: "key '<section>.field'
-// expected what, got value"; other validators write "field: message" or "field message".
+// expected what, got value"; other validators write "field: message" or "field message". A field
+// of `aliases` is named by its key, and a degrees key's value and interval ("in (0, 2 pi] rad")
+// are written in degrees ("in (0, 360] deg, got 400").
 [[noreturn]] void Invalid(const std::string& file, const std::string& section,
-                          const std::string& error);
+                          const std::string& error, std::span<const KeyAlias> aliases = {});
 
 /// The top-level keys and the `ego`, `traffic`, `actions` and `obstacles` sections
 /// (sim_section.cpp).

@@ -1,12 +1,15 @@
 #include "dualgrid/sim/scenario.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <set>
 #include <sstream>
 
+#include "dualgrid/core/limits.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/core/validation.hpp"
+#include "dualgrid/sim/vehicle_ranges.hpp"
 
 namespace dualgrid::sim {
 namespace {
@@ -35,6 +38,13 @@ void CheckVehicle(FieldCheck& c, const VehicleSpec& v, const std::string& field,
   if (v.desired_speed)
     c.InRange(field + ".desired_speed", *v.desired_speed, 0.0, kMaxTrafficSpeed,
               Interval::kLeftOpen, "m/s");
+}
+
+// A scenario vehicle type's number `v` in the range of SUMO's vType attribute `sumo_attribute`.
+void TypeNumber(FieldCheck& c, const std::string& field, const char* sumo_attribute, double v) {
+  const std::optional<NumberRange> r = VTypeAttributeRange(sumo_attribute);
+  assert(r);
+  c.InRange(field, v, r->lo, r->hi, r->ends, r->unit);
 }
 
 // The ego of the user's files must depart within the run (SUMO skips vehicles that depart before
@@ -97,6 +107,8 @@ double VClassRcs(const std::string& vclass) {
 bool ScenarioSpec::IsValid(std::string* error) const {
   FieldCheck c;
   c.Expect(!network.empty(), "network", "''", "the name or path of a network");
+  c.Expect(seed <= kMaxSeed, "seed", std::to_string(seed),
+           "a whole number in [0, " + std::to_string(kMaxSeed) + "] (as --seed)");
   CheckTimes(c, *this);
   c.InRange("step_length", step_length, 0.001, 1.0, Interval::kClosed, "s");
   c.Expect(std::abs(step_length * 1000.0 - std::round(step_length * 1000.0)) <= 1e-6, "step_length",
@@ -105,11 +117,14 @@ bool ScenarioSpec::IsValid(std::string* error) const {
   for (const auto& [name, t] : vehicle_types) {
     const std::string f = "vehicle_types." + name;
     c.Expect(ValidSumoId(name), f, Quoted(name), std::string("a type name ") + kIdRule);
-    c.InRange(f + ".length", t.length, 0.0, 30.0, Interval::kLeftOpen, "m");
-    c.InRange(f + ".width", t.width, 0.0, 4.0, Interval::kLeftOpen, "m");
-    c.InRange(f + ".max_speed", t.max_speed, 0.0, kMaxTrafficSpeed, Interval::kLeftOpen, "m/s");
-    c.Positive(f + ".accel", t.accel, "m/s^2");
-    c.Positive(f + ".decel", t.decel, "m/s^2");
+    // The same rows as the vTypes of the user's SUMO files (vehicle_ranges.hpp).
+    TypeNumber(c, f + ".length", "length", t.length);
+    TypeNumber(c, f + ".width", "width", t.width);
+    TypeNumber(c, f + ".max_speed", "maxSpeed", t.max_speed);
+    TypeNumber(c, f + ".accel", "accel", t.accel);
+    TypeNumber(c, f + ".decel", "decel", t.decel);
+    c.Expect(IsSumoVehicleClass(t.vclass), f + ".vclass", Quoted(t.vclass),
+             "a SUMO vehicle class, " + SumoVehicleClassList());
     c.InRange(f + ".rcs_dbsm", t.rcs_dbsm, kMinRcsDbsm, kMaxRcsDbsm, Interval::kClosed, "dBsm");
   }
   for (const auto& [type, rcs] : type_rcs)

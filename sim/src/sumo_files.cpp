@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "dualgrid/sim/sumo_tools.hpp"
+#include "dualgrid/sim/vehicle_ranges.hpp"
 #include "dualgrid/sim/xml_scan.hpp"
 
 namespace dualgrid::sim {
@@ -142,6 +143,12 @@ SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
     throw std::invalid_argument(cfg.string() +
                                 ": element <net-file value=\"...\"/> (or <net value=...>) "
                                 "expected in <input>");
+  // SUMO would merge several networks into one; the radar's map and the scoring take one file.
+  if (nets.size() > 1)
+    throw std::invalid_argument(cfg.string() + ": element <net-file value=\"" + *net +
+                                "\"/>: expected one network file, got " +
+                                std::to_string(nets.size()) +
+                                " (merge them with netconvert into one .net.xml)");
   in.net_file = nets.front();
   if (const auto routes = option("route-files")) in.route_files = PathList(*routes, base);
   if (const auto additional = option("additional-files"))
@@ -169,11 +176,39 @@ SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg) {
 
 namespace {
 
+// The numeric attributes of `e` and its vClass in the ranges of vehicle_ranges.hpp (libsumo
+// asserts on a NaN length and takes an infinite maxSpeed); throws std::invalid_argument
+// "<file>:<line>: <vType id="x"> length="nan": expected in (0, 30] m".
+void CheckNumbers(const std::string& file, const XmlElement& e) {
+  const std::string_view tag = e.tag();
+  const bool type = tag == "vType" || tag.rfind("carFollowing-", 0) == 0;
+  const bool vehicle = tag == "vehicle" || tag == "trip" || tag == "flow" || tag == "stop";
+  if (!type && !vehicle) return;
+  const auto where = [&](std::string_view attribute, const char* value) {
+    const char* id = e.Attribute("id");
+    return file + ":" + std::to_string(e.line()) + ": <" + std::string(tag) +
+           (id ? std::string(" id=\"") + id + "\"" : std::string()) + "> " +
+           std::string(attribute) + "=\"" + value + "\": ";
+  };
+  for (const char* const* a = e.attributes(); a != nullptr && a[0] != nullptr; a += 2) {
+    const std::optional<NumberRange> range =
+        type ? VTypeAttributeRange(a[0]) : VehicleAttributeRange(a[0]);
+    if (range)
+      if (const auto problem = SumoNumberProblem(a[1], *range))
+        throw std::invalid_argument(where(a[0], a[1]) + *problem);
+  }
+  if (const char* vclass = e.Attribute("vClass"); vclass && tag == "vType")
+    if (!IsSumoVehicleClass(vclass))
+      throw std::invalid_argument(where("vClass", vclass) + "expected a SUMO vehicle class, " +
+                                  SumoVehicleClassList());
+}
+
 // Indexes one file into `index`. `what` names its role in messages.
 void IndexFile(const std::string& file, const std::string& what, RouteFileIndex* index) {
   std::map<std::string, std::size_t> unhonoured, unseen;  // tag -> count
   ScanXml(file, what, [&](const XmlElement& e) {
     const std::string_view tag = e.tag();
+    CheckNumbers(file, e);
     const char* id = e.Attribute("id");
     if (tag == "person" || tag == "personFlow" || tag == "container" || tag == "containerFlow")
       ++unhonoured[std::string(tag)];

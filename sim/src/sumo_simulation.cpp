@@ -482,6 +482,27 @@ std::string SumoSimulation::Clock(double sumo_time) const {
   return "SUMO time " + Num(sumo_time) + " s (run time " + Num(RunTime(sumo_time)) + " s)";
 }
 
+void SumoSimulation::SumoStep() {
+  try {
+    libsumo::Simulation::step();
+  } catch (const libsumo::TraCIException&) {
+    throw;  // Step's own handlers
+  } catch (const libsumo::FatalTraCIError&) {
+    throw;
+  } catch (const std::exception& e) {
+    // SUMO's loader refusing a definition of the user's files when it is first needed (an
+    // invalid departLane: a ProcessError, possibly several lines): bad input, in one line naming
+    // the files; SUMO's full text stays in sumo.log.
+    std::string files;
+    for (const std::string& f : spec_.route_files) files += (files.empty() ? "" : ", ") + f;
+    for (const std::string& f : spec_.additional_files) files += (files.empty() ? "" : ", ") + f;
+    throw std::invalid_argument((files.empty() ? "SUMO" : "SUMO, loading " + files + ",") +
+                                " refused a definition at " +
+                                Clock(libsumo::Simulation::getTime()) + ": " + OneLine(e.what()) +
+                                " (see " + log_path_.string() + ")");
+  }
+}
+
 bool SumoSimulation::Step() {
   if (closed_) throw std::logic_error("SumoSimulation::Step after Close");
   try {
@@ -504,7 +525,7 @@ bool SumoSimulation::Step() {
               "' blocked or invalid, or departure too late; see " + log_path_.string() + ")");
         return false;
       }
-      libsumo::Simulation::step();
+      SumoStep();
       ++step_;
       ApplyDepartures();
       ApplyActions();

@@ -58,6 +58,35 @@ TEST_CASE("IsValid names the offending field", "[filter][params]") {
   CHECK_THROWS_AS(DynamicGrid(p, 1), std::invalid_argument);
 }
 
+TEST_CASE("a cell count that overflows int or exceeds kMaxCells names its key",
+          "[filter][params]") {
+  struct Case {
+    double length_x, width_y, resolution;
+    std::string key;
+  };
+  const Case cases[] = {
+      {1e300, 40.0, 0.1, "length_x = 1e+300"},  // lround would overflow: no silent 1 cell
+      {40.0, 1e300, 0.1, "width_y = 1e+300"},
+      {40.0, 40.0, 1e-9, "length_x = 40"},             // 4e10 cells along x
+      {40.0, 40.0, 5e-324, "length_x = 40"},           // inf cells
+      {3e4, 3e4, 1.0, "length_x/width_y/resolution"},  // 9e8 cells in all
+      {2e8, 1.0, 1.0, ""},                             // the bound itself: accepted
+  };
+  for (const Case& c : cases) {
+    FilterParams p;
+    p.length_x = c.length_x;
+    p.width_y = c.width_y;
+    p.resolution = c.resolution;
+    std::string error;
+    INFO(c.length_x << " " << c.width_y << " " << c.resolution << ": " << error);
+    CHECK(p.IsValid(&error) == c.key.empty());
+    if (!c.key.empty()) {
+      CHECK(error.find(c.key) == 0);
+      CHECK(error.find("at most 200000000 cells") != std::string::npos);
+    }
+  }
+}
+
 TEST_CASE("weight mode names round-trip", "[filter][params]") {
   const WeightMode m = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
   CHECK(ParseWeightMode(ToString(m)) == m);

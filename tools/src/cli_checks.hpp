@@ -8,18 +8,17 @@
 #include <CLI/CLI.hpp>
 
 #include "dualgrid/core/core_split.hpp"
+#include "dualgrid/core/limits.hpp"
 #include "dualgrid/sim/scenario.hpp"
 
 namespace dualgrid::tools {
 
-/// Largest seed accepted anywhere: 2^53 - 1, so that a seed written to JSON is read back exactly
-/// by readers that hold numbers as doubles (Python's json, JavaScript).
-inline constexpr std::uint64_t kMaxSeed = (std::uint64_t{1} << 53) - 1;
+/// Largest seed accepted anywhere (core/limits.hpp).
+using dualgrid::kMaxSeed;
 /// At most this many seeds per experiment (each is one process and one folder).
 inline constexpr int kMaxSeeds = 10000;
-/// OpenMP threads (and parallel runs) per core at most: more only adds switching, and very large
-/// counts exhaust the stack space of the thread pool.
-inline constexpr int kMaxThreadsPerCore = 4;
+/// OpenMP threads per core at most (core/limits.hpp).
+using dualgrid::kMaxThreadsPerCore;
 /// Longest simulated duration [s] accepted on the command line (as in a scenario file).
 inline constexpr double kMaxDuration = sim::kMaxDuration;
 

@@ -44,6 +44,21 @@ inline std::string Indexed(std::string_view name, std::size_t i) {
 /// Which ends of an InRange interval belong to it: [lo, hi], (lo, hi), (lo, hi], [lo, hi).
 enum class Interval { kClosed, kOpen, kLeftOpen, kRightOpen };
 
+/// True when `v` lies in the interval from `lo` to `hi`, ends included as `ends` says (NaN never).
+inline bool InInterval(double v, double lo, double hi, Interval ends) {
+  const bool open_lo = ends == Interval::kOpen || ends == Interval::kLeftOpen;
+  const bool open_hi = ends == Interval::kOpen || ends == Interval::kRightOpen;
+  return (open_lo ? v > lo : v >= lo) && (open_hi ? v < hi : v <= hi);
+}
+
+/// The interval as messages write it: "in (0, 30]".
+inline std::string IntervalText(double lo, double hi, Interval ends) {
+  const bool open_lo = ends == Interval::kOpen || ends == Interval::kLeftOpen;
+  const bool open_hi = ends == Interval::kOpen || ends == Interval::kRightOpen;
+  return std::string("in ") + (open_lo ? "(" : "[") + FormatShort(lo) + ", " + FormatShort(hi) +
+         (open_hi ? ")" : "]");
+}
+
 class FieldCheck {
  public:
   /// `prefix` is put before every field name, e.g. "series[2]." for the elements of a list.
@@ -80,13 +95,8 @@ class FieldCheck {
   /// In the interval from `lo` to `hi` (finite bounds), ends included as `ends` says.
   FieldCheck& InRange(std::string_view field, double v, double lo, double hi,
                       Interval ends = Interval::kClosed, std::string_view unit = {}) {
-    const bool open_lo = ends == Interval::kOpen || ends == Interval::kLeftOpen;
-    const bool open_hi = ends == Interval::kOpen || ends == Interval::kRightOpen;
-    const bool ok = (open_lo ? v > lo : v >= lo) && (open_hi ? v < hi : v <= hi);
-    if (ok || !ok_) return *this;
-    const std::string range = std::string("in ") + (open_lo ? "(" : "[") + FormatShort(lo) + ", " +
-                              FormatShort(hi) + (open_hi ? ")" : "]");
-    return Expect(false, field, v, WithUnit(range, unit));
+    if (InInterval(v, lo, hi, ends) || !ok_) return *this;
+    return Expect(false, field, v, WithUnit(IntervalText(lo, hi, ends), unit));
   }
 
   /// Integers: at least `lo`.

@@ -29,7 +29,7 @@ struct Measurement {
 struct SensorCoverage {
   Position origin;
   double boresight = 0.0;  ///< [rad]
-  double half_fov = 0.0;   ///< [rad]
+  double half_fov = 0.0;   ///< [rad], in [0, pi]
   double min_range = 0.0;  ///< [m]
   double max_range = 0.0;  ///< [m]
 };
@@ -100,6 +100,9 @@ class MeasurementGrid {
   // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
   // every cell holding particles.
   std::pair<int, int> BucketOf(double px, double py) const;
+  /// Squared distance [m^2] from `p` to the area of bucket (bx, by); the edge buckets reach out
+  /// without end (BucketOf clamps to them).
+  double BucketDistance2(const Position& p, int bx, int by) const;
 
   FilterParams params_;
   bool with_fit_ = false;

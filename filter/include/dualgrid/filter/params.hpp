@@ -135,7 +135,11 @@ struct FilterParams {
   VelocityLikelihood velocity_likelihood = VelocityLikelihood::kRadialFit;
   Normalisation normalisation = Normalisation::kPerCell;
 
-  /// Number of cells along x / y (rounded to the nearest whole cell, at least 1).
+  /// The most cells a grid may have (IsValid), per side and in all: 2e8 cells take about 19 GB
+  /// (MemoryBytes).
+  static constexpr double kMaxCells = 2.0e8;
+  /// Number of cells along x / y (rounded to the nearest whole cell, at least 1); valid
+  /// parameters only (IsValid bounds the count before it is rounded to int).
   int CellsX() const;
   int CellsY() const;
   /// Heap memory of one DynamicGrid with these parameters after its first Update [bytes], from

@@ -30,7 +30,8 @@ struct SumoConfigInputs {
 /// without simulating) writes SUMO's own reading of every option, synonyms and attribute forms
 /// resolved, into a temporary folder that is removed. Throws std::invalid_argument naming the
 /// file (and SUMO's first error line, or the option) when it cannot be read, SUMO refuses it,
-/// it names no net-file, or a time or step length is not a number; std::runtime_error when
+/// it names no net-file or more than one (a list "a.net.xml,b.net.xml": SUMO would merge them),
+/// or a time or step length is not a number; std::runtime_error when
 /// `sumo` cannot be started.
 SumoConfigInputs ReadSumoConfig(const std::filesystem::path& cfg);
 
@@ -69,7 +70,9 @@ struct RouteFileIndex {
 
 /// Adds what `files` define to `index`, each file parsed once; `what` names their role in
 /// messages ("SUMO route file", "SUMO additional file"). Throws std::invalid_argument naming a
-/// file that cannot be read or is not well-formed XML.
+/// file that cannot be read or is not well-formed XML, and "<file>:<line>: <vType id="x">
+/// length="nan": expected in (0, 30] m" for a number of a <vType> (or <carFollowing-...>),
+/// <vehicle>, <trip> or <flow> outside the ranges of vehicle_ranges.hpp, or an unknown vClass.
 void IndexSumoFiles(const std::vector<std::string>& files, const std::string& what,
                     RouteFileIndex* index);
 

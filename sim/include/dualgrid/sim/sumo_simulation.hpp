@@ -125,6 +125,9 @@ class SumoSimulation {
   VehicleState ReadVehicle(const std::string& id);
   // The scenario's type, or (for vehicles of the user's route files) SUMO's, cached by type id.
   const VehicleTypeSpec& TypeOf(const std::string& vehicle, const std::string& type);
+  // libsumo::Simulation::step; SUMO's other exceptions (a definition of the user's files refused
+  // when it is loaded) become std::invalid_argument in one line naming the files.
+  void SumoStep();
   void ApplyDepartures();
   void ApplyActions();
   // Checks the scenario against the loaded network: every route edge exists and consecutive

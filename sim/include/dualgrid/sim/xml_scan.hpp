@@ -21,6 +21,8 @@ class XmlElement {
   std::string_view tag() const { return tag_; }
   /// The attribute's value, or nullptr when the element has none of that name.
   const char* Attribute(std::string_view name) const;
+  /// Name, value, name, value, ..., nullptr (expat's list; valid during the callback only).
+  const char* const* attributes() const { return attributes_; }
   long line() const { return line_; }
   /// 0 for the root element.
   int depth() const { return depth_; }
