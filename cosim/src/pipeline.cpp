@@ -1,13 +1,13 @@
 #include "dualgrid/cosim/pipeline.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <utility>
+
+#include "dualgrid/core/limits.hpp"
 
 namespace dualgrid::cosim {
 
@@ -60,9 +60,8 @@ const std::string& IdRegistry::Name(int id) const {
 
 void CheckFilterMemory(const scenario::ScenarioConfig& config, std::size_t modes) {
   const double need = static_cast<double>(modes) * config.filter.MemoryBytes();
-  const double have =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
-  if (have > 0 && need > 0.8 * have) {
+  const double have = PhysicalMemoryBytes();
+  if (have > 0 && need > kMaxMemoryShare * have) {
     char buf[400];
     std::snprintf(buf, sizeof buf,
                   "%s: key 'filter.num_particles' (%d) with num_birth %d and %d x %d cells: %zu "

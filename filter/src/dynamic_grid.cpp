@@ -72,8 +72,9 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
     throw std::invalid_argument("DynamicGrid::Update: dt must be finite and >= 0, got " +
                                 std::to_string(dt));
   }
-  if (!ego.pose.position.allFinite()) {
-    throw std::invalid_argument("DynamicGrid::Update: ego position is not finite");
+  if (!(ego.pose.position.cwiseAbs().maxCoeff() <= FilterParams::kMaxCentre)) {  // also NaN
+    throw std::invalid_argument(
+        "DynamicGrid::Update: the ego position must be finite with |x|, |y| <= 1e9 m");
   }
   if (!measurement.SharesGeometry(params_) || measurement.builds() == 0 ||
       measurement.origin_index() != OriginFor(ego.pose.position)) {

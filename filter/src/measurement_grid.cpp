@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "dualgrid/core/text.hpp"
 #include "dualgrid/filter/particles.hpp"
 #include "grid_internal.hpp"
 
@@ -75,8 +76,11 @@ bool MeasurementGrid::SharesGeometry(const FilterParams& p) const {
 
 void MeasurementGrid::Build(const Position& centre, std::span<const Measurement> z,
                             std::span<const SensorCoverage> coverage) {
-  if (!centre.allFinite())
-    throw std::invalid_argument("MeasurementGrid::Build: the grid centre is not finite");
+  if (!(centre.cwiseAbs().maxCoeff() <= FilterParams::kMaxCentre)) {  // also NaN
+    throw std::invalid_argument(
+        "MeasurementGrid::Build: the grid centre must be finite with |x|, |y| <= 1e9 m, got " +
+        FormatTuple({centre.x(), centre.y()}));
+  }
   for (const SensorCoverage& c : coverage) {
     // half_fov <= pi: the angle bins (2 half_fov / free_angle_bin) stay bounded.
     if (!c.origin.allFinite() || !std::isfinite(c.boresight) || !(c.half_fov >= 0.0) ||

@@ -15,8 +15,11 @@ namespace dualgrid::filter {
 using namespace detail;
 
 void DynamicGrid::Reframe(double angle, const Position& ego) {
-  if (!std::isfinite(angle) || !ego.allFinite())
-    throw std::invalid_argument("DynamicGrid::Reframe: angle and ego position must be finite");
+  if (!std::isfinite(angle) || !(ego.cwiseAbs().maxCoeff() <= FilterParams::kMaxCentre)) {
+    throw std::invalid_argument(
+        "DynamicGrid::Reframe: the angle must be finite and the ego position finite with |x|, "
+        "|y| <= 1e9 m");
+  }
   if (!initialized_ || angle == 0.0) return;
   sorted_current_ = false;  // the weighted particles stay binned on the old cells
   // New coordinates of a point with old coordinates p: R(-angle) p.

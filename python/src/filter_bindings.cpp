@@ -2,6 +2,7 @@
 // the named presets and DynamicGrid with numpy inputs and outputs (docs/python.md).
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -14,6 +15,7 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "dualgrid/core/limits.hpp"
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
@@ -310,6 +312,21 @@ void CheckIndex(const DynamicGrid& grid, int ix, int iy) {
                           std::to_string(grid.cells_y()) + " cells");
 }
 
+// ValueError when one grid of `params` would need more than the share of this machine's memory
+// the command line allows (kMaxMemoryShare), before anything is allocated: the kernel's
+// out-of-memory killer would otherwise end the interpreter.
+void CheckGridMemory(const FilterParams& params) {
+  const double need = params.MemoryBytes(), have = PhysicalMemoryBytes();
+  if (have <= 0 || need <= kMaxMemoryShare * have) return;
+  char buf[300];
+  std::snprintf(buf, sizeof buf,
+                "DynamicGrid: FilterParams num_particles = %d, num_birth = %d and %d x %d cells "
+                "would need %.1f GB, more than %.0f %% of this machine's %.1f GB",
+                params.num_particles, params.num_birth, params.CellsX(), params.CellsY(),
+                need / 1e9, 100.0 * kMaxMemoryShare, have / 1e9);
+  throw py::value_error(buf);
+}
+
 void BindDynamicGrid(py::module_& m) {
   py::class_<Grid> cls(m, "DynamicGrid", R"doc(
 Radar-only dynamic occupancy grid with position, velocity and dual particle weights
@@ -324,6 +341,7 @@ serialised; update() releases the GIL.)doc");
   cls.def(py::init([](const FilterParams& params, std::uint64_t seed) {
             std::string error;
             if (!params.IsValid(&error)) throw py::value_error("FilterParams: " + error);
+            CheckGridMemory(params);
             return std::make_unique<Grid>(params, seed);
           }),
           py::arg("params") = FilterParams(), py::arg("seed") = 0,

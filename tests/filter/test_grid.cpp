@@ -432,3 +432,30 @@ TEST_CASE("ForEachWeightedCellWhere gives the particles of the cells a layer kee
   CHECK_THROWS_AS(g.ForEachWeightedCellWhere(std::span<const float>(dyn), above(0.5), record),
                   std::logic_error);
 }
+
+TEST_CASE("an ego beyond kMaxCentre is refused before the grid moves", "[filter][measurement]") {
+  // A jump to 1e300 m after the first cycle used to overflow the global cell index (a shift of
+  // ~2^63 cells, cleared column by column: a hang); the bound is checked before anything changes.
+  FilterParams fp;
+  fp.num_particles = 1000;
+  fp.num_birth = 100;
+  DynamicGrid g(fp, 5);
+  Pose2 ego;
+  g.Update({ego, {0, 0}}, {}, {}, 0.05);
+  REQUIRE(g.step() == 1);
+  for (const double far : {1e300, -1e300, 2.0 * FilterParams::kMaxCentre}) {
+    Pose2 jump;
+    jump.position = Vector2(far, 0.0);
+    CHECK_THROWS_AS(g.Update({jump, {0, 0}}, {}, {}, 0.05), std::invalid_argument);
+    jump.position = Vector2(0.0, far);
+    CHECK_THROWS_AS(g.Update({jump, {0, 0}}, {}, {}, 0.05), std::invalid_argument);
+    CHECK_THROWS_AS(g.Reframe(0.1, Vector2(far, 0.0)), std::invalid_argument);
+    MeasurementGrid m(fp);
+    CHECK_THROWS_AS(m.Build(Vector2(far, 0.0), {}, {}), std::invalid_argument);
+  }
+  CHECK(g.step() == 1);  // nothing ran
+  Pose2 edge;            // the bound itself is accepted
+  edge.position = Vector2(FilterParams::kMaxCentre, -FilterParams::kMaxCentre);
+  g.Update({edge, {0, 0}}, {}, {}, 0.05);
+  CHECK(g.step() == 2);
+}

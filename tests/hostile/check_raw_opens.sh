@@ -12,10 +12,6 @@ allowed=(
   "core/src/input_file.cpp:open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)"
   # HDF5 opens by name: CheckInputFile (regular, readable, no loop) runs just before.
   "recorded/src/radarscenes_read.cpp:H5Fopen(h5_name.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT)"
-  # Writers (mode w): outputs, not inputs.
-  "outputs/src/output_file.cpp:gzopen(path.c_str(), \"wb6\")"
-  "outputs/src/output_file.cpp:std::fopen(path.c_str(), \"wb\")"
-  "sim/src/xml_scan.cpp:std::fopen(out.c_str(), \"wb\")"
   # Logs our own child processes (SUMO, netconvert, ffmpeg) just wrote into our output folder.
   "sim/src/sumo_tools.cpp:std::ifstream in(log)"
   "tools/src/child_process.cpp:std::ifstream in(p)"
@@ -34,8 +30,10 @@ while IFS= read -r hit; do
   file=${hit%%:*}
   rest=${hit#*:}
   line=${rest#*:}
-  # Comments, and open() for writing (O_WRONLY): not reads.
+  # Comments, open() for writing (O_WRONLY) and fopen/gzopen in a write or append mode ("w...",
+  # "a..."): writers, not readers.
   [[ "$line" =~ ^[[:space:]]*// || "$line" == *O_WRONLY* ]] && continue
+  [[ "$line" =~ (fopen|gzopen)\(.*,\ *\"[wa][^\"]*\"\) ]] && continue
   ok=0
   for a in "${allowed[@]}"; do
     [[ "$file" == "${a%%:*}" && "$line" == *"${a#*:}"* ]] && ok=1 && break

@@ -54,6 +54,20 @@ class GridBoundTest(unittest.TestCase):
                 with self.assertRaisesRegex(ValueError, key + ".*at most 200000000 cells"):
                     dualgrid.DynamicGrid(dualgrid.FilterParams(**kw), seed=1)
 
+    def test_memory(self):
+        # More particles than 80 % of this machine's memory holds (memory_bytes() is the layout's
+        # estimate, within 5 % of the allocation): refused before anything is allocated, as the
+        # command line refuses it; the largest count the int field holds is far beyond any machine
+        # this suite runs on (2^31 - 1 particles ~ 146 GB).
+        total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        huge = dualgrid.FilterParams(num_particles=2**31 - 1)
+        self.assertGreater(huge.memory_bytes(), 0.8 * total)
+        with self.assertRaisesRegex(ValueError, r"num_particles = 2147483647.*more than 80 % of"):
+            dualgrid.DynamicGrid(huge, seed=1)
+        small = dualgrid.FilterParams(num_particles=1000, num_birth=100)
+        self.assertLess(small.memory_bytes(), 0.8 * total)
+        dualgrid.DynamicGrid(small, seed=1)  # an ordinary size is accepted
+
     def test_half_fov(self):
         grid = dualgrid.DynamicGrid(dualgrid.FilterParams(length_x=20.0, width_y=10.0,
                                                           num_particles=1000, num_birth=100), seed=1)

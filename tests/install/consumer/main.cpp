@@ -62,6 +62,7 @@ int main() {
   o.network_dir = sim::DefaultNetworkDir();
   o.figures = o.record = false;
   o.quiet = true;
+  o.force = true;  // the test's own temporary folder, written again by every run of the test
   const outputs::RunFolderResult r = outputs::WriteRunFolder(run, config, o);
   if (!r.complete || !std::filesystem::exists(o.out / "summary.json")) return 1;
   std::printf("run folder ok\n");

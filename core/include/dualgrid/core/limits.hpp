@@ -19,4 +19,12 @@ inline constexpr int kMaxThreadsPerCore = 4;
 /// The most OpenMP threads a run may ask for: kMaxThreadsPerCore x Cores().
 inline int MaxThreads() { return kMaxThreadsPerCore * Cores(); }
 
+/// The share of the machine's physical memory one configuration may plan to use: more is refused
+/// at once rather than left to the kernel's out-of-memory killer, which would take the process
+/// (or the Python interpreter) with everything already computed.
+inline constexpr double kMaxMemoryShare = 0.8;
+
+/// This machine's physical memory [bytes] (sysconf), 0 when it cannot be read.
+double PhysicalMemoryBytes();
+
 }  // namespace dualgrid

@@ -81,7 +81,8 @@ class DynamicGrid {
   /// geometry (MeasurementGrid::SharesGeometry) can share one: the co-simulation builds it once per
   /// step for its three modes. Same results, bit for bit, as the Update above with the same
   /// inputs. Only the call's duration reads `measurement`. Throws std::invalid_argument when it
-  /// does not share this grid's geometry, was never built, or was built for another position.
+  /// does not share this grid's geometry, was never built, or was built for another position, or
+  /// for an ego position beyond FilterParams::kMaxCentre (or not finite).
   /// `noise`, if not null, holds this cycle's prediction normals, drawn once for filters with the
   /// same seed and step (PredictionNoise::Draw(seed, step(), params().num_particles)): read
   /// instead of drawing them, same results bit for bit; std::invalid_argument if it holds others.
@@ -97,7 +98,8 @@ class DynamicGrid {
   /// moves by at most half a cell diagonal); new cells outside the old grid are unknown. Until the
   /// next Update, weighted_particles() and Cell()'s velocity moments still refer to the old frame.
   /// No-op before the first Update or for angle == 0. O(particles + cells); its scratch layers
-  /// are allocated at the first call. Throws std::invalid_argument for a non-finite input.
+  /// are allocated at the first call. Throws std::invalid_argument for a non-finite input or an
+  /// ego beyond FilterParams::kMaxCentre.
   void Reframe(double angle, const Position& ego);
 
   int cells_x() const { return nx_; }

@@ -69,7 +69,8 @@ class MeasurementGrid {
   /// cycle's EgoInput, after any Reframe). Detections or sensors with non-finite values are
   /// skipped, as in DynamicGrid::Update. O(cells + detections x cutoff area); parallel over rows
   /// (OpenMP), results independent of the thread count. Throws std::invalid_argument for a
-  /// non-finite centre or an invalid SensorCoverage (as DynamicGrid::Update).
+  /// centre that is not finite or beyond FilterParams::kMaxCentre, or an invalid SensorCoverage
+  /// (as DynamicGrid::Update).
   void Build(const Position& centre, std::span<const Measurement> z,
              std::span<const SensorCoverage> coverage);
 

@@ -138,6 +138,10 @@ struct FilterParams {
   /// The most cells a grid may have (IsValid), per side and in all: 2e8 cells take about 19 GB
   /// (MemoryBytes).
   static constexpr double kMaxCells = 2.0e8;
+  /// The largest |x| or |y| [m] of a grid centre (the ego position given to an update): 1e9 m,
+  /// 25 times the Earth's circumference, keeps every global cell index and cell centre exact in
+  /// 64-bit integers and doubles; beyond it DynamicGrid::Update and MeasurementGrid::Build throw.
+  static constexpr double kMaxCentre = 1.0e9;
   /// Number of cells along x / y (rounded to the nearest whole cell, at least 1); valid
   /// parameters only (IsValid bounds the count before it is rounded to int).
   int CellsX() const;
