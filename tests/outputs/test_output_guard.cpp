@@ -1,5 +1,6 @@
 // The output guard (outputs/output_guard.hpp): outputs apart from inputs however the paths are
 // spelled, names confined to the output folder, and folders emptied only of dualgrid's own files.
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -217,6 +218,27 @@ TEST_CASE("A folder is emptied only with --force, and only of dualgrid's own fil
     CHECK(Slurp(out / "precious.txt") == "keep");
     CHECK_FALSE(fs::exists(out / "table.md"));
     CHECK(fs::exists(root / "damaged"));
+  }
+  SECTION("a marker that is no regular file is never read through and removes nothing foreign") {
+    // The marker is read back under --force: a FIFO would block open(), /dev/zero would never
+    // end, a folder or a loop would fail to read. Each must end at once (the checked opener) and
+    // leave the folder's foreign files alone.
+    for (const std::string kind : {"fifo", "folder", "zero", "loop"}) {
+      const fs::path out = root / ("odd_" + kind);
+      PrepareOutputFolder(out);
+      fs::remove(out / kRunMarker);
+      if (kind == "fifo") REQUIRE(mkfifo((out / kRunMarker).c_str(), 0600) == 0);
+      if (kind == "folder") fs::create_directory(out / kRunMarker);
+      if (kind == "zero") fs::create_symlink("/dev/zero", out / kRunMarker);
+      if (kind == "loop") fs::create_symlink(out / kRunMarker, out / kRunMarker);
+      Touch(out / "precious.txt", "keep");
+      try {
+        PrepareOutputFolder(out, {.force = true});
+      } catch (const std::invalid_argument&) {
+        // refused: as good as removing nothing
+      }
+      CHECK(Slurp(out / "precious.txt") == "keep");
+    }
   }
   SECTION("a file where the folder should be is refused") {
     Touch(root / "afile", "keep");
