@@ -5,7 +5,6 @@
 #include "dualgrid/filter/simd.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
@@ -100,12 +99,15 @@ inline void WeighVector(const WeighInputs& in, const CellParticles& c, const flo
   VI jn;
   Nearest(in, c, x, y, d2, jn);
   const auto has = hn::RebindMask(df, hn::Gt(jn, hn::Set(di, -1)));
-  const VI jc = hn::Max(jn, hn::Zero(di));
-  const VF fd =
-      hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(d2, hn::Set(df, in.inv_2sf2)))));
-  const VF e2v = VelocityError(in, vx, vy, jc);
-  const VF fv =
-      hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(e2v, hn::Set(df, in.inv_2v2)))));
+  // Without a detection in any lane both likelihoods are 0 in every lane: the exps and the
+  // gathers are skipped (most vectors of a sparse scene; the same values as computing them).
+  VF fd = hn::Zero(df), fv = hn::Zero(df);
+  if (!hn::AllFalse(df, has)) {
+    const VI jc = hn::Max(jn, hn::Zero(di));
+    fd = hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(d2, hn::Set(df, in.inv_2sf2)))));
+    const VF e2v = VelocityError(in, vx, vy, jc);
+    fv = hn::IfThenElseZero(has, hn::Exp(df, hn::Neg(hn::Mul(e2v, hn::Set(df, in.inv_2v2)))));
+  }
   const VF keep = hn::Set(df, in.keep), one = hn::Set(df, 1.0f);
   // Unobserved and no detection: the decayed prior for both.
   const auto scored = c.observed ? hn::FirstN(df, kMaxLanes) : has;
@@ -125,6 +127,13 @@ inline void WeighVector(const WeighInputs& in, const CellParticles& c, const flo
   acc.vel = hn::Add(acc.vel, wv);
   acc.mode = hn::Add(acc.mode, ModeFactor(in.mode, wp, wv));
   acc.a_dyn = hn::Add(acc.a_dyn, hn::Mul(mf, ModeFactor(in.mode, lp, lv)));
+}
+
+// Copies the m < lanes floats of a vector's tail (a loop, not a library call: a cell's tail is
+// 1-3 particles and sparse scenes have many such cells).
+inline void CopyTail(const float* from, float* to, std::size_t m) {
+  for (std::size_t k = 0; k < kMaxLanes; ++k)
+    if (k < m) to[k] = from[k];
 }
 
 // Lanes of v summed in lane order, in double.
@@ -153,11 +162,11 @@ CellSums WeighParticles(const WeighInputs& in, const CellParticles& c) {
     const std::size_t m = static_cast<std::size_t>(c.hi - i);
     alignas(64) float buf[7][kMaxLanes] = {};
     const float* src[7] = {c.x, c.y, c.vx, c.vy, c.weight, c.w_position, c.w_velocity};
-    for (int a = 0; a < 7; ++a) std::memcpy(buf[a], src[a] + i, m * sizeof(float));
+    for (int a = 0; a < 7; ++a) CopyTail(src[a] + i, buf[a], m);
     WeighVector(in, c, buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], m, acc);
-    std::memcpy(c.weight + i, buf[4], m * sizeof(float));
-    std::memcpy(c.w_position + i, buf[5], m * sizeof(float));
-    std::memcpy(c.w_velocity + i, buf[6], m * sizeof(float));
+    CopyTail(buf[4], c.weight + i, m);
+    CopyTail(buf[5], c.w_position + i, m);
+    CopyTail(buf[6], c.w_velocity + i, m);
   }
   return {LaneSum(acc.slow), LaneSum(acc.fast), LaneSum(acc.pos),
           LaneSum(acc.vel),  LaneSum(acc.mode), LaneSum(acc.a_dyn)};
@@ -186,9 +195,9 @@ double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c) {
     const std::size_t m = static_cast<std::size_t>(c.hi - i);
     alignas(64) float buf[3][kMaxLanes] = {};
     float* const dst[3] = {c.weight + i, c.w_position + i, c.w_velocity + i};
-    for (int a = 0; a < 3; ++a) std::memcpy(buf[a], dst[a], m * sizeof(float));
+    for (int a = 0; a < 3; ++a) CopyTail(dst[a], buf[a], m);
     vector(buf[0], buf[1], buf[2], m);
-    for (int a = 0; a < 3; ++a) std::memcpy(dst[a], buf[a], m * sizeof(float));
+    for (int a = 0; a < 3; ++a) CopyTail(buf[a], dst[a], m);
   }
   return LaneSum(sum);
 }
