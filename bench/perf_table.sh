@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The performance table of docs/performance.md (issues 14 and 25), measured side by side on this
+# The performance table of docs/performance.md (issues 14, 25 and 37), measured side by side on this
 # machine.
 #
 #   bench/perf_table.sh [BUILD_DIR [OLD_BUILD_DIR]]      (defaults: build, none)
@@ -18,9 +18,11 @@
 #     1 ms batch window;
 #   - the floor (round 6, docs/performance.md): bench_filter's BM_Floor* (the prediction's Philox
 #     noise and one pass over the state, no arithmetic) and bench_sim_step (SUMO and the radar
-#     alone, no filters), beside the budgets they leave of the targets.
+#     alone, no filters), beside the budgets they leave of the targets;
+#   - issue 37's floor of the new design: bench_filter's BM_FloorCycle (a cycle's least work) and
+#     bench_floor_e2e (the end-to-end rows' ceiling with every cycle at that floor).
 # The benchmarks run with OMP_WAIT_POLICY=PASSIVE GOMP_SPINCOUNT=300, what `dualgrid` sets for
-# itself. Prints a Markdown table: values, targets (issue 25's; issue 23's for the recorded row)
+# itself. Prints a Markdown table: values, targets (issue 37's)
 # and the loaded / quiet slowdown. Takes ~8 min (new build only) to ~16 min (both). Nothing else
 # should run meanwhile: timings of a busy machine are noise (check `uptime` before).
 set -euo pipefail
@@ -122,6 +124,15 @@ bench_any() {
       printf "%.4f\n", t }'
 }
 
+# The end-to-end rows' ceilings (bench_floor_e2e: each step's source + the floor cycle for three
+# modes, both cores busy): "HIGHWAY/RECORDED" x real time, or nothing when the build has no such
+# benchmark (builds before issue 37).
+floor_e2e() {
+  [[ -x "$1/bench/bench_floor_e2e" ]] || return 0
+  "$1/bench/bench_floor_e2e" 2>/dev/null | grep -o 'ceiling_x_real_time=[0-9.]*' | cut -d= -f2 |
+    awk '{ v[NR] = $1 } END { if (NR == 2) printf "%.1fx/%.1fx\n", v[1], v[2] }'
+}
+
 median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 
 declare -A SAMPLES
@@ -145,6 +156,13 @@ for b in "${BUILDS[@]}"; do
   echo "  $b: bench_filter quiet and loaded" >&2
   add "paper50_quiet|$b" "$(bench "$b" BM_PaperConfig/10000/2/)"
   add "paper700_quiet|$b" "$(bench "$b" BM_PaperHighway/10000/2/)"
+  add "paper50_one|$b" "$(OMP_NUM_THREADS=1 bench "$b" BM_PaperConfig/10000/1/)"
+  # Issue 37's floor of the new design: a cycle's least work (bench/floor_cycle.hpp).
+  add "fc50|$b" "$(bench "$b" BM_FloorCycle/0/2/)"
+  add "fc700|$b" "$(bench "$b" BM_FloorCycle/1/2/)"
+  add "fcnuss|$b" "$(bench "$b" BM_FloorCycle/2/2/)"
+  add "fc50one|$b" "$(OMP_NUM_THREADS=1 bench "$b" BM_FloorCycle/0/1/)"
+  add "e2efloor|$b" "$(floor_e2e "$b")"
   add "nuss_quiet|$b" "$(bench "$b" BM_Scale/2000000/2/)"
   # The floor (round 6): the Philox noise and one pass over the state, no arithmetic; libgomp's
   # default wait policy, the lower figure.
@@ -189,19 +207,22 @@ row() {  # key kind label target
   done
   echo "$line"
 }
-row e2e xrt "highway run, 3 modes, no figures: x real time" ">= 50x; loaded <= 2x slower"
-line="| the default run (recording + figures, no video): x real time | >= 25x |"
+row e2e xrt "highway run, 3 modes, no figures: x real time" ">= 30x; loaded <= 2x slower"
+line="| the default run (recording + figures, no video): x real time | >= 15x |"
 for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med e2e_figures "$b")" xrt) | - | - |"; done
 echo "$line"
 row paper50 cps "filter, paper size, 2 threads, 50 detections: cycles/s" ">= 5,000/s; loaded <= 2x"
 row paper700 cps "filter, paper size, 2 threads, 700 detections: cycles/s" ">= 3,000/s; loaded <= 2x"
+line="| filter, paper size, 1 thread, 50 detections: cycles/s | >= 2,500/s |"
+for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med paper50_one "$b")" cps) | - | - |"; done
+echo "$line"
 line="| filter, Nuss scale (1.44e6 cells, 2e6 + 2e5 particles), 2 threads: ms/cycle | <= 50 ms |"
 for b in "${BUILDS[@]}"; do line+=" $(fmt "$(med nuss_quiet "$b")" ms) | - | - |"; done
 echo "$line"
 line="| replay video of the 60 s highway (\`dualgrid replay\`): s | <= 16 s |"
 for b in "${BUILDS[@]}"; do line+=" $(med video "$b") s | - | - |"; done
 echo "$line"
-line="| recorded sequence, 3 modes, 1 ms window, 2 threads (bench_recorded): x real time | >= 10x (issue 23) |"
+line="| recorded sequence, 3 modes, 1 ms window, 2 threads (bench_recorded): x real time | >= 20x |"
 for b in "${BUILDS[@]}"; do line+=" $(med recorded_quiet "$b")x | - | - |"; done
 echo "$line"
 line="| recorded sequence, dual only, 1 ms window, 2 threads (bench_recorded): x real time | >= 10x (issue 23) |"
@@ -221,4 +242,13 @@ echo "$line"
 line="| SUMO + radar alone, highway, 2 threads, no filters (bench_sim_step): ms per step | 50x = 1.0 ms per step in all |"
 for b in "${BUILDS[@]}"; do line+=" $(med sim_step "$b") ms | - | - |"; done
 echo "$line"
+line="| floor of the new design (BM_FloorCycle): paper 50 / 700 detections, Nuss, 2 threads; paper 50, 1 thread: ms | the four filter rows |"
+for b in "${BUILDS[@]}"; do
+  line+=" $(med fc50 "$b") / $(med fc700 "$b") / $(med fcnuss "$b") / $(med fc50one "$b") ms | - | - |"
+done
+echo "$line"
+line="| ceiling of the end-to-end rows at the floor (bench_floor_e2e): highway / recorded, x real time | the highway and recorded rows |"
+for b in "${BUILDS[@]}"; do line+=" $(med e2efloor "$b") | - | - |"; done
+echo "$line"
+echo "(targets: issue 37's, for a machine whose yardstick prints ~330 us: scale them by 330 / its time here)"
 echo "(medians of $REPS runs for the highway, video and recorded rows, of 3 repetitions for bench_filter; $(date -u +%FT%TZ))"
