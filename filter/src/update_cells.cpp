@@ -81,6 +81,21 @@ std::int32_t FastCells(const FastCellInputs& in, std::int64_t c_lo, std::int64_t
   return n_slow;
 }
 
+// A single mode's other weight `w` (w_velocity in position mode, w_position in velocity mode),
+// normalised in double exactly as ScalarNormalise does, for a cell whose factor for it does not
+// fit in float: literal, rho_p w / sum (that weight is not in q_norm); per cell, rho_p w / sum,
+// or rho_p m / fast_mass without a sum. Particles with weight 0 are left as they are.
+void OtherWeight(const CellParticles& c, float* w, bool literal, double q_norm, double rho_p,
+                 double sum, double fast_mass) {
+  for (std::int64_t i = c.lo; i < c.hi; ++i) {
+    if (c.weight[i] == 0.0f) continue;
+    if (literal)
+      w[i] = static_cast<float>(q_norm > 0.0 && sum > 0.0 ? rho_p * (w[i] / sum) : 0.0);
+    else
+      w[i] = static_cast<float>(sum > 0.0 ? rho_p * w[i] / sum : rho_p * c.weight[i] / fast_mass);
+  }
+}
+
 }  // namespace
 
 detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
@@ -423,13 +438,25 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
         kp = rho_p / (nf.mass_p ? fast_mass : sum_pos);
         kv = rho_p / (nf.mass_v ? fast_mass : sum_vel);
       }
+      // A factor out of float's range matters only for a weight the mode resamples on: a single
+      // mode's other weight is then normalised in double (OtherWeight) and the mode's own weights
+      // take the lanes as everywhere else, so that a mode's results never depend on the
+      // likelihood of the weight it does not use (docs/algorithm.md, "Float state").
       constexpr double kFloatMax = std::numeric_limits<float>::max();
-      if (hi > lo && !(std::abs(kp) <= kFloatMax && std::abs(kv) <= kFloatMax)) {
+      const bool fits_p = std::abs(kp) <= kFloatMax, fits_v = std::abs(kv) <= kFloatMax;
+      const bool uses_p = p.mode != WeightMode::kVelocity, uses_v = p.mode != WeightMode::kPosition;
+      if (hi > lo && ((uses_p && !fits_p) || (uses_v && !fits_v))) {
         ScalarNormalise(cp, literal_norm, fell_back, q_norm, scale, rho_p, sum_pos, sum_vel,
                         fast_mass);
       } else if (hi > lo) {
-        nf.kp = static_cast<float>(kp);
-        nf.kv = static_cast<float>(kv);
+        if (!fits_p)
+          OtherWeight(cp, cp.w_position, literal_norm, q_norm, rho_p, sum_pos, fast_mass);
+        if (!fits_v)
+          OtherWeight(cp, cp.w_velocity, literal_norm, q_norm, rho_p, sum_vel, fast_mass);
+        nf.store_p = fits_p;
+        nf.store_v = fits_v;
+        nf.kp = fits_p ? static_cast<float>(kp) : 0.0f;
+        nf.kv = fits_v ? static_cast<float>(kv) : 0.0f;
         nf.kw = static_cast<float>(kw);
         const double sum_res = NormaliseWeights(nf, cp);
         if (sum_res > 0.0 && !literal_norm) ScaleWeights(static_cast<float>(rho_p / sum_res), cp);

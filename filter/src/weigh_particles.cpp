@@ -184,8 +184,8 @@ double NormaliseWeights(const NormaliseFactors& f, const CellParticles& c) {
     const VF sp = f.mass_p ? m : wp, sv = f.mass_v ? m : wv;
     const VF np = hn::Mul(sp, kp), nv = hn::Mul(sv, kv);
     const VF nw = f.literal ? hn::Mul(ModeFactor(f.mode, sp, sv), kw) : ModeFactor(f.mode, np, nv);
-    hn::StoreU(hn::IfThenElse(live, np, wp), df, pwp);
-    hn::StoreU(hn::IfThenElse(live, nv, wv), df, pwv);
+    if (f.store_p) hn::StoreU(hn::IfThenElse(live, np, wp), df, pwp);
+    if (f.store_v) hn::StoreU(hn::IfThenElse(live, nv, wv), df, pwv);
     hn::StoreU(hn::IfThenElse(live, nw, m), df, pw);
     sum = hn::Add(sum, hn::IfThenElseZero(live, nw));
   };

@@ -56,9 +56,11 @@ CellSums WeighParticles(const WeighInputs& in, const CellParticles& c);
 /// weight m != 0 and weights (wp, wv) gets sources sp = (mass_p ? m : wp), sv = (mass_v ? m : wv),
 /// w_position = sp kp, w_velocity = sv kv and weight = mode(sp, sv) kw (literal) or
 /// mode(w_position, w_velocity) (per cell, scaled afterwards by ScaleWeights). Particles with
-/// weight 0 are left as they are.
+/// weight 0 are left as they are. store_p / store_v false: w_position / w_velocity are left as
+/// they are too (a single mode's other weight, normalised by the caller: UpdateCells).
 struct NormaliseFactors {
   bool mass_p = false, mass_v = false, literal = false;
+  bool store_p = true, store_v = true;
   float kp = 0, kv = 0, kw = 0;
   WeightMode mode = WeightMode::kDual;
 };
