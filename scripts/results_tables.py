@@ -19,9 +19,11 @@ docs/results.md (the tables of its sections 1, 2, 3 and 9 are parsed; a value qu
 taken where it has the most decimals), and prints (Markdown) two tables:
   1. every (scenario, experiment, metric, mode) of both: old and new mean ± 95 % CI half-width,
      the difference, and "moved" when |new - old| exceeds the larger of the two half-widths;
-  2. every (scenario, experiment, metric) whose comparison of two modes changed: the relation of
-     each pair of modes is "a > b" or "a < b", written "a >> b" when the intervals do not overlap
-     (|a - b| > ci_a + ci_b); a row is listed when a relation flipped or gained or lost ">>".
+  2. every pair of modes (per scenario, experiment and metric) whose relation changed: "a > b"
+     (a better: higher D, D_v, F1, lower otherwise), "a >> b" when the intervals do not overlap
+     (|a - b| > ci_a + ci_b); the change is "flipped, intervals apart" (the order turned and the
+     intervals were or are apart), "reordered within intervals", "now apart" or "now within
+     intervals".
 --moved lists only the moved rows of table 1; --metrics restricts both tables.
 
 Exit status: 0 done; 2 bad input (a missing folder or page, an unreadable table: one line naming
@@ -455,29 +457,47 @@ def compare_values(old, new, only_moved, metrics):
 
 
 def relation(values, key_of, a, b, metric):
-    """'a > b' / 'a >> b' (intervals apart) for two modes, better first; None if missing."""
+    """(better mode, apart) for two modes; apart when the intervals do not overlap; None if
+    either is missing."""
     x, y = values.get(key_of(a)), values.get(key_of(b))
     if x is None or y is None or x[0] is None or y[0] is None:
         return None
     sign = 1 if metric in HIGHER_IS_BETTER else -1
-    first, second, fx, fy = (a, b, x, y) if sign * (x[0] - y[0]) >= 0 else (b, a, y, x)
-    apart = abs(x[0] - y[0]) > (x[1] or 0.0) + (y[1] or 0.0)
-    return f"{first[:3]} {'>>' if apart else '>'} {second[:3]}"
+    better = a if sign * (x[0] - y[0]) >= 0 else b
+    return better, abs(x[0] - y[0]) > (x[1] or 0.0) + (y[1] or 0.0)
+
+
+def change_of(old, new):
+    """How the relation of two modes changed, or None when it did not."""
+    if old == new or old is None or new is None:
+        return None if old == new else "appeared or vanished"
+    if old[0] != new[0]:
+        return "**flipped, intervals apart**" if old[1] or new[1] else "reordered within intervals"
+    return "now apart" if new[1] else "now within intervals"
+
+
+def show(rel, a, b):
+    if rel is None:
+        return "—"
+    worse = b if rel[0] == a else a
+    return f"{rel[0][:3]} {'>>' if rel[1] else '>'} {worse[:3]}"
 
 
 def compare_orderings(old, new, metrics):
-    print("\n| scenario | experiment | metric | old (better first) | new (better first) |")
-    print("|---|---|---|---|---|")
-    cases = sorted({k[:3] for k in set(old) & set(new)})
-    for scen, exp, metric in cases:
+    print("\nPairs of modes whose relation changed (better first; >> intervals apart):\n")
+    print("| scenario | experiment | metric | old | new | change |")
+    print("|---|---|---|---|---|---|")
+    pairs = [("position", "velocity"), ("position", "dual"), ("velocity", "dual")]
+    for scen, exp, metric in sorted({k[:3] for k in set(old) & set(new)}):
         if metrics and metric not in metrics:
             continue
-        pairs = [("position", "velocity"), ("position", "dual"), ("velocity", "dual")]
-        rel_old = [relation(old, lambda m: (scen, exp, metric, m), a, b, metric) for a, b in pairs]
-        rel_new = [relation(new, lambda m: (scen, exp, metric, m), a, b, metric) for a, b in pairs]
-        if rel_old != rel_new:
-            show = lambda rs: ", ".join(r or "—" for r in rs)  # noqa: E731
-            print(f"| {scen} | {exp} | {metric} | {show(rel_old)} | {show(rel_new)} |")
+        for a, b in pairs:
+            key_of = lambda m: (scen, exp, metric, m)  # noqa: E731
+            r_old, r_new = relation(old, key_of, a, b, metric), relation(new, key_of, a, b, metric)
+            change = change_of(r_old, r_new)
+            if change:
+                print(f"| {scen} | {exp} | {metric} | {show(r_old, a, b)} | {show(r_new, a, b)} "
+                      f"| {change} |")
 
 
 def main(argv):
