@@ -23,7 +23,9 @@ taken where it has the most decimals), and prints (Markdown) two tables:
      (a better: higher D, D_v, F1, lower otherwise), "a >> b" when the intervals do not overlap
      (|a - b| > ci_a + ci_b); the change is "flipped, intervals apart" (the order turned and the
      intervals were or are apart), "reordered within intervals", "now apart" or "now within
-     intervals".
+     intervals". Two modes equal at the printed precision are a tie, not an order. A page's
+     values carry its rounding: a relation within a printed unit of "apart" may change by
+     rounding alone (compare a page with the OUT folder it was printed from to see which).
 --moved lists only the moved rows of table 1; --metrics restricts both tables.
 
 Exit status: 0 done; 2 bad input (a missing folder or page, an unreadable table: one line naming
@@ -44,7 +46,8 @@ SCENARIO_TITLE = {"simple_road": "Simple road", "highway": "Highway",
 SECTION2_LABEL = {
     "simple_road": "Simple road (beside Table I):",
     "highway": "Highway (beside Table II):",
-    "crossing": "Crossing traffic (4 cars crossing ahead at 15 m/s, perpendicular to the front radar):",
+    "crossing": "Crossing traffic (4 cars crossing ahead at 15 m/s, perpendicular to the front "
+                "radar):",
     "parallel": "Parallel traffic (alongside, perpendicular to the corner radars):",
 }
 # Section 3's rows: experiment folder -> the row's label on the page, in the page's order.
@@ -91,8 +94,9 @@ def fail(message):
 
 
 # ---------------------------------------------------------------------------------------------
-# Reading an OUT folder: {(scenario, experiment, metric, mode): (mean|None, ci|None, decimals)}
-# and {(scenario, metric, mode): the paper's value}; seeds[(scenario, experiment)] = number of seeds.
+# Reading an OUT folder: values {(scenario, experiment, metric, mode): (mean|None, ci|None,
+# decimals)}, paper {(scenario, metric, mode): the paper's value}, seeds {(scenario, experiment):
+# the number of seeds}.
 
 
 def read_experiment(folder):
@@ -103,7 +107,8 @@ def read_experiment(folder):
     except (OSError, ValueError):
         complete = False
     if not complete:
-        print(f"results_tables.py: {folder}: not complete (summary.json), left out", file=sys.stderr)
+        print(f"results_tables.py: {folder}: not complete (summary.json), left out",
+              file=sys.stderr)
         return None
     path = os.path.join(folder, "table.csv")
     try:
@@ -133,11 +138,11 @@ def load_out(out):
         if not os.path.isdir(base):
             continue
         for exp in sorted(os.listdir(base)):
-            rows = read_experiment(os.path.join(base, exp)) if os.path.isdir(
-                os.path.join(base, exp)) else None
+            folder = os.path.join(base, exp)
+            rows = read_experiment(folder) if os.path.isdir(folder) else None
             if rows is None:
                 continue
-            path = os.path.join(base, exp, "table.csv")
+            path = os.path.join(folder, "table.csv")
             for r in rows:
                 key = (scen, exp, r["metric"], r["mode"])
                 values[key] = (number(r["mean"], path, "mean"),
@@ -151,7 +156,8 @@ def load_out(out):
             if exp == same and (scen, alias, metric, mode) not in values:
                 values[(scen, alias, metric, mode)] = v
     if not values:
-        fail(f"{out}: expected experiment folders SCENARIO/EXPERIMENT/table.csv of scripts/ablation.sh")
+        fail(f"{out}: expected experiment folders SCENARIO/EXPERIMENT/table.csv of "
+             "scripts/ablation.sh")
     return values, paper, seeds
 
 
@@ -184,7 +190,8 @@ def paper_cell(paper, scen, metric, mode):
 def metric_table(values, paper, scen, exp, with_paper):
     """Sections 1 and 2: one row per metric, the paper's values beside ours when with_paper."""
     if with_paper:
-        head = "| metric | position | position (paper) | velocity | velocity (paper) | dual | dual (paper) |"
+        head = ("| metric | position | position (paper) | velocity | velocity (paper) | dual "
+                "| dual (paper) |")
     else:
         head = "| metric | position | velocity | dual |"
     lines = [head, "|---|" + "---:|" * (6 if with_paper else 3)]
@@ -210,7 +217,8 @@ def section1(values, paper, seeds):
     if has(values, "simple_road", "preset_paper"):
         out += [f"Simple road ({seeds.get(('simple_road', 'preset_paper'), 0)} seeds):", ""]
         out += metric_table(values, paper, "simple_road", "preset_paper", True) + [""]
-    many = sorted(e for (s, e) in seeds if s == "highway" and re.fullmatch(r"preset_paper_\d+seeds", e))
+    many = sorted(e for (s, e) in seeds
+                  if s == "highway" and re.fullmatch(r"preset_paper_\d+seeds", e))
     for exp in many:
         out += [f"Highway (**{seeds[('highway', exp)]} seeds**):", ""]
         out += metric_table(values, paper, "highway", exp, True) + [""]
@@ -279,7 +287,8 @@ def section9_all(values):
         if not exps:
             continue
         for groups in (["D_v", "D"], ["delta_v", "delta_x", "t_d"]):
-            head = "| configuration |" + "".join(f" {m} {mode[:3]} |" for m in groups for mode in MODES)
+            head = "| configuration |" + "".join(
+                f" {m} {mode[:3]} |" for m in groups for mode in MODES)
             gain = groups[0] == "D_v"
             head += " dual − best single (D_v) |" if gain else ""
             out += [f"#### {scen}: {' '.join(groups)}", "", head,
@@ -428,7 +437,9 @@ def load(source):
 def fmt(v):
     mean, ci, dec = v
     dec = min(dec, 3) if dec else 0
-    return "—" if mean is None else f"{mean:.{dec}f}" + ("" if ci is None else f" ± {ci:.{dec}f}")
+    if mean is None:
+        return "—"
+    return f"{mean:.{dec}f}" + ("" if ci is None else f" ± {ci:.{dec}f}")
 
 
 def moved(a, b):
@@ -457,13 +468,14 @@ def compare_values(old, new, only_moved, metrics):
 
 
 def relation(values, key_of, a, b, metric):
-    """(better mode, apart) for two modes; apart when the intervals do not overlap; None if
-    either is missing."""
+    """(better mode, apart) for two modes: better is None for a tie at the printed precision,
+    apart when the intervals do not overlap; None if either is missing."""
     x, y = values.get(key_of(a)), values.get(key_of(b))
     if x is None or y is None or x[0] is None or y[0] is None:
         return None
     sign = 1 if metric in HIGHER_IS_BETTER else -1
-    better = a if sign * (x[0] - y[0]) >= 0 else b
+    d = sign * (x[0] - y[0])
+    better = None if abs(d) < 0.5 * 10.0 ** -min(x[2], y[2]) else (a if d > 0 else b)
     return better, abs(x[0] - y[0]) > (x[1] or 0.0) + (y[1] or 0.0)
 
 
@@ -471,6 +483,8 @@ def change_of(old, new):
     """How the relation of two modes changed, or None when it did not."""
     if old == new or old is None or new is None:
         return None if old == new else "appeared or vanished"
+    if old[0] != new[0] and old[1] == new[1] and None in (old[0], new[0]):
+        return None  # a tie at the printed precision on one side, nothing else changed
     if old[0] != new[0]:
         return "**flipped, intervals apart**" if old[1] or new[1] else "reordered within intervals"
     return "now apart" if new[1] else "now within intervals"
@@ -479,6 +493,8 @@ def change_of(old, new):
 def show(rel, a, b):
     if rel is None:
         return "—"
+    if rel[0] is None:
+        return f"{a[:3]} = {b[:3]}"
     worse = b if rel[0] == a else a
     return f"{rel[0][:3]} {'>>' if rel[1] else '>'} {worse[:3]}"
 
