@@ -16,16 +16,15 @@ the line that introduces it on the page (a label or a heading).
 
 `compare` reads OLD and NEW, each an OUT folder or a Markdown page in the format of
 docs/results.md (the tables of its sections 1, 2, 3 and 9 are parsed; a value quoted twice is
-taken where it has the most decimals), and prints (Markdown) two tables:
+taken where it has the most decimals; each value is compared at the coarser of its two
+precisions), and prints (Markdown) two tables:
   1. every (scenario, experiment, metric, mode) of both: old and new mean ± 95 % CI half-width,
      the difference, and "moved" when |new - old| exceeds the larger of the two half-widths;
   2. every pair of modes (per scenario, experiment and metric) whose relation changed: "a > b"
      (a better: higher D, D_v, F1, lower otherwise), "a >> b" when the intervals do not overlap
      (|a - b| > ci_a + ci_b); the change is "flipped, intervals apart" (the order turned and the
      intervals were or are apart), "reordered within intervals", "now apart" or "now within
-     intervals". Two modes equal at the printed precision are a tie, not an order. A page's
-     values carry its rounding: a relation within a printed unit of "apart" may change by
-     rounding alone (compare a page with the OUT folder it was printed from to see which).
+     intervals". Two modes equal at the printed precision are a tie, not an order.
 --moved lists only the moved rows of table 1; --metrics restricts both tables.
 
 Exit status: 0 done; 2 bad input (a missing folder or page, an unreadable table: one line naming
@@ -442,10 +441,22 @@ def fmt(v):
     return f"{mean:.{dec}f}" + ("" if ci is None else f" ± {ci:.{dec}f}")
 
 
+def at_common_precision(old, new):
+    """Both sets restricted to their common keys, each value rounded to the coarser of its two
+    precisions (a page's values are rounded; an OUT folder's are not)."""
+    def rounded(v, dec):
+        mean, ci, _ = v
+        return (None if mean is None else round(mean, dec),
+                None if ci is None else round(ci, dec), dec)
+    keys = set(old) & set(new)
+    dec = {k: min(old[k][2], new[k][2]) for k in keys}
+    return ({k: rounded(old[k], dec[k]) for k in keys}, {k: rounded(new[k], dec[k]) for k in keys})
+
+
 def moved(a, b):
     if a[0] is None or b[0] is None:
         return a[0] is not b[0]
-    return abs(b[0] - a[0]) > max(a[1] or 0.0, b[1] or 0.0)
+    return round(abs(b[0] - a[0]), b[2]) > max(a[1] or 0.0, b[1] or 0.0)
 
 
 def compare_values(old, new, only_moved, metrics):
@@ -476,15 +487,16 @@ def relation(values, key_of, a, b, metric):
     sign = 1 if metric in HIGHER_IS_BETTER else -1
     d = sign * (x[0] - y[0])
     better = None if abs(d) < 0.5 * 10.0 ** -min(x[2], y[2]) else (a if d > 0 else b)
-    return better, abs(x[0] - y[0]) > (x[1] or 0.0) + (y[1] or 0.0)
+    dec = min(x[2], y[2])
+    return better, round(abs(x[0] - y[0]), dec) > round((x[1] or 0.0) + (y[1] or 0.0), dec)
 
 
 def change_of(old, new):
     """How the relation of two modes changed, or None when it did not."""
     if old == new or old is None or new is None:
         return None if old == new else "appeared or vanished"
-    if old[0] != new[0] and old[1] == new[1] and None in (old[0], new[0]):
-        return None  # a tie at the printed precision on one side, nothing else changed
+    if None in (old[0], new[0]):  # a tie at the printed precision on one side
+        return None if old[1] == new[1] else ("now apart" if new[1] else "now within intervals")
     if old[0] != new[0]:
         return "**flipped, intervals apart**" if old[1] or new[1] else "reordered within intervals"
     return "now apart" if new[1] else "now within intervals"
@@ -541,7 +553,7 @@ def main(argv):
                 metrics, rest = set(rest[1].split(",")), rest[2:]
             else:
                 fail(f"unknown option '{rest[0]}'\n{usage}")
-        old, new = load(argv[1]), load(argv[2])
+        old, new = at_common_precision(load(argv[1]), load(argv[2]))
         compare_values(old, new, only_moved, metrics)
         compare_orderings(old, new, metrics)
         return 0
