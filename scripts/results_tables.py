@@ -11,8 +11,9 @@ looks finished. `fit_none` and `fit_both` fall back to `bdoppler_zkeep_lradial` 
 `preset_dualgrid` when missing (the same settings: the dualgrid preset with Doppler births and the
 radial likelihood, and the dualgrid preset itself).
 
-`tables` prints the Markdown tables of the four sections in the page's formats, each preceded by
-the line that introduces it on the page (a label or a heading).
+`tables` prints, per section, a comment line `<!-- section N -->` and the Markdown tables of the
+section in the page's formats, each preceded by the line that introduces it on the page (a label
+or a heading); section 9 ends with scripts/ablation.sh's own table of the fit_* experiments.
 
 `compare` reads OLD and NEW, each an OUT folder or a Markdown page in the format of
 docs/results.md (the tables of its sections 1, 2, 3 and 9 are parsed; a value quoted twice is
