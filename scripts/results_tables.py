@@ -35,6 +35,7 @@ import csv
 import json
 import os
 import re
+import signal
 import sys
 
 MODES = ["position", "velocity", "dual"]
@@ -562,4 +563,5 @@ def main(argv):
 
 
 if __name__ == "__main__":
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `... | head` ends quietly
     sys.exit(main(sys.argv[1:]))
