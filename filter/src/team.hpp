@@ -59,14 +59,14 @@ void ForRoundRobin(const Team& t, std::int64_t n, Body&& body) {
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
-/// body(i) for i in [0, n): schedule(dynamic, 1), then a barrier.
+/// body(i) for i in [0, n): schedule(dynamic, chunk), then a barrier.
 template <typename Body>
-void ForDynamic(const Team& t, std::int64_t n, Body&& body) {
+void ForDynamic(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk = 1) {
   if (!t.shared) {
     for (std::int64_t i = 0; i < n; ++i) body(i);
     return;
   }
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(dynamic, chunk)
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
