@@ -65,13 +65,20 @@ Position DynamicGrid::CellCenter(CellIndex c) const {
 void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measurements,
                          std::span<const SensorCoverage> coverage, double dt) {
   if (!own_measurement_) own_measurement_.emplace(params_);
-  // Build refuses a non-finite centre or coverage before anything changes.
-  own_measurement_->Build(ego.pose.position, measurements, coverage);  // 4. measurement grid
-  Update(ego, *own_measurement_, dt);
+  // Prepare refuses a non-finite centre or coverage before anything changes; the tables are
+  // filled in the cycle's region (4. measurement grid, MeasurementGrid::Fill).
+  own_measurement_->Prepare(ego.pose.position, measurements, coverage);
+  Run(ego, *own_measurement_, dt, nullptr, &*own_measurement_, coverage);
 }
 
 void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
                          const PredictionNoise* noise) {
+  Run(ego, measurement, dt, noise, nullptr, {});
+}
+
+void DynamicGrid::Run(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+                      const PredictionNoise* noise, MeasurementGrid* fill,
+                      std::span<const SensorCoverage> coverage) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) {
     throw std::invalid_argument("DynamicGrid::Update: dt must be finite and >= 0, got " +
                                 std::to_string(dt));
@@ -80,7 +87,7 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
     throw std::invalid_argument(
         "DynamicGrid::Update: the ego position must be finite with |x|, |y| <= 1e9 m");
   }
-  if (!measurement.SharesGeometry(params_) || measurement.builds() == 0 ||
+  if (!measurement.SharesGeometry(params_) || (fill == nullptr && measurement.builds() == 0) ||
       measurement.origin_index() != OriginFor(ego.pose.position)) {
     throw std::invalid_argument(
         "DynamicGrid::Update: the MeasurementGrid was not built for this grid (another geometry, "
@@ -106,11 +113,15 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
   PrepareCycle(z.size());
   sorted_gx_ = origin_gx_;  // the cells the particles are sorted on below
   sorted_gy_ = origin_gy_;
+  const auto cycle = [&](const Team& t) {
+    if (fill != nullptr) fill->Fill(t, coverage);  // 4. measurement grid, 4a. Doppler fit
+    Cycle(t, z, dt, noise, first);
+  };
   if (OneThreadHere()) {  // no team to build (dualgrid/core/parallel.hpp)
-    Cycle(Team::Solo(), z, dt, noise, first);
+    cycle(Team::Solo());
   } else {
 #pragma omp parallel
-    Cycle(Team::OfRegion(), z, dt, noise, first);
+    cycle(Team::OfRegion());
   }
   shift_gx_ = shift_gy_ = 0;  // applied in the prediction
   sorted_current_ = true;     // sorted_ and cell_start_ bin the particles on the current cells

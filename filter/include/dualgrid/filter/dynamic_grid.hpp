@@ -73,8 +73,17 @@ class DynamicGrid {
   DynamicGrid(const FilterParams& params, std::uint64_t seed);
 
   /// One filter cycle. The first call initialises the grid around the ego. `dt` >= 0 [s].
-  /// Builds this cycle's measurement grid (MeasurementGrid::Build on ego.pose.position) and runs
-  /// the cycle on it. The grid's own MeasurementGrid is allocated at the first call.
+  /// Builds this cycle's measurement grid (as MeasurementGrid::Build on ego.pose.position) and
+  /// runs the cycle on it, both in the one parallel region below. The grid's own MeasurementGrid
+  /// is allocated at the first call.
+  ///
+  /// Threads (both Update overloads): one OpenMP parallel region per call, with the team the
+  /// calling thread would get (omp_get_max_threads()), barriers between the cycle's stages; no
+  /// region at all when a region here would get one thread (dualgrid/core/parallel.hpp,
+  /// OneThreadHere: one thread allowed, or the caller is inside a region and no further level may
+  /// be active). May be called from inside a parallel region (its region then nests there);
+  /// distinct grids may be updated by distinct threads at once. Results are the same bits for any
+  /// team size. Threads that wait at a barrier follow OMP_WAIT_POLICY (dualgrid sets PASSIVE).
   void Update(const EgoInput& ego, std::span<const Measurement> measurements,
               std::span<const SensorCoverage> coverage, double dt);
   /// One filter cycle on a measurement grid built for it: `measurement.Build(ego.pose.position,
@@ -200,6 +209,12 @@ class DynamicGrid {
   // Team; the stages below are called by every thread of the team in the same order, separated
   // by the team's barriers, and neither allocate nor throw. Each value is computed by one thread
   // from the same inputs, so the results do not depend on the team's size.
+  // The checks of Update (throws), then the cycle on `measurement`; with `fill` (the grid's own
+  // MeasurementGrid, prepared: MeasurementGrid::Prepare), its tables are filled first, in the
+  // same region.
+  void Run(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+           const PredictionNoise* noise, MeasurementGrid* fill,
+           std::span<const SensorCoverage> coverage);
   void PrepareCycle(std::size_t detections);
   void Cycle(const detail::Team& t, std::span<const Measurement> z, double dt,
              const PredictionNoise* noise, bool first);
