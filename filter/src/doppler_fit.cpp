@@ -138,7 +138,7 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
     det_fit_t_[j] = f.vx * tx + f.vy * ty;
     det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
   };
-  ForDynamic(t, nz, fit, 32);
+  ForDynamicNoWait(t, nz, fit, 32);  // Fill's contract: no barrier at the end
 }
 
 }  // namespace dualgrid::filter

@@ -114,7 +114,9 @@ void DynamicGrid::Run(const EgoInput& ego, const MeasurementGrid& measurement, d
   sorted_gx_ = origin_gx_;  // the cells the particles are sorted on below
   sorted_gy_ = origin_gy_;
   const auto cycle = [&](const Team& t) {
-    if (fill != nullptr) fill->Fill(t, coverage);  // 4. measurement grid, 4a. Doppler fit
+    // 4. measurement grid, 4a. Doppler fit. Fill ends without a barrier: the cycle reads its
+    // tables only after the prediction's and the sort's first barriers (PredictAndSort).
+    if (fill != nullptr) fill->Fill(t, coverage);
     Cycle(t, z, dt, noise, first);
   };
   if (OneThreadHere()) {  // no team to build (dualgrid/core/parallel.hpp)

@@ -148,9 +148,13 @@ void MeasurementGrid::Fill(const Team& t, std::span<const SensorCoverage> covera
     Bins(coverage);
     FieldOfViewTables(coverage);
   });
+  // The stamp's barrier: the buckets, lines of sight (the fit) and bins (the field of view) are
+  // ready after it.
   ForDynamic(t, kStampBands, [&](std::int64_t b) { StampBand(static_cast<int>(b)); });
-  // Field of view and ray free space per cell (rows: each cell has one writer).
-  ForDynamic(
+  // Field of view and ray free space per cell (rows: each cell has one writer), then the fit,
+  // which reads none of it: no barrier between them, nor after them. Build's region ends here;
+  // DynamicGrid's cycle reads these tables only after two more of its barriers.
+  ForDynamicNoWait(
       t, ny_, [&](std::int64_t ly) { FieldOfViewRow(static_cast<int>(ly), coverage); }, 2);
   if (with_fit_) FitDetectionVelocities(t);
   SingleNoWait(t, [&] { ++builds_; });

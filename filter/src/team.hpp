@@ -70,6 +70,18 @@ void ForDynamic(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk =
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
+/// ForDynamic without the barrier: a thread that runs out of iterations goes on at once (the
+/// caller orders any reader of the results behind a later barrier).
+template <typename Body>
+void ForDynamicNoWait(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk = 1) {
+  if (!t.shared) {
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+    return;
+  }
+#pragma omp for schedule(dynamic, chunk) nowait
+  for (std::int64_t i = 0; i < n; ++i) body(i);
+}
+
 /// Every thread waits here for the others.
 inline void Barrier(const Team& t) {
   if (!t.shared) return;

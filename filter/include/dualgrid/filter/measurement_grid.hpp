@@ -97,7 +97,8 @@ class MeasurementGrid {
   // Build in two parts. Prepare (serial): checks the inputs (throws), places the grid and the
   // detections (PlaceDetections) and sizes every array the build writes. Fill: the tables, by
   // the team t (detail::Team's contract: every thread of it calls Fill; no allocation, no throw).
-  // DynamicGrid::Update runs Fill in the cycle's own region.
+  // Fill ends without a barrier: the tables are complete for a reader only after the team's next
+  // barrier (Build: its region's end). DynamicGrid::Update runs Fill in the cycle's own region.
   void Prepare(const Position& centre, std::span<const Measurement> z,
                std::span<const SensorCoverage> coverage);
   void Fill(const detail::Team& t, std::span<const SensorCoverage> coverage);
@@ -115,7 +116,7 @@ class MeasurementGrid {
   // Per detection the unit line of sight and the signed radial speed into det_los_.
   void ComputeLinesOfSight();
   // Per detection the tangential velocity a robust fit to its neighbours' Doppler gives, and its
-  // standard deviation (inf: no fit), by the team t.
+  // standard deviation (inf: no fit), by the team t; no barrier at the end.
   void FitDetectionVelocities(const detail::Team& t);
   // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
   // every cell holding particles.
