@@ -150,7 +150,12 @@ void MeasurementGrid::Fill(const Team& t, std::span<const SensorCoverage> covera
   });
   // The stamp's barrier: the buckets, lines of sight (the fit) and bins (the field of view) are
   // ready after it.
-  ForDynamic(t, kStampBands, [&](std::int64_t b) { StampBand(static_cast<int>(b)); });
+  if (t.shared) {
+    ForDynamic(t, kStampBands,
+               [&](std::int64_t b) { StampBands(static_cast<int>(b), static_cast<int>(b) + 1); });
+  } else {
+    StampBands(0, kStampBands);  // one pass over the detections
+  }
   // Field of view and ray free space per cell (rows: each cell has one writer), then the fit,
   // which reads none of it: no barrier between them, nor after them. Build's region ends here;
   // DynamicGrid's cycle reads these tables only after two more of its barriers.
@@ -213,18 +218,19 @@ void MeasurementGrid::FillBuckets() {
   }
 }
 
-void MeasurementGrid::StampBand(int band) {
+void MeasurementGrid::StampBands(int band_lo, int band_hi) {
   const std::span<const Measurement> z = z_;
   const double r = params_.resolution;
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
   const int rc = static_cast<int>(std::ceil(cutoff / r));
-  std::vector<std::int64_t>& touched = touched_[band];
-  for (std::int64_t s : touched) {
-    near_det_[s] = -1;
-    near_d2_[s] = kInf;
+  for (int band = band_lo; band < band_hi; ++band) {
+    for (std::int64_t s : touched_[band]) {
+      near_det_[s] = -1;
+      near_d2_[s] = kInf;
+    }
+    touched_[band].clear();  // keeps the capacity PlaceDetections reserved
   }
-  touched.clear();  // keeps the capacity PlaceDetections reserved
-  const int row_a = band * ny_ / kStampBands, row_b = (band + 1) * ny_ / kStampBands;
+  const int row_a = band_lo * ny_ / kStampBands, row_b = band_hi * ny_ / kStampBands;
   const std::int64_t sx0 = Mod(origin_gx_, nx_);
   const int nz = static_cast<int>(z.size());
   for (int j = 0; j < nz; ++j) {
@@ -232,8 +238,12 @@ void MeasurementGrid::StampBand(int band) {
     const Position& p = z[j].position;
     const auto [lx, ly, row_lo] = det_stamp_[j];
     const int cy_lo = std::max(0, ly - rc), cy_hi = std::min(ny_ - 1, ly + rc);
+    // Its storage rows row_lo .. end - 1 (mod ny): skip it unless they meet [row_a, row_b).
+    const int end = row_lo + cy_hi - cy_lo + 1;
+    if (!((row_lo < row_b && std::min(end, ny_) > row_a) || end - ny_ > row_a)) continue;
     for (int cy = cy_lo, srow = row_lo; cy <= cy_hi; ++cy, srow = srow + 1 == ny_ ? 0 : srow + 1) {
       if (srow < row_a || srow >= row_b) continue;
+      std::vector<std::int64_t>& touched = touched_[band_of_row_[srow]];
       const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
       const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
       for (int cx = std::max(0, lx - rc); cx <= std::min(nx_ - 1, lx + rc); ++cx) {

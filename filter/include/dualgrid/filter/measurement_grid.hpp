@@ -106,10 +106,11 @@ class MeasurementGrid {
   void PlaceDetections();
   // The detection buckets' ranges and contents in bucket order (serial).
   void FillBuckets();
-  // Nearest detection per cell centre of one band of storage rows (kStampBands bands): resets
-  // the band's cells of the last build, then stamps every detection's cells in the band in
-  // detection order (ties to the lower index whatever the band or thread).
-  void StampBand(int band);
+  // Nearest detection per cell centre of the bands [band_lo, band_hi) of storage rows
+  // (kStampBands bands): resets the bands' cells of the last build, then stamps every
+  // detection's cells in them in detection order (ties to the lower index whatever the bands
+  // or thread).
+  void StampBands(int band_lo, int band_hi);
   void Bins(std::span<const SensorCoverage> cov);               // the bins' ranges (serial)
   void FieldOfViewTables(std::span<const SensorCoverage> cov);  // per-sensor constants (serial)
   void FieldOfViewRow(int ly, std::span<const SensorCoverage> cov);  // view_ of logical row ly
