@@ -59,19 +59,15 @@ void ForRoundRobin(const Team& t, std::int64_t n, Body&& body) {
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
-/// body(i) for i in [0, n): schedule(dynamic, chunk), then a barrier.
-template <typename Body>
-void ForDynamic(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk = 1) {
-  if (!t.shared) {
-    for (std::int64_t i = 0; i < n; ++i) body(i);
-    return;
-  }
-#pragma omp for schedule(dynamic, chunk)
-  for (std::int64_t i = 0; i < n; ++i) body(i);
+/// Every thread waits here for the others.
+inline void Barrier(const Team& t) {
+  if (!t.shared) return;
+#pragma omp barrier
 }
 
-/// ForDynamic without the barrier: a thread that runs out of iterations goes on at once (the
-/// caller orders any reader of the results behind a later barrier).
+/// body(i) for i in [0, n): schedule(dynamic, chunk), without a barrier: a thread that runs out
+/// of iterations goes on at once (the caller orders any reader of the results behind a later
+/// barrier).
 template <typename Body>
 void ForDynamicNoWait(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk = 1) {
   if (!t.shared) {
@@ -82,10 +78,11 @@ void ForDynamicNoWait(const Team& t, std::int64_t n, Body&& body, std::int64_t c
   for (std::int64_t i = 0; i < n; ++i) body(i);
 }
 
-/// Every thread waits here for the others.
-inline void Barrier(const Team& t) {
-  if (!t.shared) return;
-#pragma omp barrier
+/// ForDynamicNoWait, then a barrier.
+template <typename Body>
+void ForDynamic(const Team& t, std::int64_t n, Body&& body, std::int64_t chunk = 1) {
+  ForDynamicNoWait(t, n, body, chunk);
+  Barrier(t);
 }
 
 /// f() on one thread, then a barrier.
