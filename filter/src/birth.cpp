@@ -19,13 +19,21 @@ namespace {
 constexpr std::int64_t kChunksPerBlock = kScanBlock / kCellChunk;
 }  // namespace
 
-bool DynamicGrid::BirthMass(const Team& t) {
+bool DynamicGrid::BirthMass(const Team& t, BirthSums& sums) {
+  static_assert(BirthSums::kBlocks * kChunksPerBlock == BirthSums::kChunks);
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
   const std::int64_t nc = num_cells_;
   // Prefix sums of the birth masses with the summation order of ExclusiveScan (blocks of
   // kScanBlock), without materialising them: block totals here, running sums in DrawBirths.
   const std::int64_t blocks = (nc + kScanBlock - 1) / kScanBlock;
-  double* const tot = born_block_.data();  // blocks + 1 (the constructor's)
+  // Few blocks (the paper size: 2): every thread sums them itself into its own `sums` (the same
+  // sums in the same order), so no thread waits for another here. Otherwise the team shares
+  // born_block_ (blocks + 1) and born_chunk_acc_.
+  const bool few = blocks <= BirthSums::kBlocks;
+  double* const tot = few ? sums.own_tot : born_block_.data();
+  double* const chunk_acc = few ? sums.own_chunk_acc : born_chunk_acc_.data();
+  sums.tot = tot;
+  sums.chunk_acc = chunk_acc;
   // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so only the cells of
   // UpdateCells' per-chunk lists (non-zero mass, in cell order) are visited: same sums.
   const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
@@ -41,15 +49,14 @@ bool DynamicGrid::BirthMass(const Team& t) {
   const auto scan = [&] {
     tot[0] = 0.0;
     for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
-    if (nb > 0 && !(tot[blocks] > 0.0)) {  // no birth mass: zero-weight births
-      std::fill(births_.weight.begin(), births_.weight.end(), 0.0f);
-      std::fill(births_.w_position.begin(), births_.w_position.end(), 0.0f);
-      std::fill(births_.w_velocity.begin(), births_.w_velocity.end(), 0.0f);
-    }
+  };
+  const auto zero_births = [&] {  // no birth mass: zero-weight births
+    std::fill(births_.weight.begin(), births_.weight.end(), 0.0f);
+    std::fill(births_.w_position.begin(), births_.w_position.end(), 0.0f);
+    std::fill(births_.w_velocity.begin(), births_.w_velocity.end(), 0.0f);
   };
   // Running sum at each chunk start (sequential from the block base, as in DrawBirths), so that
   // the births can be generated chunk by chunk (load balance: births cluster in few blocks).
-  double* const chunk_acc = born_chunk_acc_.data();
   const auto chunk_sums = [&](std::int64_t b) {
     double acc = tot[b];
     for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
@@ -59,28 +66,29 @@ bool DynamicGrid::BirthMass(const Team& t) {
       for (std::int32_t k = 0; k < born_count_[ch]; ++k) acc += born_[list[k]];
     }
   };
-  // Few blocks (the paper size: 2): one thread does it all, one barrier.
-  if (blocks <= 8) {
-    Single(t, [&] {
-      for (std::int64_t b = 0; b < blocks; ++b) block_total(b);
-      scan();
-      if (nb > 0 && tot[blocks] > 0.0)
-        for (std::int64_t b = 0; b < blocks; ++b) chunk_sums(b);
-    });
-    return nb > 0 && tot[blocks] > 0.0;
+  if (few) {
+    for (std::int64_t b = 0; b < blocks; ++b) block_total(b);
+    scan();
+  } else {
+    ForStatic(t, blocks, block_total);
+    Single(t, scan);  // every thread reads the same total below
   }
-  ForStatic(t, blocks, block_total);
-  Single(t, scan);
-  if (!(nb > 0 && tot[blocks] > 0.0)) return false;  // every thread reads the same total
-  ForStatic(t, blocks, chunk_sums);
+  const bool draw = nb > 0 && tot[blocks] > 0.0;
+  if (nb > 0 && !draw) SingleNoWait(t, zero_births);  // read after a later barrier (Cycle)
+  if (!draw) return false;
+  if (few) {
+    for (std::int64_t b = 0; b < blocks; ++b) chunk_sums(b);
+  } else {
+    ForStatic(t, blocks, chunk_sums);
+  }
   return true;
 }
 
-void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z) {
+void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z, const BirthSums& sums) {
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
   const std::int64_t nc = num_cells_;
   const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
-  const double* const tot = born_block_.data();
+  const double* const tot = sums.tot;
   const double total = tot[(nc + kScanBlock - 1) / kScanBlock];
   // New-born particles are spread over cells in proportion to their birth mass (systematic
   // allocation, SystematicRanges); every birth carries the same mass total / num_birth.
@@ -94,7 +102,7 @@ void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z) {
     if (i == nc) return nb;
     return std::clamp(CeilToInt(cumulative * scale - u), std::int64_t{0}, nb);
   };
-  const double* const chunk_acc = born_chunk_acc_.data();
+  const double* const chunk_acc = sums.chunk_acc;
   ForDynamic(t, n_chunks, [&](std::int64_t ch) {
     const std::int64_t b = ch / kChunksPerBlock;
     const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;

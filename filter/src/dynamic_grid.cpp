@@ -145,10 +145,11 @@ void DynamicGrid::Cycle(const Team& t, std::span<const Measurement> z, double dt
   // 4. measurement grid and 4a. Doppler fit: in `measurement` (MeasurementGrid::Build).
   UpdateCells(t, z);  // 5.-6. occupancy update, weights, 9. statistics
   // 7. birth, with the resampling's prefix sums over the persistent particles beside it.
-  const bool births = BirthMass(t);
+  BirthSums sums;  // this thread's own
+  const bool births = BirthMass(t, sums);
   SingleNoWait(t, [&] { ScanPersistent(); });
   if (births) {
-    DrawBirths(t, z);
+    DrawBirths(t, z, sums);
   } else {
     Barrier(t);
   }

@@ -103,10 +103,14 @@ void DynamicGrid::PredictAndSort(const Team& t, std::span<const Measurement> z, 
   // detection tables and the copy of the field-of-view bits (Cell, ExportMasses), which nothing
   // before the cell update reads.
   ForStatic(t, chunks, predict_and_count);
-  ForStatic(t, nblocks, block_total);
+  // Few blocks (the paper size: 20): their totals on the scanning thread, one barrier fewer.
+  const bool few = nblocks <= 32;
+  if (!few) ForStatic(t, nblocks, block_total);
   Both(
       t,
       [&] {
+        if (few)
+          for (std::int64_t b = 0; b < nblocks; ++b) block_total(b);
         scan_blocks();
         std::copy(mg_->view_.begin(), mg_->view_.end(), view_.begin());  // same size
       },

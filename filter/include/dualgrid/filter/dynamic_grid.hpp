@@ -233,9 +233,17 @@ class DynamicGrid {
                        double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
                        double fast_mass) const;
   // Step 7 in two parts: the birth mass's prefix sums (true when births are to be drawn; false
-  // leaves zero-weight births), then the births themselves.
-  bool BirthMass(const detail::Team& t);
-  void DrawBirths(const detail::Team& t, std::span<const Measurement> z);
+  // leaves zero-weight births once the team's next barrier is passed), then the births
+  // themselves. The sums: block totals `tot` and running sums at each cell chunk's start
+  // `chunk_acc`, either the thread's own (few blocks: each thread computes them) or the team's
+  // shared born_block_ / born_chunk_acc_.
+  struct BirthSums {
+    static constexpr int kBlocks = 8, kChunks = 256;  // own arrays: scan blocks, cell chunks
+    double own_tot[kBlocks + 1], own_chunk_acc[kChunks];
+    const double *tot = nullptr, *chunk_acc = nullptr;
+  };
+  bool BirthMass(const detail::Team& t, BirthSums& sums);
+  void DrawBirths(const detail::Team& t, std::span<const Measurement> z, const BirthSums& sums);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                       std::int64_t k_hi, double mass, double vmax);
