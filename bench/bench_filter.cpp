@@ -2,6 +2,7 @@
 //   bench_filter --benchmark_filter=Paper    (10k particles, 200 m x 25 m at 0.5 m)
 //   bench_filter --benchmark_filter=Scale    (1e5 .. 2e6 particles, 10 % births, 1.4e6 cells)
 //   bench_filter --benchmark_filter=Floor    (floors: the noise, one pass, a whole float cycle)
+//   bench_filter --benchmark_filter=Barrier  (what a barrier's wake-up costs on this machine)
 // Arguments: particles, threads (OpenMP). Results: docs/performance.md.
 #include <benchmark/benchmark.h>
 
@@ -301,6 +302,36 @@ BENCHMARK(BM_FloorCycle)
     ->Args({2, 2})
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
+
+// 4. What one barrier of the cycle's region costs on this machine (docs/performance.md, issue
+//    37, third part): two threads cross 200 barriers; before each, thread 0 works `late` us
+//    (argument) while thread 1 waits, so with OMP_WAIT_POLICY=PASSIVE it sleeps and must be
+//    woken. Counter us_per_barrier: wall time per barrier beyond the work.
+double BusyFor(double us) {
+  const double t0 = omp_get_wtime();
+  double x = 0.0;
+  while ((omp_get_wtime() - t0) * 1e6 < us) x += 1.0;
+  return x;
+}
+
+void BM_BarrierWake(benchmark::State& state) {
+  const double late = static_cast<double>(state.range(0));
+  constexpr int kBarriers = 200;
+  double sink = 0.0, spent = 0.0;
+  for (auto _ : state) {
+    const double t0 = omp_get_wtime();
+#pragma omp parallel num_threads(2) reduction(+ : sink)
+    for (int k = 0; k < kBarriers; ++k) {
+      if (omp_get_thread_num() == 0) sink += BusyFor(late);
+#pragma omp barrier
+    }
+    spent += omp_get_wtime() - t0;
+  }
+  benchmark::DoNotOptimize(sink);
+  state.counters["us_per_barrier"] =
+      1e6 * spent / (static_cast<double>(state.iterations()) * kBarriers) - late;
+}
+BENCHMARK(BM_BarrierWake)->Arg(1)->Arg(20)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

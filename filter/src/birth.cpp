@@ -5,53 +5,91 @@
 #include <algorithm>
 #include <cmath>
 
-#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/filter/simd_normals.hpp"
 #include "fast_normal.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
 using namespace detail;
 
-void DynamicGrid::Birth(std::span<const Measurement> z) {
+namespace {
+constexpr std::int64_t kChunksPerBlock = kScanBlock / kCellChunk;
+}  // namespace
+
+bool DynamicGrid::BirthMass(const Team& t, BirthSums& sums) {
+  static_assert(BirthSums::kBlocks * kChunksPerBlock == BirthSums::kChunks);
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
   const std::int64_t nc = num_cells_;
   // Prefix sums of the birth masses with the summation order of ExclusiveScan (blocks of
-  // kScanBlock), without materialising them: block totals here, running sums in the loop below.
+  // kScanBlock), without materialising them: block totals here, running sums in DrawBirths.
   const std::int64_t blocks = (nc + kScanBlock - 1) / kScanBlock;
-  std::vector<double>& tot = born_block_;
-  tot.resize(blocks + 1);
+  // Few blocks (the paper size: 2): every thread sums them itself into its own `sums` (the same
+  // sums in the same order), so no thread waits for another here. Otherwise the team shares
+  // born_block_ (blocks + 1) and born_chunk_acc_.
+  const bool few = blocks <= BirthSums::kBlocks;
+  double* const tot = few ? sums.own_tot : born_block_.data();
+  double* const chunk_acc = few ? sums.own_chunk_acc : born_chunk_acc_.data();
+  sums.tot = tot;
+  sums.chunk_acc = chunk_acc;
   // Most cells have no birth mass; adding +-0 leaves acc (>= +0) unchanged, so only the cells of
   // UpdateCells' per-chunk lists (non-zero mass, in cell order) are visited: same sums.
   const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
-  constexpr std::int64_t kChunksPerBlock = kScanBlock / kCellChunk;
-  const auto for_each_born = [&](std::int64_t b, auto&& f) {
+  const auto block_total = [&](std::int64_t b) {
+    double acc = 0.0;
     for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
          ++ch) {
       const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
-      for (std::int32_t t = 0; t < born_count_[ch]; ++t) f(list[t]);
+      for (std::int32_t k = 0; k < born_count_[ch]; ++k) acc += born_[list[k]];
+    }
+    tot[b + 1] = acc;
+  };
+  const auto scan = [&] {
+    tot[0] = 0.0;
+    for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
+  };
+  const auto zero_births = [&] {  // no birth mass: zero-weight births
+    std::fill(births_.weight.begin(), births_.weight.end(), 0.0f);
+    std::fill(births_.w_position.begin(), births_.w_position.end(), 0.0f);
+    std::fill(births_.w_velocity.begin(), births_.w_velocity.end(), 0.0f);
+  };
+  // Running sum at each chunk start (sequential from the block base, as in DrawBirths), so that
+  // the births can be generated chunk by chunk (load balance: births cluster in few blocks).
+  const auto chunk_sums = [&](std::int64_t b) {
+    double acc = tot[b];
+    for (std::int64_t ch = b * kChunksPerBlock; ch < std::min(n_chunks, (b + 1) * kChunksPerBlock);
+         ++ch) {
+      chunk_acc[ch] = acc;
+      const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
+      for (std::int32_t k = 0; k < born_count_[ch]; ++k) acc += born_[list[k]];
     }
   };
-  ParallelFor(
-      blocks, Schedule::kStatic,
-      [&](std::int64_t b) {
-        double acc = 0.0;
-        for_each_born(b, [&](std::int64_t s) { acc += born_[s]; });
-        tot[b + 1] = acc;
-      },
-      /*worth=*/blocks > 8);
-  tot[0] = 0.0;
-  for (std::int64_t b = 0; b < blocks; ++b) tot[b + 1] += tot[b];
-  const double total = tot[blocks];
-  if (nb == 0) return;
-  if (!(total > 0.0)) {
-    std::fill(births_.weight.begin(), births_.weight.end(), 0.0);
-    std::fill(births_.w_position.begin(), births_.w_position.end(), 0.0);
-    std::fill(births_.w_velocity.begin(), births_.w_velocity.end(), 0.0);
-    return;
+  if (few) {
+    for (std::int64_t b = 0; b < blocks; ++b) block_total(b);
+    scan();
+  } else {
+    ForStatic(t, blocks, block_total);
+    Single(t, scan);  // every thread reads the same total below
   }
+  const bool draw = nb > 0 && tot[blocks] > 0.0;
+  if (nb > 0 && !draw) SingleNoWait(t, zero_births);  // read after a later barrier (Cycle)
+  if (!draw) return false;
+  if (few) {
+    for (std::int64_t b = 0; b < blocks; ++b) chunk_sums(b);
+  } else {
+    ForStatic(t, blocks, chunk_sums);
+  }
+  return true;
+}
+
+void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z, const BirthSums& sums) {
+  const std::int64_t nb = static_cast<std::int64_t>(births_.size());
+  const std::int64_t nc = num_cells_;
+  const std::int64_t n_chunks = static_cast<std::int64_t>(born_count_.size());
+  const double* const tot = sums.tot;
+  const double total = tot[(nc + kScanBlock - 1) / kScanBlock];
   // New-born particles are spread over cells in proportion to their birth mass (systematic
   // allocation, SystematicRanges); every birth carries the same mass total / num_birth.
   CounterRng offset_rng(seed_, RngPurpose::kFilterBirth, step_, 0xFFFFFFFFu);
@@ -64,22 +102,8 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
     if (i == nc) return nb;
     return std::clamp(CeilToInt(cumulative * scale - u), std::int64_t{0}, nb);
   };
-  // Running sum at each chunk start (sequential from the block base, as in the loop below), so
-  // that the births can be generated chunk by chunk (load balance: births cluster in few blocks).
-  double* const chunk_acc = born_chunk_acc_.data();
-  ParallelFor(
-      blocks, Schedule::kStatic,
-      [&](std::int64_t b) {
-        double acc = tot[b];
-        for (std::int64_t ch = b * kChunksPerBlock;
-             ch < std::min(n_chunks, (b + 1) * kChunksPerBlock); ++ch) {
-          chunk_acc[ch] = acc;
-          const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
-          for (std::int32_t t = 0; t < born_count_[ch]; ++t) acc += born_[list[t]];
-        }
-      },
-      /*worth=*/blocks > 8);
-  ParallelFor(n_chunks, Schedule::kDynamic, [&](std::int64_t ch) {
+  const double* const chunk_acc = sums.chunk_acc;
+  ForDynamic(t, n_chunks, [&](std::int64_t ch) {
     const std::int64_t b = ch / kChunksPerBlock;
     const std::int64_t last = std::min(nc, (b + 1) * kScanBlock) - 1;
     const bool has_last = last < (ch + 1) * kCellChunk;  // the block's last cell is in this chunk
@@ -97,7 +121,7 @@ void DynamicGrid::Birth(std::span<const Measurement> z) {
       GenerateBirths(z, s, k_lo, k_hi, mass, vmax);
     };
     const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
-    for (std::int32_t t = 0; t < born_count_[ch]; ++t) visit(list[t], born_[list[t]]);
+    for (std::int32_t k = 0; k < born_count_[ch]; ++k) visit(list[k], born_[list[k]]);
     if (has_last && !last_seen) visit(last, 0.0);
   });
 }

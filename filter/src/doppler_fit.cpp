@@ -11,6 +11,7 @@
 
 #include "dualgrid/filter/measurement_grid.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
@@ -90,23 +91,19 @@ double MeasurementGrid::BucketDistance2(const Position& p, int bx, int by) const
   return dx * dx + dy * dy;
 }
 
-void MeasurementGrid::FitDetectionVelocities() {
+void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const std::span<const Measurement> z = z_;
-  const int nz = static_cast<int>(z.size());
-  if (static_cast<int>(det_fit_t_.size()) < nz) {  // grow only
-    det_fit_t_.resize(nz);
-    det_fit_sd_.resize(nz);
-  }
+  const int nz = static_cast<int>(z.size());  // det_fit_t_, det_fit_sd_: Prepare sized them
   const double radius2 = params_.doppler_fit_radius * params_.doppler_fit_radius;
   const int reach = static_cast<int>(
       std::ceil(params_.doppler_fit_radius / (bucket_cells_ * params_.resolution)));
   const double floor = params_.doppler_fit_sigma;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
-#pragma omp parallel for schedule(dynamic, 32)
-  for (int j = 0; j < nz; ++j) {
+  const auto fit = [&](std::int64_t jj) {
+    const int j = static_cast<int>(jj);
     det_fit_t_[j] = 0.0;
     det_fit_sd_[j] = std::numeric_limits<double>::infinity();
-    if (det_bucket_[j] < 0) continue;  // not near the grid: no birth from it
+    if (det_bucket_[j] < 0) return;  // not near the grid: no birth from it
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
     double ux[kMaxNeighbours], uy[kMaxNeighbours], y[kMaxNeighbours];
@@ -131,7 +128,7 @@ void MeasurementGrid::FitDetectionVelocities() {
       }
     }
     Fit f;
-    if (n < 3 || !RobustFit(ux, uy, y, n, floor, &f)) continue;
+    if (n < 3 || !RobustFit(ux, uy, y, n, floor, &f)) return;
     // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
     // t^T (scale^2 A^-1) t.
     const double tx = -los[3 * j + 1], ty = los[3 * j];
@@ -140,7 +137,8 @@ void MeasurementGrid::FitDetectionVelocities() {
         f.scale * f.scale * (tx * tx * f.a11 - 2.0 * tx * ty * f.a01 + ty * ty * f.a00) / det;
     det_fit_t_[j] = f.vx * tx + f.vy * ty;
     det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
-  }
+  };
+  ForDynamicNoWait(t, nz, fit, 32);  // Fill's contract: no barrier at the end
 }
 
 }  // namespace dualgrid::filter

@@ -10,8 +10,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
@@ -42,6 +44,8 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 10) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
   scan_out_.assign(n + b + 1, 0.0);
+  scan_base_.assign(static_cast<std::size_t>((n + b + kScanBlock - 1) / kScanBlock + 1), 0.0);
+  born_block_.assign(static_cast<std::size_t>((num_cells_ + kScanBlock - 1) / kScanBlock + 1), 0.0);
 }
 
 std::int64_t DynamicGrid::Storage(std::int64_t gx, std::int64_t gy) const {
@@ -61,13 +65,20 @@ Position DynamicGrid::CellCenter(CellIndex c) const {
 void DynamicGrid::Update(const EgoInput& ego, std::span<const Measurement> measurements,
                          std::span<const SensorCoverage> coverage, double dt) {
   if (!own_measurement_) own_measurement_.emplace(params_);
-  // Build refuses a non-finite centre or coverage before anything changes.
-  own_measurement_->Build(ego.pose.position, measurements, coverage);  // 4. measurement grid
-  Update(ego, *own_measurement_, dt);
+  // Prepare refuses a non-finite centre or coverage before anything changes; the tables are
+  // filled in the cycle's region (4. measurement grid, MeasurementGrid::Fill).
+  own_measurement_->Prepare(ego.pose.position, measurements, coverage);
+  Run(ego, *own_measurement_, dt, nullptr, &*own_measurement_, coverage);
 }
 
 void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
                          const PredictionNoise* noise) {
+  Run(ego, measurement, dt, noise, nullptr, {});
+}
+
+void DynamicGrid::Run(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+                      const PredictionNoise* noise, MeasurementGrid* fill,
+                      std::span<const SensorCoverage> coverage) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) {
     throw std::invalid_argument("DynamicGrid::Update: dt must be finite and >= 0, got " +
                                 std::to_string(dt));
@@ -76,7 +87,7 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
     throw std::invalid_argument(
         "DynamicGrid::Update: the ego position must be finite with |x|, |y| <= 1e9 m");
   }
-  if (!measurement.SharesGeometry(params_) || measurement.builds() == 0 ||
+  if (!measurement.SharesGeometry(params_) || (fill == nullptr && measurement.builds() == 0) ||
       measurement.origin_index() != OriginFor(ego.pose.position)) {
     throw std::invalid_argument(
         "DynamicGrid::Update: the MeasurementGrid was not built for this grid (another geometry, "
@@ -89,8 +100,9 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
         std::to_string(seed_) + ", step " + std::to_string(step_) + ", " +
         std::to_string(params_.num_particles) + " particles)");
   }
-  if (!initialized_) {
-    Initialize(ego);
+  const bool first = !initialized_;
+  if (first) {
+    InitializeOrigin(ego);  // the particles: in the cycle (SpreadParticles)
   } else {
     ShiftTo(ego.pose.position);  // 1. ego motion: whole cells
   }
@@ -98,14 +110,50 @@ void DynamicGrid::Update(const EgoInput& ego, const MeasurementGrid& measurement
   mg_ = &measurement;
   const std::span<const Measurement> z = measurement.measurements();
   cycle_params_ = ForCycle(params_, dt);  // per-cycle factors for this dt
-  PredictAndSort(dt, noise);              // 2. prediction, 3. assignment
-  // 4. measurement grid and 4a. Doppler fit: in `measurement` (MeasurementGrid::Build).
-  UpdateCells(z);             // 5.-6. occupancy update, weights, 9. statistics
-  Birth(z);                   // 7. birth
-  Resample();                 // 8. resampling
-  view_ = measurement.view_;  // same size: a copy, no allocation (Cell, ExportMasses)
+  PrepareCycle(z.size());
+  sorted_gx_ = origin_gx_;  // the cells the particles are sorted on below
+  sorted_gy_ = origin_gy_;
+  const auto cycle = [&](const Team& t) {
+    // 4. measurement grid, 4a. Doppler fit. Fill ends without a barrier: the cycle reads its
+    // tables only after the prediction's and the sort's first barriers (PredictAndSort).
+    if (fill != nullptr) fill->Fill(t, coverage);
+    Cycle(t, z, dt, noise, first);
+  };
+  if (OneThreadHere()) {  // no team to build (dualgrid/core/parallel.hpp)
+    cycle(Team::Solo());
+  } else {
+#pragma omp parallel
+    cycle(Team::OfRegion());
+  }
+  shift_gx_ = shift_gy_ = 0;  // applied in the prediction
+  sorted_current_ = true;     // sorted_ and cell_start_ bin the particles on the current cells
   mg_ = nullptr;
   ++step_;
+}
+
+void DynamicGrid::PrepareCycle(std::size_t detections) {
+  const std::size_t rows = std::max<std::size_t>(detections, 1);  // WeighTables reads row 0
+  if (det_f_.size() < 9 * rows) det_f_.assign(9 * rows, 0.0f);    // grow only
+  if (det_fv0_.size() < detections) det_fv0_.resize(detections);
+  if (det_fit_k_.size() < detections) det_fit_k_.resize(detections);
+}
+
+void DynamicGrid::Cycle(const Team& t, std::span<const Measurement> z, double dt,
+                        const PredictionNoise* noise, bool first) {
+  if (first) SpreadParticles(t);
+  PredictAndSort(t, z, dt, noise);  // 2. prediction, 3. assignment
+  // 4. measurement grid and 4a. Doppler fit: in `measurement` (MeasurementGrid::Build).
+  UpdateCells(t, z);  // 5.-6. occupancy update, weights, 9. statistics
+  // 7. birth, with the resampling's prefix sums over the persistent particles beside it.
+  BirthSums sums;  // this thread's own
+  const bool births = BirthMass(t, sums);
+  SingleNoWait(t, [&] { ScanPersistent(); });
+  if (births) {
+    DrawBirths(t, z, sums);
+  } else {
+    Barrier(t);
+  }
+  Resample(t);  // 8. resampling
 }
 
 namespace {

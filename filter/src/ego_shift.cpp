@@ -10,27 +10,30 @@
 
 #include "dualgrid/core/random.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
 using namespace detail;
 
-void DynamicGrid::Initialize(const EgoInput& ego) {
+void DynamicGrid::InitializeOrigin(const EgoInput& ego) {
   const auto origin = OriginFor(ego.pose.position);
   origin_gx_ = origin[0];
   origin_gy_ = origin[1];
-  // Particles start spread over the grid with zero weight: the first births replace them.
   shift_gx_ = shift_gy_ = 0;
+  initialized_ = true;
+}
+
+// Particles start spread over the grid with zero weight: the first births replace them.
+void DynamicGrid::SpreadParticles(const Team& t) {
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
+  ForStatic(t, n, [&](std::int64_t i) {
     CounterRng rng(seed_, RngPurpose::kFilterInit, 0, static_cast<std::uint32_t>(i));
     particles_.x[i] = static_cast<float>(rng.Uniform() * nx_ * params_.resolution);  // local [m]
     particles_.y[i] = static_cast<float>(rng.Uniform() * ny_ * params_.resolution);
     particles_.vx[i] = particles_.vy[i] = 0.0f;
     particles_.w_position[i] = particles_.w_velocity[i] = particles_.weight[i] = 0.0f;
-  }
-  initialized_ = true;
+  });
 }
 
 void DynamicGrid::ResetColumn(std::int64_t gx) {

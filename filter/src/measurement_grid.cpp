@@ -8,9 +8,10 @@
 #include <string>
 #include <utility>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/text.hpp"
-#include "dualgrid/filter/particles.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
@@ -50,7 +51,10 @@ MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
   view_.assign(c, 0);
   near_det_.assign(c, -1);
   near_d2_.assign(c, kInf);
-  touched_.reserve(4096);
+  band_of_row_.resize(static_cast<std::size_t>(ny_));
+  for (int b = 0; b < kStampBands; ++b)
+    for (int row = b * ny_ / kStampBands; row < (b + 1) * ny_ / kStampBands; ++row)
+      band_of_row_[row] = b;
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
   // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
   // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
@@ -76,6 +80,17 @@ bool MeasurementGrid::SharesGeometry(const FilterParams& p) const {
 
 void MeasurementGrid::Build(const Position& centre, std::span<const Measurement> z,
                             std::span<const SensorCoverage> coverage) {
+  Prepare(centre, z, coverage);
+  if (OneThreadHere()) {  // no team to build (dualgrid/core/parallel.hpp)
+    Fill(Team::Solo(), coverage);
+  } else {
+#pragma omp parallel
+    Fill(Team::OfRegion(), coverage);
+  }
+}
+
+void MeasurementGrid::Prepare(const Position& centre, std::span<const Measurement> z,
+                              std::span<const SensorCoverage> coverage) {
   if (!(centre.cwiseAbs().maxCoeff() <= FilterParams::kMaxCentre)) {  // also NaN
     throw std::invalid_argument(
         "MeasurementGrid::Build: the grid centre must be finite with |x|, |y| <= 1e9 m, got " +
@@ -96,33 +111,71 @@ void MeasurementGrid::Build(const Position& centre, std::span<const Measurement>
   origin_gx_ = origin[0];
   origin_gy_ = origin[1];
   z_.assign(z.begin(), z.end());  // capacity reused across builds
-  Stamp();
-  Bins(coverage);
-  FieldOfView(coverage);
-  ComputeLinesOfSight();
-  if (with_fit_) FitDetectionVelocities();
-  ++builds_;
+  // Every per-detection and per-sensor array at its size for this build (grow only).
+  const std::size_t nz = z_.size();
+  if (det_bucket_.size() < nz) {
+    det_bucket_.resize(nz);
+    det_stamp_.resize(nz);
+    bucket_items_.resize(nz);
+    det_x_.resize(nz);
+    det_y_.resize(nz);
+    det_fit_t_.resize(nz);
+    det_fit_sd_.resize(nz);
+  }
+  if (det_los_.size() < 3 * nz) det_los_.resize(3 * nz);
+  // Bearing bins per sensor: range of the closest detection shadowing each bin (Bins).
+  const int ns = static_cast<int>(coverage.size());
+  bin_offset_.assign(ns + 1, 0);  // small vectors; capacity is reused across cycles
+  for (int s = 0; s < ns; ++s) {
+    const int bins = std::max(
+        1, static_cast<int>(std::ceil(2.0 * coverage[s].half_fov / params_.free_angle_bin)));
+    bin_offset_[s + 1] = bin_offset_[s] + bins;
+  }
+  bin_range_.assign(bin_offset_[ns], kInf);
+  bin_run_end_.resize(bin_range_.size());
+  sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
+  PlaceDetections();
 }
 
-void MeasurementGrid::Stamp() {
+void MeasurementGrid::Fill(const Team& t, std::span<const SensorCoverage> coverage) {
+  // The serial parts beside the stamping (the buckets and lines of sight for the fit, the bins
+  // for the field of view), each on one thread; the stamping's barrier orders them before use.
+  SingleNoWait(t, [&] {
+    FillBuckets();
+    ComputeLinesOfSight();
+  });
+  SingleNoWait(t, [&] {
+    Bins(coverage);
+    FieldOfViewTables(coverage);
+  });
+  // The stamp's barrier: the buckets, lines of sight (the fit) and bins (the field of view) are
+  // ready after it.
+  if (t.shared) {
+    ForDynamic(t, kStampBands,
+               [&](std::int64_t b) { StampBands(static_cast<int>(b), static_cast<int>(b) + 1); });
+  } else {
+    StampBands(0, kStampBands);  // one pass over the detections
+  }
+  // Field of view and ray free space per cell (rows: each cell has one writer), then the fit,
+  // which reads none of it: no barrier between them, nor after them. Build's region ends here;
+  // DynamicGrid's cycle reads these tables only after two more of its barriers.
+  ForDynamicNoWait(
+      t, ny_, [&](std::int64_t ly) { FieldOfViewRow(static_cast<int>(ly), coverage); }, 2);
+  if (with_fit_) FitDetectionVelocities(t);
+  SingleNoWait(t, [&] { ++builds_; });
+}
+
+void MeasurementGrid::PlaceDetections() {
   const std::span<const Measurement> z = z_;
   const double r = params_.resolution;
-  const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
+  const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
   const int rc = static_cast<int>(std::ceil(cutoff / r));
-  for (std::int64_t s : touched_) {
-    near_det_[s] = -1;
-    near_d2_[s] = kInf;
-  }
-  touched_.clear();
-
-  // Nearest detection per cell centre, stamped detection by detection (serial, so ties resolve
-  // to the lower index whatever the thread count). Also fills the detection buckets.
   std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
   const int nz = static_cast<int>(z.size());
-  if (static_cast<int>(det_bucket_.size()) < nz) det_bucket_.resize(nz);  // grows only
-  std::vector<std::int64_t>& bucket_of = det_bucket_;
+  // Per band an upper bound of the cells its stamps touch (the touched lists never grow in Fill).
+  std::int64_t bound[kStampBands] = {};
   for (int j = 0; j < nz; ++j) {
-    bucket_of[j] = -1;
+    det_bucket_[j] = -1;
     const Position& p = z[j].position;
     if (!p.allFinite() || !z[j].radial_velocity.allFinite()) continue;
     const double fx = std::floor(p.x() / r) - static_cast<double>(origin_gx_);
@@ -130,11 +183,68 @@ void MeasurementGrid::Stamp() {
     if (fx < -rc || fy < -rc || fx >= nx_ + rc || fy >= ny_ + rc) continue;
     const int lx = static_cast<int>(fx), ly = static_cast<int>(fy);
     const auto [bx, by] = BucketOf(p.x(), p.y());
-    bucket_of[j] = static_cast<std::int64_t>(by) * nbx_ + bx;
-    ++bucket_count_[bucket_of[j]];
-    const std::int64_t sx0 = Mod(origin_gx_, nx_);
-    for (int cy = std::max(0, ly - rc); cy <= std::min(ny_ - 1, ly + rc); ++cy) {
-      const std::int64_t row = Mod(origin_gy_ + cy, ny_) * nx_;  // one division per row
+    det_bucket_[j] = static_cast<std::int64_t>(by) * nbx_ + bx;
+    ++bucket_count_[det_bucket_[j]];
+    const int cy_lo = std::max(0, ly - rc), cy_hi = std::min(ny_ - 1, ly + rc);
+    const int row_lo = static_cast<int>(Mod(origin_gy_ + cy_lo, ny_));
+    det_stamp_[j] = {lx, ly, row_lo};
+    const int ncx = std::max(0, std::min(nx_ - 1, lx + rc) - std::max(0, lx - rc) + 1);
+    for (int cy = cy_lo, row = row_lo; cy <= cy_hi; ++cy, row = row + 1 == ny_ ? 0 : row + 1)
+      bound[band_of_row_[row]] += ncx;
+  }
+  for (int b = 0; b < kStampBands; ++b) {
+    const std::int64_t rows = (b + 1) * ny_ / kStampBands - b * ny_ / kStampBands;
+    touched_[b].reserve(static_cast<std::size_t>(std::min(bound[b], rows * nx_)));
+  }
+}
+
+void MeasurementGrid::FillBuckets() {
+  const std::span<const Measurement> z = z_;
+  const int nz = static_cast<int>(z.size());
+  const std::int64_t nb = static_cast<std::int64_t>(nbx_) * nby_;
+  std::int64_t acc = 0;  // exclusive prefix sums of the counts (integers: exact)
+  for (std::int64_t b = 0; b < nb; ++b) {
+    bucket_start_[b] = acc;
+    acc += bucket_count_[b];
+    bucket_count_[b] = 0;
+  }
+  bucket_start_[nb] = acc;
+  for (int j = 0; j < nz; ++j) {
+    if (det_bucket_[j] < 0) continue;
+    const std::int64_t k = bucket_start_[det_bucket_[j]] + bucket_count_[det_bucket_[j]]++;
+    bucket_items_[k] = j;
+    det_x_[k] = z[j].position.x();
+    det_y_[k] = z[j].position.y();
+  }
+}
+
+void MeasurementGrid::StampBands(int band_lo, int band_hi) {
+  const std::span<const Measurement> z = z_;
+  const double r = params_.resolution;
+  const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
+  const int rc = static_cast<int>(std::ceil(cutoff / r));
+  for (int band = band_lo; band < band_hi; ++band) {
+    for (std::int64_t s : touched_[band]) {
+      near_det_[s] = -1;
+      near_d2_[s] = kInf;
+    }
+    touched_[band].clear();  // keeps the capacity PlaceDetections reserved
+  }
+  const int row_a = band_lo * ny_ / kStampBands, row_b = band_hi * ny_ / kStampBands;
+  const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  const int nz = static_cast<int>(z.size());
+  for (int j = 0; j < nz; ++j) {
+    if (det_bucket_[j] < 0) continue;
+    const Position& p = z[j].position;
+    const auto [lx, ly, row_lo] = det_stamp_[j];
+    const int cy_lo = std::max(0, ly - rc), cy_hi = std::min(ny_ - 1, ly + rc);
+    // Its storage rows row_lo .. end - 1 (mod ny): skip it unless they meet [row_a, row_b).
+    const int end = row_lo + cy_hi - cy_lo + 1;
+    if (!((row_lo < row_b && std::min(end, ny_) > row_a) || end - ny_ > row_a)) continue;
+    for (int cy = cy_lo, srow = row_lo; cy <= cy_hi; ++cy, srow = srow + 1 == ny_ ? 0 : srow + 1) {
+      if (srow < row_a || srow >= row_b) continue;
+      std::vector<std::int64_t>& touched = touched_[band_of_row_[srow]];
+      const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
       const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
       for (int cx = std::max(0, lx - rc); cx <= std::min(nx_ - 1, lx + rc); ++cx) {
         const double ex = (static_cast<double>(origin_gx_ + cx) + 0.5) * r - p.x();
@@ -142,7 +252,7 @@ void MeasurementGrid::Stamp() {
         if (d2 > cutoff2) continue;
         const std::int64_t sx = sx0 + cx;
         const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-        if (near_det_[s] < 0) touched_.push_back(s);
+        if (near_det_[s] < 0) touched.push_back(s);
         if (d2 < near_d2_[s]) {
           near_d2_[s] = d2;
           near_det_[s] = j;
@@ -150,37 +260,15 @@ void MeasurementGrid::Stamp() {
       }
     }
   }
-  const std::int64_t nb = static_cast<std::int64_t>(nbx_) * nby_;
-  ExclusiveScan(std::span<const std::int64_t>(bucket_count_.data(), nb),
-                std::span<std::int64_t>(bucket_start_.data(), nb + 1));
-  if (static_cast<int>(bucket_items_.size()) < nz) {  // grows only
-    bucket_items_.resize(nz);
-    det_x_.resize(nz);
-    det_y_.resize(nz);
-  }
-  std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
-  for (int j = 0; j < nz; ++j) {
-    if (bucket_of[j] < 0) continue;
-    const std::int64_t k = bucket_start_[bucket_of[j]] + bucket_count_[bucket_of[j]]++;
-    bucket_items_[k] = j;
-    det_x_[k] = z[j].position.x();
-    det_y_[k] = z[j].position.y();
-  }
 }
 
 void MeasurementGrid::Bins(std::span<const SensorCoverage> cov) {
   const std::span<const Measurement> z = z_;
   const int nz = static_cast<int>(z.size());
 
-  // Bearing bins per sensor: range of the closest detection shadowing each bin.
+  // Bearing bins per sensor (Prepare: bin_offset_, bin_range_ at kInf): range of the closest
+  // detection shadowing each bin.
   const int ns = static_cast<int>(cov.size());
-  bin_offset_.assign(ns + 1, 0);  // small vectors; capacity is reused across cycles
-  for (int s = 0; s < ns; ++s) {
-    const int bins =
-        std::max(1, static_cast<int>(std::ceil(2.0 * cov[s].half_fov / params_.free_angle_bin)));
-    bin_offset_[s + 1] = bin_offset_[s] + bins;
-  }
-  bin_range_.assign(bin_offset_[ns], kInf);
   for (int j = 0; j < nz; ++j) {
     const Measurement& m = z[j];
     if (!m.position.allFinite() || !m.sensor_position.allFinite()) continue;
@@ -202,14 +290,9 @@ void MeasurementGrid::Bins(std::span<const SensorCoverage> cov) {
   }
 }
 
-void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
+void MeasurementGrid::FieldOfViewTables(std::span<const SensorCoverage> cov) {
   const int ns = static_cast<int>(cov.size());
-  const double r = params_.resolution;
-  // Field of view and ray free space per cell (rows in parallel: each cell has one writer).
-  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
-  const std::int64_t sx0 = Mod(origin_gx_, nx_);
-  // Per-sensor trigonometry once per cycle, not per row.
-  sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
+  // Per-sensor trigonometry once per cycle, not per row (Prepare sized the tables).
   for (int k = 0; k < ns; ++k) {
     sensor_trig_[4 * k] = std::cos(cov[k].boresight);
     sensor_trig_[4 * k + 1] = std::sin(cov[k].boresight);
@@ -219,7 +302,6 @@ void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
     sensor_trig_[4 * k + 3] = inner > 0.0 && cov[k].half_fov < 0.5 * kPi ? std::tan(inner) : -1.0;
   }
   // Last bin of the run of equal ranges each bin belongs to (per sensor): O(1) uniformity test.
-  bin_run_end_.resize(bin_range_.size());
   for (int k = 0; k < ns; ++k) {
     const std::int64_t b_lo = bin_offset_[k], b_hi = bin_offset_[k + 1];
     for (std::int64_t b = b_hi - 1; b >= b_lo; --b) {
@@ -228,163 +310,166 @@ void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
                             : static_cast<int>(b - b_lo);
     }
   }
-#pragma omp parallel for schedule(dynamic, 2)
-  for (int ly = 0; ly < ny_; ++ly) {
-    const std::int64_t row = Mod(origin_gy_ + ly, ny_) * nx_;
-    const double cy = y0 + (ly + 0.5) * r;
-    std::fill_n(view_.begin() + row, nx_, 0);  // whole storage row = whole logical row
-    for (int k = 0; k < ns; ++k) {
-      const SensorCoverage& sc = cov[k];
-      const double dy = cy - sc.origin.y();
-      if (std::abs(dy) > sc.max_range) continue;
-      const double half_x = std::sqrt(sc.max_range * sc.max_range - dy * dy);
-      const int lx_lo =
-          std::max(0, static_cast<int>(std::floor((sc.origin.x() - half_x - x0) / r)));
-      const int lx_hi =
-          std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
-      // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
-      // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
-      const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
-      const bool narrow = sc.half_fov < 0.5 * kPi;
-      const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
-      const int* const run_end = bin_run_end_.data() + bin_offset_[k];
-      const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
-      const double* bins = bin_range_.data() + bin_offset_[k];
-      const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
-      const double inv_bin = 1.0 / params_.free_angle_bin;
-      const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
-      // Exact per-cell test (the reference definition of the bits).
-      const auto exact = [&](int lx) {
-        const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
-        const double d2 = dx * dx + dy * dy;
-        if (d2 < min2 || d2 > max2) return;
-        const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-        if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) return;
-        const double rel = FastAtan2(fy, fx);
-        if (std::abs(rel) > sc.half_fov) return;
-        const std::int64_t sx = sx0 + lx;
-        const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-        const int b = std::clamp(static_cast<int>((rel + sc.half_fov) * inv_bin), 0, nbins - 1);
-        const double br = bins[b];
-        // Free in front of the bin's closest detection, unknown behind it; a bin without any
-        // detection is weakly free over the whole range.
-        view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
-                                              (br != kInf && d2 < br * br ? kFreeRay : 0));
-      };
-      int lo_x = lx_lo, hi_x = lx_hi;
-      // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
-      // (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0): their interval of dx.
-      const auto wedge = [&](double tan_w, double* dmin, double* dmax) {
-        *dmin = -kInf;
-        *dmax = kInf;
-        for (const auto& [c, d] :
-             {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
-              std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
-          if (c > 0.0) {
-            *dmin = std::max(*dmin, -d / c);
-          } else if (c < 0.0) {
-            *dmax = std::min(*dmax, -d / c);
-          } else if (d < 0.0) {
-            *dmax = -kInf;
-          }
-        }
-        return *dmin <= *dmax;
-      };
-      const double big = 4.0 * nx_;
-      int in_lo = 1, in_hi = 0;  // cells well inside the wedge (empty unless narrow)
-      if (narrow) {
-        // Clip the row to the wedge, two cells of margin (the exact test still decides every
-        // cell).
-        double dmin, dmax;
-        if (!wedge(tan_hf, &dmin, &dmax)) continue;
-        const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
-        const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
-        lo_x = std::max(lo_x, static_cast<int>(l0));
-        hi_x = std::min(hi_x, static_cast<int>(l1));
-        // The cells of the inner wedge (half_fov - 4 kAtanError, one cell of margin) pass the
-        // field-of-view part of the segment test below: segmenting the row there first saves the
-        // bisection down to the wedge edges. Only the segmentation changes, not any cell's bits.
-        if (tan_in > 0.0 && wedge(tan_in, &dmin, &dmax)) {
-          in_lo = std::max(
-              lo_x, static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big)));
-          in_hi = std::min(
-              hi_x, static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big)));
+}
+
+void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov) {
+  const int ns = static_cast<int>(cov.size());
+  const double r = params_.resolution;
+  const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
+  const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  const std::int64_t row = Mod(origin_gy_ + ly, ny_) * nx_;
+  const double cy = y0 + (ly + 0.5) * r;
+  std::fill_n(view_.begin() + row, nx_, 0);  // whole storage row = whole logical row
+  for (int k = 0; k < ns; ++k) {
+    const SensorCoverage& sc = cov[k];
+    const double dy = cy - sc.origin.y();
+    if (std::abs(dy) > sc.max_range) continue;
+    const double half_x = std::sqrt(sc.max_range * sc.max_range - dy * dy);
+    const int lx_lo = std::max(0, static_cast<int>(std::floor((sc.origin.x() - half_x - x0) / r)));
+    const int lx_hi =
+        std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
+    // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
+    // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
+    const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
+    const bool narrow = sc.half_fov < 0.5 * kPi;
+    const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
+    const int* const run_end = bin_run_end_.data() + bin_offset_[k];
+    const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
+    const double* bins = bin_range_.data() + bin_offset_[k];
+    const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
+    const double inv_bin = 1.0 / params_.free_angle_bin;
+    const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
+    // Exact per-cell test (the reference definition of the bits).
+    const auto exact = [&](int lx) {
+      const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
+      const double d2 = dx * dx + dy * dy;
+      if (d2 < min2 || d2 > max2) return;
+      const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+      if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) return;
+      const double rel = FastAtan2(fy, fx);
+      if (std::abs(rel) > sc.half_fov) return;
+      const std::int64_t sx = sx0 + lx;
+      const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
+      const int b = std::clamp(static_cast<int>((rel + sc.half_fov) * inv_bin), 0, nbins - 1);
+      const double br = bins[b];
+      // Free in front of the bin's closest detection, unknown behind it; a bin without any
+      // detection is weakly free over the whole range.
+      view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
+                                            (br != kInf && d2 < br * br ? kFreeRay : 0));
+    };
+    int lo_x = lx_lo, hi_x = lx_hi;
+    // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
+    // (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0): their interval of dx.
+    const auto wedge = [&](double tan_w, double* dmin, double* dmax) {
+      *dmin = -kInf;
+      *dmax = kInf;
+      for (const auto& [c, d] :
+           {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
+            std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
+        if (c > 0.0) {
+          *dmin = std::max(*dmin, -d / c);
+        } else if (c < 0.0) {
+          *dmax = std::min(*dmax, -d / c);
+        } else if (d < 0.0) {
+          *dmax = -kInf;
         }
       }
-      if (lo_x > hi_x) continue;
-      // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
-      // is within kAtanError of it, so the cells' computed bearings lie within 2 kAtanError of the
-      // hull of the end points' ones and their bins (a monotonic function of the bearing) within
-      // the bins of that hull. If all those bins hold the same range, every cell gets the same bin
-      // value as in the exact test without its atan2; otherwise the segment is split.
-      const auto rel_of = [&](int lx, double* fx_out) {
-        const double dxe = x0 + (lx + 0.5) * r - sc.origin.x();
-        const double fx = dxe * cb + dy * sb, fy = dy * cb - dxe * sb;
-        *fx_out = fx;
-        return FastAtan2(fy, fx);
-      };
-      int stack[128][2];
-      int top = 0;
-      if (in_lo <= in_hi) {
-        for (const auto& [sa, se] :
-             {std::pair{lo_x, in_lo - 1}, std::pair{in_lo, in_hi}, std::pair{in_hi + 1, hi_x}}) {
-          if (sa > se) continue;
-          stack[top][0] = sa;
-          stack[top][1] = se;
-          ++top;
-        }
-      } else {
-        stack[top][0] = lo_x;
-        stack[top][1] = hi_x;
+      return *dmin <= *dmax;
+    };
+    const double big = 4.0 * nx_;
+    int in_lo = 1, in_hi = 0;  // cells well inside the wedge (empty unless narrow)
+    if (narrow) {
+      // Clip the row to the wedge, two cells of margin (the exact test still decides every
+      // cell).
+      double dmin, dmax;
+      if (!wedge(tan_hf, &dmin, &dmax)) continue;
+      const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
+      const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
+      lo_x = std::max(lo_x, static_cast<int>(l0));
+      hi_x = std::min(hi_x, static_cast<int>(l1));
+      // The cells of the inner wedge (half_fov - 4 kAtanError, one cell of margin) pass the
+      // field-of-view part of the segment test below: segmenting the row there first saves the
+      // bisection down to the wedge edges. Only the segmentation changes, not any cell's bits.
+      if (tan_in > 0.0 && wedge(tan_in, &dmin, &dmax)) {
+        in_lo = std::max(lo_x,
+                         static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big)));
+        in_hi = std::min(
+            hi_x, static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big)));
+      }
+    }
+    if (lo_x > hi_x) continue;
+    // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
+    // is within kAtanError of it, so the cells' computed bearings lie within 2 kAtanError of the
+    // hull of the end points' ones and their bins (a monotonic function of the bearing) within
+    // the bins of that hull. If all those bins hold the same range, every cell gets the same bin
+    // value as in the exact test without its atan2; otherwise the segment is split.
+    const auto rel_of = [&](int lx, double* fx_out) {
+      const double dxe = x0 + (lx + 0.5) * r - sc.origin.x();
+      const double fx = dxe * cb + dy * sb, fy = dy * cb - dxe * sb;
+      *fx_out = fx;
+      return FastAtan2(fy, fx);
+    };
+    int stack[128][2];
+    int top = 0;
+    if (in_lo <= in_hi) {
+      for (const auto& [sa, se] :
+           {std::pair{lo_x, in_lo - 1}, std::pair{in_lo, in_hi}, std::pair{in_hi + 1, hi_x}}) {
+        if (sa > se) continue;
+        stack[top][0] = sa;
+        stack[top][1] = se;
         ++top;
       }
-      while (top > 0) {
-        --top;
-        const int a = stack[top][0], e = stack[top][1];
-        if (e - a < 4) {
-          for (int lx = a; lx <= e; ++lx) exact(lx);
-          continue;
-        }
-        double fxa, fxe;
-        const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
-        const double lo = std::min(ra, re) - 2.0 * kAtanError,
-                     hi = std::max(ra, re) + 2.0 * kAtanError;
-        bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
-        double br = kInf;
-        if (uniform) {
-          const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
-          const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
-          br = bins[b0];
-          uniform = run_end[b0] >= b1;
-        }
-        if (!uniform) {
-          const int mid = a + (e - a) / 2;
-          stack[top][0] = mid + 1;
-          stack[top][1] = e;
-          ++top;
-          stack[top][0] = a;
-          stack[top][1] = mid;
-          ++top;
-          continue;
-        }
-        // Branch-free over the segment (vectorises), split where the storage row wraps.
-        const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
-        const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
-        const double br2 = br * br;
-        const int wrap = static_cast<int>(nx_ - sx0);  // first lx whose storage column wraps
-        for (int part = 0; part < 2; ++part) {
-          const int pa = part == 0 ? a : std::max(a, wrap);
-          const int pe = part == 0 ? std::min(e, wrap - 1) : e;
-          std::uint8_t* dst = view_.data() + row + sx0 - (part == 0 ? 0 : nx_);
-          for (int lx = pa; lx <= pe; ++lx) {
-            const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
-            const double d2 = dx * dx + dy * dy;
-            const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-            const bool in = (d2 >= min2) & (d2 <= max2) &
-                            ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
-            const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
-            dst[lx] |= in ? v : 0;
-          }
+    } else {
+      stack[top][0] = lo_x;
+      stack[top][1] = hi_x;
+      ++top;
+    }
+    while (top > 0) {
+      --top;
+      const int a = stack[top][0], e = stack[top][1];
+      if (e - a < 4) {
+        for (int lx = a; lx <= e; ++lx) exact(lx);
+        continue;
+      }
+      double fxa, fxe;
+      const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
+      const double lo = std::min(ra, re) - 2.0 * kAtanError,
+                   hi = std::max(ra, re) + 2.0 * kAtanError;
+      bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
+      double br = kInf;
+      if (uniform) {
+        const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
+        const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
+        br = bins[b0];
+        uniform = run_end[b0] >= b1;
+      }
+      if (!uniform) {
+        const int mid = a + (e - a) / 2;
+        stack[top][0] = mid + 1;
+        stack[top][1] = e;
+        ++top;
+        stack[top][0] = a;
+        stack[top][1] = mid;
+        ++top;
+        continue;
+      }
+      // Branch-free over the segment (vectorises), split where the storage row wraps.
+      const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
+      const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
+      const double br2 = br * br;
+      const int wrap = static_cast<int>(nx_ - sx0);  // first lx whose storage column wraps
+      for (int part = 0; part < 2; ++part) {
+        const int pa = part == 0 ? a : std::max(a, wrap);
+        const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+        std::uint8_t* dst = view_.data() + row + sx0 - (part == 0 ? 0 : nx_);
+        for (int lx = pa; lx <= pe; ++lx) {
+          const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
+          const double d2 = dx * dx + dy * dy;
+          const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+          const bool in = (d2 >= min2) & (d2 <= max2) &
+                          ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
+          const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
+          dst[lx] |= in ? v : 0;
         }
       }
     }
@@ -392,8 +477,7 @@ void MeasurementGrid::FieldOfView(std::span<const SensorCoverage> cov) {
 }
 
 void MeasurementGrid::ComputeLinesOfSight() {
-  const int nz = static_cast<int>(z_.size());
-  if (det_los_.size() < 3 * z_.size()) det_los_.resize(3 * z_.size());  // grow only
+  const int nz = static_cast<int>(z_.size());  // det_los_: Prepare sized it
   for (int j = 0; j < nz; ++j) {
     Vector2 u = z_[j].position - z_[j].sensor_position;
     const double n = u.norm();

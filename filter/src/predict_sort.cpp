@@ -3,19 +3,19 @@
 #include "dualgrid/filter/dynamic_grid.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
-#include <omp.h>
-
-#include "dualgrid/core/parallel.hpp"
 #include "grid_internal.hpp"
 #include "predict.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
 using namespace detail;
 
-void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
+void DynamicGrid::PredictAndSort(const Team& t, std::span<const Measurement> z, double dt,
+                                 const PredictionNoise* noise) {
   const float sp = static_cast<float>(params_.process_noise_position * std::sqrt(dt));
   const float sv = static_cast<float>(params_.process_noise_velocity * std::sqrt(dt));
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
@@ -27,13 +27,12 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
   const PositionMap<float> map{static_cast<float>(dt), 1.0f, static_cast<float>(shift_gx_) * r,
                                static_cast<float>(shift_gy_) * r};
   const std::int64_t sx0 = Mod(origin_gx_, nx_), sy0 = Mod(origin_gy_, ny_);
-  // Any chunking gives the same sorted order (stable): one chunk when one thread runs them all.
-  const bool one_thread = OneThreadHere();
-  const int chunks = one_thread ? 1 : std::clamp(omp_get_max_threads(), 1, kMaxSortChunks);
+  // Any chunking gives the same sorted order (stable): one chunk per thread.
+  const int chunks = std::min(t.size, kMaxSortChunks);
   // Blocks of cells for pass 2 (small enough to balance two threads at the paper size).
   constexpr std::int64_t kCellBlock = 1 << 10;
   const std::int64_t nblocks = (c1 + kCellBlock - 1) / kCellBlock;
-  if (static_cast<std::int64_t>(hist_total_.size()) < nblocks + 1) hist_total_.resize(nblocks + 1);
+  assert(static_cast<std::int64_t>(hist_total_.size()) >= nblocks + 1);  // the constructor's
   std::int64_t* block_base = hist_total_.data();
   // Counting sort, stable: particle order within a cell = order before sorting, for any chunking.
   // Pass 1 (per chunk): prediction (step 2, batch by batch while the batch is in cache), storage
@@ -100,32 +99,24 @@ void DynamicGrid::PredictAndSort(double dt, const PredictionNoise* noise) {
       sorted_.CopyFrom(particles_, i, h[cell_of_[i]]++);
     }
   };
-  if (one_thread) {  // no team to build (dualgrid/core/parallel.hpp)
-    for (int k = 0; k < chunks; ++k) predict_and_count(k);
-    for (std::int64_t b = 0; b < nblocks; ++b) block_total(b);
-    scan_blocks();
-    for (std::int64_t b = 0; b < nblocks; ++b) block_offsets(b);
-    for (int k = 0; k < chunks; ++k) scatter(k);
-  } else {
-    // One parallel region; the worksharing loops' implicit barriers order the passes.
-#pragma omp parallel
-    {
-#pragma omp for schedule(static)
-      for (int k = 0; k < chunks; ++k) predict_and_count(k);
-#pragma omp for schedule(static)
-      for (std::int64_t b = 0; b < nblocks; ++b) block_total(b);
-#pragma omp single
-      scan_blocks();
-#pragma omp for schedule(static)
-      for (std::int64_t b = 0; b < nblocks; ++b) block_offsets(b);
-#pragma omp for schedule(static)
-      for (int k = 0; k < chunks; ++k) scatter(k);
-    }
-  }
-  shift_gx_ = shift_gy_ = 0;  // applied
-  sorted_gx_ = origin_gx_;
-  sorted_gy_ = origin_gy_;
-  sorted_current_ = true;  // sorted_ and cell_start_ bin the particles on the current cells
+  // The passes in order, each ending at a barrier; the serial scan runs beside this cycle's
+  // detection tables and the copy of the field-of-view bits (Cell, ExportMasses), which nothing
+  // before the cell update reads.
+  ForStatic(t, chunks, predict_and_count);
+  // Few blocks (the paper size: 20): their totals on the scanning thread, one barrier fewer.
+  const bool few = nblocks <= 32;
+  if (!few) ForStatic(t, nblocks, block_total);
+  Both(
+      t,
+      [&] {
+        if (few)
+          for (std::int64_t b = 0; b < nblocks; ++b) block_total(b);
+        scan_blocks();
+        std::copy(mg_->view_.begin(), mg_->view_.end(), view_.begin());  // same size
+      },
+      [&] { DetectionTables(z); });
+  ForStatic(t, nblocks, block_offsets);
+  ForStatic(t, chunks, scatter);
 }
 
 }  // namespace dualgrid::filter

@@ -7,8 +7,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/filter/dynamic_grid.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
@@ -32,31 +34,29 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
   const double r = params_.resolution;
   const double ox = static_cast<double>(origin_gx_), oy = static_cast<double>(origin_gy_);
   const double nx0 = static_cast<double>(new_origin[0]), ny0 = static_cast<double>(new_origin[1]);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
+  const auto turn = [&](std::int64_t i) {
     const double x = ox * r + q.x[i], y = oy * r + q.y[i], vx = q.vx[i], vy = q.vy[i];
     q.x[i] = static_cast<float>((c * x + s * y) - nx0 * r);
     q.y[i] = static_cast<float>((-s * x + c * y) - ny0 * r);
     q.vx[i] = static_cast<float>(c * vx + s * vy);
     q.vy[i] = static_cast<float>(-s * vx + c * vy);
-  }
+  };
   InvalidateExports();
 
   // The old layers, then each new cell from the old cell under its centre.
   const std::size_t cells = static_cast<std::size_t>(num_cells_);
-  reframe_layers_.resize(3 * cells);
-  std::copy(free_.begin(), free_.end(), reframe_layers_.begin());
-  std::copy(static_.begin(), static_.end(), reframe_layers_.begin() + cells);
-  std::copy(dynamic_.begin(), dynamic_.end(), reframe_layers_.begin() + 2 * cells);
+  reframe_layers_.resize(3 * cells);  // before the region: nothing in it may throw
+  const auto keep_old = [&] {
+    std::copy(free_.begin(), free_.end(), reframe_layers_.begin());
+    std::copy(static_.begin(), static_.end(), reframe_layers_.begin() + cells);
+    std::copy(dynamic_.begin(), dynamic_.end(), reframe_layers_.begin() + 2 * cells);
+  };
   const double* const old_free = reframe_layers_.data();
   const double* const old_static = old_free + cells;
   const double* const old_dynamic = old_static + cells;
   const std::int64_t ogx = origin_gx_, ogy = origin_gy_;
-  // Plain variables, not a structured binding: clang 14 (the fuzz and TSan builds) cannot
-  // capture a binding into the OpenMP region.
   const std::int64_t gx = new_origin[0], gy = new_origin[1];
-#pragma omp parallel for schedule(static)
-  for (std::int64_t iy = 0; iy < ny_; ++iy) {
+  const auto row = [&](std::int64_t iy) {
     const double yn = (static_cast<double>(gy + iy) + 0.5) * r;
     for (std::int64_t ix = 0; ix < nx_; ++ix) {
       const double xn = (static_cast<double>(gx + ix) + 0.5) * r;
@@ -74,6 +74,19 @@ void DynamicGrid::Reframe(double angle, const Position& ego) {
       static_[to] = old_static[from];
       dynamic_[to] = old_dynamic[from];
     }
+  };
+  // One region (none for one thread, as the cycle: team.hpp): the old layers are kept beside the
+  // particles' turn, the rows are resampled after both.
+  const auto run = [&](const Team& t) {
+    SingleNoWait(t, keep_old);
+    ForStatic(t, n, turn);
+    ForStatic(t, ny_, row);
+  };
+  if (OneThreadHere()) {
+    run(Team::Solo());
+  } else {
+#pragma omp parallel
+    run(Team::OfRegion());
   }
   origin_gx_ = gx;
   origin_gy_ = gy;

@@ -5,11 +5,9 @@
 #include <algorithm>
 #include <vector>
 
-#include <omp.h>
-
-#include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/random.hpp"
 #include "grid_internal.hpp"
+#include "team.hpp"
 
 namespace dualgrid::filter {
 
@@ -17,17 +15,25 @@ using namespace detail;
 
 namespace {
 
-// Exclusive prefix sum over the concatenation of a[0..na) and b[0..n - na) (floats, summed in
-// double) into out[0..n], with exactly the summation order of ExclusiveScan (particles.cpp: blocks
-// of kScanBlock, block totals, serial scan, local scans): bit-identical to it, without
-// materialising the concatenated input.
-void ConcatScan(const float* a, std::int64_t na, const float* b, std::int64_t n, double* out) {
-  const auto block_sum = [&](std::int64_t lo, std::int64_t hi, double acc) {
+// The exclusive prefix sums of ExclusiveScan (particles.cpp: blocks of kScanBlock, block totals,
+// serial scan, local scans) over the concatenation of the persistent weights a[0..na) and the
+// births' b[0..n - na) (floats, summed in double) into out[0..n]: the same summation order, so
+// bit-identical to it, without materialising the concatenated input.
+struct ConcatScan {
+  const float *a, *b;
+  std::int64_t na, n;
+  double* out;
+  double* tot;  // blocks() + 1 block totals
+
+  std::int64_t blocks() const { return (n + kScanBlock - 1) / kScanBlock; }
+  // acc + x[lo] + ... + x[hi - 1] over the concatenation, in order.
+  double Sum(std::int64_t lo, std::int64_t hi, double acc) const {
     for (std::int64_t i = lo; i < std::min(hi, na); ++i) acc += static_cast<double>(a[i]);
     for (std::int64_t i = std::max(lo, na); i < hi; ++i) acc += static_cast<double>(b[i - na]);
     return acc;
-  };
-  const auto block_scan = [&](std::int64_t lo, std::int64_t hi, double acc) {
+  }
+  // out[i] = the running sum before x[i], for i in [lo, hi), from acc; returns the sum after.
+  double Scan(std::int64_t lo, std::int64_t hi, double acc) const {
     for (std::int64_t i = lo; i < std::min(hi, na); ++i) {
       out[i] = acc;
       acc += static_cast<double>(a[i]);
@@ -37,27 +43,29 @@ void ConcatScan(const float* a, std::int64_t na, const float* b, std::int64_t n,
       acc += static_cast<double>(b[i - na]);
     }
     return acc;
-  };
-  const std::int64_t blocks = (n + kScanBlock - 1) / kScanBlock;
-  if (blocks <= 1) {
-    out[n] = block_scan(0, n, 0.0);
-    return;
   }
-  static thread_local std::vector<double> base;
-  if (base.size() < static_cast<std::size_t>(blocks) + 1) base.resize(blocks + 1);
-  double* const tot = base.data();
-  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t k) {
-    const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
-    tot[k + 1] = block_sum(lo, hi, 0.0);
-  });
-  tot[0] = 0.0;
-  for (std::int64_t k = 0; k < blocks; ++k) tot[k + 1] += tot[k];
-  ParallelFor(blocks, Schedule::kStatic, [&](std::int64_t k) {
-    const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
-    block_scan(lo, hi, tot[k]);
-  });
-  out[n] = tot[blocks];
-}
+  // The whole scan by the team t; with one block, `head` is Scan(0, na, 0.0), already done.
+  void Run(const Team& t, double head) const {
+    const std::int64_t nbk = blocks();
+    if (nbk <= 1) {
+      Single(t, [&] { out[n] = Scan(na, n, head); });
+      return;
+    }
+    ForStatic(t, nbk, [&](std::int64_t k) {
+      const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
+      tot[k + 1] = Sum(lo, hi, 0.0);
+    });
+    Single(t, [&] {
+      tot[0] = 0.0;
+      for (std::int64_t k = 0; k < nbk; ++k) tot[k + 1] += tot[k];
+      out[n] = tot[nbk];
+    });
+    ForStatic(t, nbk, [&](std::int64_t k) {
+      const std::int64_t lo = k * kScanBlock, hi = std::min(n, lo + kScanBlock);
+      Scan(lo, hi, tot[k]);
+    });
+  }
+};
 
 // SystematicRanges (particles.cpp) for one source: first output slot of source i. The argument
 // of the ceiling lies in [-1, n] (cumulative <= total), so CeilToInt is exact.
@@ -70,22 +78,37 @@ inline std::int64_t SystematicStart(const double* cumulative, std::int64_t i, st
 
 }  // namespace
 
-void DynamicGrid::Resample() {
+void DynamicGrid::ScanPersistent() {
+  const std::int64_t n_in = cell_start_[num_cells_];  // sorted persistent particles on the grid
+  const std::int64_t n_src = n_in + static_cast<std::int64_t>(births_.size());
+  const ConcatScan scan{sorted_.weight.data(), births_.weight.data(), n_in, n_src,
+                        scan_out_.data(),      scan_base_.data()};
+  // One block: the persistent weights' share of the serial scan, the births' follows in
+  // Resample. Several blocks: Resample does all of it with the team.
+  if (scan.blocks() <= 1) scan_persistent_ = scan.Scan(0, n_in, 0.0);
+}
+
+void DynamicGrid::Resample(const Team& t) {
   const std::int64_t n_in = cell_start_[num_cells_];  // sorted persistent particles on the grid
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());
   const std::int64_t n_src = n_in + nb;
   const std::int64_t n = static_cast<std::int64_t>(particles_.size());
   // Prefix sums straight from the float weights (no separate gather pass).
-  ConcatScan(sorted_.weight.data(), n_in, births_.weight.data(), n_src, scan_out_.data());
-  const double total = scan_out_[n_src];
+  const ConcatScan scan{sorted_.weight.data(), births_.weight.data(), n_in, n_src,
+                        scan_out_.data(),      scan_base_.data()};
+  scan.Run(t, scan_persistent_);
+  const double total = scan_out_[n_src];  // every thread reads it after Run's barrier
   if (!(total > 0.0)) {
     // No dynamic mass anywhere: keep the particle positions (zero weight), refilled uniformly
     // from the sources so the count stays fixed.
     if (n_src == 0) {
-      Initialize(EgoInput{Pose2{CellCenter({nx_ / 2, ny_ / 2}), 0.0}, Velocity::Zero()});
+      Single(t, [&] {
+        InitializeOrigin(EgoInput{Pose2{CellCenter({nx_ / 2, ny_ / 2}), 0.0}, Velocity::Zero()});
+      });
+      SpreadParticles(t);
       return;
     }
-    ParallelFor(n, Schedule::kStatic, [&](std::int64_t k) {
+    ForStatic(t, n, [&](std::int64_t k) {
       const std::int64_t i = k * n_src / n;
       if (i < n_in) {
         particles_.CopyFrom(sorted_, i, k);
@@ -103,31 +126,24 @@ void DynamicGrid::Resample() {
   const double scale = static_cast<double>(n) / total;
   const double share = total / static_cast<double>(n);
   const double* const cum = scan_out_.data();
-  // Contiguous source ranges per thread; each range boundary is computed once.
-  const auto copy_range = [&](std::int64_t t, std::int64_t nt) {
-    const std::int64_t i_lo = n_src * t / nt, i_hi = n_src * (t + 1) / nt;
-    std::int64_t k1 = SystematicStart(cum, i_lo, n_src, scale, u, n);
-    for (std::int64_t i = i_lo; i < i_hi; ++i) {
-      const std::int64_t k0 = k1;
-      k1 = SystematicStart(cum, i + 1, n_src, scale, u, n);
-      if (k0 == k1) continue;
-      const LocalParticles& src = i < n_in ? sorted_ : births_;
-      const std::int64_t si = i < n_in ? i : i - n_in;
-      // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
-      const double ratio = share / src.weight[si];
-      for (std::int64_t k = k0; k < k1; ++k) {
-        particles_.CopyFrom(src, si, k);
-        particles_.weight[k] = share;
-        particles_.w_position[k] *= ratio;
-        particles_.w_velocity[k] *= ratio;
-      }
+  // Contiguous source ranges per thread of the team; each range boundary is computed once. No
+  // barrier at the end: the cycle's region ends here.
+  const std::int64_t i_lo = n_src * t.id / t.size, i_hi = n_src * (t.id + 1) / t.size;
+  std::int64_t k1 = SystematicStart(cum, i_lo, n_src, scale, u, n);
+  for (std::int64_t i = i_lo; i < i_hi; ++i) {
+    const std::int64_t k0 = k1;
+    k1 = SystematicStart(cum, i + 1, n_src, scale, u, n);
+    if (k0 == k1) continue;
+    const LocalParticles& src = i < n_in ? sorted_ : births_;
+    const std::int64_t si = i < n_in ? i : i - n_in;
+    // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
+    const double ratio = share / src.weight[si];
+    for (std::int64_t k = k0; k < k1; ++k) {
+      particles_.CopyFrom(src, si, k);
+      particles_.weight[k] = share;
+      particles_.w_position[k] *= ratio;
+      particles_.w_velocity[k] *= ratio;
     }
-  };
-  if (OneThreadHere()) {
-    copy_range(0, 1);
-  } else {
-#pragma omp parallel
-    copy_range(omp_get_thread_num(), omp_get_num_threads());
   }
 }
 

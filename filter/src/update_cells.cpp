@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
 #include "grid_internal.hpp"
+#include "team.hpp"
 #include "weigh_particles.hpp"
 
 namespace dualgrid::filter {
@@ -98,15 +100,31 @@ void OtherWeight(const CellParticles& c, float* w, bool literal, double q_norm, 
 
 }  // namespace
 
-detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
+void DynamicGrid::DetectionTables(std::span<const Measurement> z) {
   const FilterParams& p = cycle_params_;
   const MeasurementGrid& mg = *mg_;
-  const std::size_t nz = z.size();
-  // Nine float columns: bucket-order x, y [m, grid-local]; per detection u0, u1, u2, fit_k, fit_t,
-  // vr_x, vr_y (WeighInputs). At least one row: the kernel gathers row 0 for lanes without a
-  // detection.
-  const std::size_t rows = std::max<std::size_t>(nz, 1);
-  if (det_f_.size() < 9 * rows) det_f_.assign(9 * rows, 0.0f);  // grow only
+  const int nz = static_cast<int>(z.size());
+  // Per detection: f_v of the static hypothesis (v = 0; the same in both likelihood forms, since a
+  // zero velocity has no line-of-sight component either).
+  const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
+  for (int j = 0; j < nz; ++j)
+    det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
+  // radial_fit: per detection 1 / (2 (sigma_v^2 + s_t^2)) of the tangential term, 0 where no fit.
+  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
+  if (radial_fit) {
+    for (int j = 0; j < nz; ++j) {
+      const double s2 = p.sigma_v * p.sigma_v + mg.det_fit_sd_[j] * mg.det_fit_sd_[j];
+      det_fit_k_[j] = std::isfinite(s2) ? 0.5 / s2 : 0.0;
+    }
+    // The static hypothesis (v = 0) is scored by the same f_v: under radial_fit its tangential
+    // part 0 against the fit's v_t as well, so a fitted crossing car is not taken for static.
+    for (int j = 0; j < nz; ++j)
+      if (det_fit_k_[j] > 0.0)
+        det_fv0_[j] *= ExpUnder(-mg.det_fit_t_[j] * mg.det_fit_t_[j] * det_fit_k_[j]);
+  }
+  // Nine float columns (PrepareCycle sized them): bucket-order x, y [m, grid-local]; per
+  // detection u0, u1, u2, fit_k, fit_t, vr_x, vr_y (WeighInputs).
+  const std::size_t rows = det_f_.size() / 9;
   float* col[9];
   for (std::size_t c = 0; c < 9; ++c) col[c] = det_f_.data() + c * rows;
   const double r = params_.resolution;
@@ -116,8 +134,7 @@ detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
     col[0][k] = static_cast<float>(mg.det_x_[k] - x0);
     col[1][k] = static_cast<float>(mg.det_y_[k] - y0);
   }
-  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
-  for (std::size_t j = 0; j < nz; ++j) {
+  for (int j = 0; j < nz; ++j) {
     col[2][j] = static_cast<float>(mg.det_los_[3 * j]);
     col[3][j] = static_cast<float>(mg.det_los_[3 * j + 1]);
     col[4][j] = static_cast<float>(mg.det_los_[3 * j + 2]);
@@ -126,6 +143,15 @@ detail::WeighInputs DynamicGrid::WeighTables(std::span<const Measurement> z) {
     col[7][j] = static_cast<float>(z[j].radial_velocity.x());
     col[8][j] = static_cast<float>(z[j].radial_velocity.y());
   }
+}
+
+detail::WeighInputs DynamicGrid::WeighTables() const {
+  const FilterParams& p = cycle_params_;
+  const MeasurementGrid& mg = *mg_;
+  const std::size_t rows = det_f_.size() / 9;
+  const float* col[9];
+  for (std::size_t c = 0; c < 9; ++c) col[c] = det_f_.data() + c * rows;
+  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
   WeighInputs in;
   const double cutoff = p.cutoff_sigmas * p.sigma_f;
   in.inv_2sf2 = static_cast<float>(0.5 / (p.sigma_f * p.sigma_f));
@@ -204,40 +230,17 @@ void DynamicGrid::ScalarNormalise(const detail::CellParticles& c, bool literal_n
   }
 }
 
-void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
+void DynamicGrid::UpdateCells(const Team& team, std::span<const Measurement> z) {
   // This cycle's factors (persistence, decay, birth probability scaled to dt).
   const FilterParams& p = cycle_params_;
   const MeasurementGrid& mg = *mg_;
   const double inv_2sf2 = 0.5 / (p.sigma_f * p.sigma_f);
   const double inv_sd2 = 1.0 / (p.sigma_static_distance * p.sigma_static_distance);
   const double inv_sv2 = 1.0 / (p.sigma_static_velocity * p.sigma_static_velocity);
-  const double inv_2v2 = 0.5 / (p.sigma_v * p.sigma_v);
   const double keep = 1.0 - p.decay_eps;
   const double max_speed2 = p.max_speed * p.max_speed;
   LocalParticles& q = sorted_;
-  // Per detection, once per cycle: f_v of the static hypothesis (v = 0; the same in both
-  // likelihood forms, since a zero velocity has no line-of-sight component either), and for the
-  // radial likelihood the unit line of sight u and the signed compensated radial speed v_r . u.
-  const int nz = static_cast<int>(z.size());
-  if (static_cast<int>(det_fv0_.size()) < nz) det_fv0_.resize(nz);  // grow only
-  for (int j = 0; j < nz; ++j)
-    det_fv0_[j] = ExpUnder(-z[j].radial_velocity.squaredNorm() * inv_2v2);
-  // radial_fit: per detection 1 / (2 (sigma_v^2 + s_t^2)) of the tangential term, 0 where no fit.
-  const bool radial_fit = p.velocity_likelihood == VelocityLikelihood::kRadialFit;
-  if (radial_fit) {
-    if (static_cast<int>(det_fit_k_.size()) < nz) det_fit_k_.resize(nz);  // grow only
-    for (int j = 0; j < nz; ++j) {
-      const double s2 = p.sigma_v * p.sigma_v + mg.det_fit_sd_[j] * mg.det_fit_sd_[j];
-      det_fit_k_[j] = std::isfinite(s2) ? 0.5 / s2 : 0.0;
-    }
-  }
-  const double* const fit_k = det_fit_k_.data();
-  const double* const fit_t = mg.det_fit_t_.data();
-  // The static hypothesis (v = 0) is scored by the same f_v: under radial_fit its tangential
-  // part 0 against the fit's v_t as well, so a fitted crossing car is not taken for static.
-  if (radial_fit)
-    for (int j = 0; j < nz; ++j)
-      if (fit_k[j] > 0.0) det_fv0_[j] *= ExpUnder(-fit_t[j] * fit_t[j] * fit_k[j]);
+  // Per detection (DetectionTables, this cycle): f_v of the static hypothesis.
   const double* const fv0_of = det_fv0_.data();
   const bool literal_norm = p.normalisation == Normalisation::kLiteral;
   const bool keep_prediction = p.zero_likelihood == ZeroLikelihood::kKeepPrediction;
@@ -248,25 +251,21 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
   const double* const near_d2 = mg.near_d2_.data();
   const std::int64_t* const bucket_start = mg.bucket_start_.data();
   const int nbx = mg.nbx_, nby = mg.nby_;
-  const WeighInputs weigh = WeighTables(z);
+  const WeighInputs weigh = WeighTables();
   const float inv_bucket = static_cast<float>(1.0 / (mg.bucket_cells_ * params_.resolution));
   const std::uint8_t* const view_bits = mg.view_.data();
   double* const free_l = free_.data();
   double* const static_l = static_.data();
   double* const dynamic_l = dynamic_.data();
   double* const born_l = born_.data();
-  // Blocks of cells in parallel, dealt round robin: the same block goes to the same thread every
+  // Blocks of cells dealt round robin over the team: the same block goes to the same thread every
   // cycle (its cells stay in that core's cache; dynamic scheduling moved them between cores, which
   // cost more than it balanced: docs/performance.md, round 3), and neighbouring blocks, where the
   // particles cluster, go to different threads. Every value is computed by one thread from the
-  // same inputs, so results do not depend on the thread count. A plain pragma, not ParallelFor
-  // (dualgrid/core/parallel.hpp): the loop body as a lambda compiled to 2 % more instructions
-  // (callgrind, bench_filter paper size), more than the one team per cycle costs inside the
-  // co-simulation's per-mode threads (docs/performance.md, round 5).
+  // same inputs, so results do not depend on the thread count.
   const FastCellInputs fast_in{start, near, view_bits, fm, fm_nr, static_persistence, free_decay};
   const std::int64_t chunks = (num_cells_ + kCellChunk - 1) / kCellChunk;
-#pragma omp parallel for schedule(static, 1)
-  for (std::int64_t ch = 0; ch < chunks; ++ch) {
+  ForRoundRobin(team, chunks, [&](std::int64_t ch) {
     const std::int64_t c_lo = ch * kCellChunk, c_hi = std::min(num_cells_, c_lo + kCellChunk);
     // Fast path (most cells): no particle, no detection (FastCells). The other cells keep their
     // values there and are updated in the loop below, which visits only them.
@@ -472,7 +471,7 @@ void DynamicGrid::UpdateCells(std::span<const Measurement> z) {
       if (rho_b != 0.0) born_list[n_born++] = s;
     }
     born_count_[ch] = n_born;
-  }
+  });
 }
 
 }  // namespace dualgrid::filter

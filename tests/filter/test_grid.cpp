@@ -184,45 +184,90 @@ TEST_CASE("free space lies in front of detections, unknown behind and outside th
   CHECK(at.static_occ + at.dynamic > 0.5);
 }
 
+namespace {
+
+// Particles and cell states after six cycles (with a Reframe after the third when `turn`), as
+// doubles, with the calling thread's OpenMP settings.
+std::vector<double> GridBits(WeightMode mode, bool turn) {
+  FilterParams fp;
+  fp.mode = mode;
+  fp.num_particles = 20000;  // many particles so both threads get work
+  fp.num_birth = 2000;
+  DynamicGrid g(fp, 77);
+  Pose2 ego;
+  for (int step = 0; step < 6; ++step) {
+    ego.position.x() += 1.2;
+    const auto cov = Sensors(ego);
+    g.Update({ego, {24, 0}}, RandomDetections(ego, 77, step, cov), cov, 0.05);
+    if (turn && step == 2) g.Reframe(0.1, ego.position);
+  }
+  std::vector<double> out;
+  const ParticleSet& p = g.particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    out.insert(out.end(),
+               {p.x[i], p.y[i], p.vx[i], p.vy[i], p.w_position[i], p.w_velocity[i], p.weight[i]});
+  }
+  for (int y = 0; y < g.cells_y(); ++y) {
+    for (int x = 0; x < g.cells_x(); ++x) {
+      const CellState c = g.Cell({x, y});
+      out.insert(out.end(),
+                 {c.free, c.static_occ, c.dynamic, c.mean_velocity.x(), c.velocity_cov(0, 1)});
+    }
+  }
+  return out;
+}
+
+std::size_t Mismatches(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return a.size() + b.size();
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) m += a[i] != b[i];
+  return m;
+}
+
+}  // namespace
+
 TEST_CASE("output is bit-identical with 1, 2 and 3 OpenMP threads", "[filter][determinism]") {
   const WeightMode mode = GENERATE(WeightMode::kPosition, WeightMode::kVelocity, WeightMode::kDual);
+  const bool turn = GENERATE(false, true);
   const auto run = [&](int threads) {
     omp_set_num_threads(threads);
-    FilterParams fp;
-    fp.mode = mode;
-    fp.num_particles = 20000;  // many particles so both threads get work
-    fp.num_birth = 2000;
-    DynamicGrid g(fp, 77);
-    Pose2 ego;
-    for (int step = 0; step < 6; ++step) {
-      ego.position.x() += 1.2;
-      const auto cov = Sensors(ego);
-      g.Update({ego, {24, 0}}, RandomDetections(ego, 77, step, cov), cov, 0.05);
-    }
-    std::vector<double> out;
-    const ParticleSet& p = g.particles();
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      out.insert(out.end(),
-                 {p.x[i], p.y[i], p.vx[i], p.vy[i], p.w_position[i], p.w_velocity[i], p.weight[i]});
-    }
-    for (int y = 0; y < g.cells_y(); ++y) {
-      for (int x = 0; x < g.cells_x(); ++x) {
-        const CellState c = g.Cell({x, y});
-        out.insert(out.end(),
-                   {c.free, c.static_occ, c.dynamic, c.mean_velocity.x(), c.velocity_cov(0, 1)});
-      }
-    }
-    return out;
+    return GridBits(mode, turn);
   };
   const int saved = omp_get_max_threads();
   // Three threads split the float kernels' cells and particles at other places again.
   const std::vector<double> one = run(1), two = run(2), three = run(3);
   omp_set_num_threads(saved);
-  REQUIRE(one.size() == two.size());
-  REQUIRE(one.size() == three.size());
-  std::size_t mismatches = 0;
-  for (std::size_t i = 0; i < one.size(); ++i) mismatches += one[i] != two[i] || one[i] != three[i];
-  CHECK(mismatches == 0);
+  REQUIRE(!one.empty());
+  CHECK(Mismatches(one, two) == 0);
+  CHECK(Mismatches(one, three) == 0);
+}
+
+// The co-simulation's pattern (cosim/src/cosimulation.cpp): filters updated on the threads of an
+// enclosing region, each with omp_set_num_threads(per_filter). The cycle's region binds to its
+// own team (with one thread per filter: no region, so nothing binds to the enclosing one).
+TEST_CASE("Update from the threads of an enclosing region gives the same bits",
+          "[filter][determinism]") {
+  const int per_filter = GENERATE(1, 2);
+  const int levels = GENERATE(1, 2);  // 1: the filters' regions get one thread; 2: nested teams
+  const std::vector<double> plain = [] {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(1);
+    auto bits = GridBits(WeightMode::kDual, true);
+    omp_set_num_threads(saved);
+    return bits;
+  }();
+  const int saved_levels = omp_get_max_active_levels();
+  omp_set_max_active_levels(levels);
+  std::vector<double> nested[2];
+#pragma omp parallel num_threads(2)
+  {
+    omp_set_num_threads(per_filter);  // this thread's nested regions only
+    nested[omp_get_thread_num()] = GridBits(WeightMode::kDual, true);
+  }
+  omp_set_max_active_levels(saved_levels);
+  INFO("per_filter " << per_filter << ", max active levels " << levels);
+  CHECK(Mismatches(plain, nested[0]) == 0);
+  CHECK(Mismatches(plain, nested[1]) == 0);
 }
 
 TEST_CASE("new-born mass belongs to the last update only, in every path and after a shift",

@@ -30,6 +30,7 @@ namespace dualgrid::filter {
 namespace detail {
 struct WeighInputs;
 struct CellParticles;
+struct Team;
 }  // namespace detail
 
 /// The ego in the caller's frame; the grid is centred on pose.position (a caller wanting the ego
@@ -72,8 +73,17 @@ class DynamicGrid {
   DynamicGrid(const FilterParams& params, std::uint64_t seed);
 
   /// One filter cycle. The first call initialises the grid around the ego. `dt` >= 0 [s].
-  /// Builds this cycle's measurement grid (MeasurementGrid::Build on ego.pose.position) and runs
-  /// the cycle on it. The grid's own MeasurementGrid is allocated at the first call.
+  /// Builds this cycle's measurement grid (as MeasurementGrid::Build on ego.pose.position) and
+  /// runs the cycle on it, both in the one parallel region below. The grid's own MeasurementGrid
+  /// is allocated at the first call.
+  ///
+  /// Threads (both Update overloads): one OpenMP parallel region per call, with the team the
+  /// calling thread would get (omp_get_max_threads()), barriers between the cycle's stages; no
+  /// region at all when a region here would get one thread (dualgrid/core/parallel.hpp,
+  /// OneThreadHere: one thread allowed, or the caller is inside a region and no further level may
+  /// be active). May be called from inside a parallel region (its region then nests there);
+  /// distinct grids may be updated by distinct threads at once. Results are the same bits for any
+  /// team size. Threads that wait at a barrier follow OMP_WAIT_POLICY (dualgrid sets PASSIVE).
   void Update(const EgoInput& ego, std::span<const Measurement> measurements,
               std::span<const SensorCoverage> coverage, double dt);
   /// One filter cycle on a measurement grid built for it: `measurement.Build(ego.pose.position,
@@ -184,27 +194,64 @@ class DynamicGrid {
   std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
   // Storage column and row of logical cell (0, 0).
   std::array<std::int64_t, 2> StorageOrigin() const;
-  void Initialize(const EgoInput& ego);
+  // Initialisation around the ego: the origin (serial), then the particles spread over the grid
+  // with zero weight (by the team t).
+  void InitializeOrigin(const EgoInput& ego);
+  void SpreadParticles(const detail::Team& t);
   void ShiftTo(const Position& ego);
   // Global index of logical cell (0, 0) for a grid centred on `ego`.
   std::array<std::int64_t, 2> OriginFor(const Position& ego) const;
   void ResetColumn(std::int64_t gx);
   void ResetRow(std::int64_t gy);
+  // Threads of a cycle (docs/algorithm.md, "One cycle"): Update sizes every scratch buffer
+  // (PrepareCycle), then runs Cycle either on the calling thread alone (OneThreadHere: no
+  // parallel region at all) or in ONE parallel region, every thread of it calling Cycle with its
+  // Team; the stages below are called by every thread of the team in the same order, separated
+  // by the team's barriers, and neither allocate nor throw. Each value is computed by one thread
+  // from the same inputs, so the results do not depend on the team's size.
+  // The checks of Update (throws), then the cycle on `measurement`; with `fill` (the grid's own
+  // MeasurementGrid, prepared: MeasurementGrid::Prepare), its tables are filled first, in the
+  // same region.
+  void Run(const EgoInput& ego, const MeasurementGrid& measurement, double dt,
+           const PredictionNoise* noise, MeasurementGrid* fill,
+           std::span<const SensorCoverage> coverage);
+  void PrepareCycle(std::size_t detections);
+  void Cycle(const detail::Team& t, std::span<const Measurement> z, double dt,
+             const PredictionNoise* noise, bool first);
   // Prediction (PredictParticles) fused with the counting sort's first pass; `noise` may be null.
-  void PredictAndSort(double dt, const PredictionNoise* noise);
+  // Also fills this cycle's detection tables (DetectionTables) and view_, beside the sort's scan.
+  void PredictAndSort(const detail::Team& t, std::span<const Measurement> z, double dt,
+                      const PredictionNoise* noise);
+  // This cycle's per-detection tables (det_fv0_, det_fit_k_, the float columns det_f_); serial.
+  void DetectionTables(std::span<const Measurement> z);
   // Particle weights (eqs. 7, 8, 14) and occupancy fusion (eqs. 9-12) cell by cell.
-  void UpdateCells(std::span<const Measurement> z);
-  // This cycle's float detection tables of the particle kernel (into det_f_).
-  detail::WeighInputs WeighTables(std::span<const Measurement> z);
+  void UpdateCells(const detail::Team& t, std::span<const Measurement> z);
+  // The particle kernel's view of the detection tables (pointers into det_f_).
+  detail::WeighInputs WeighTables() const;
   // Eqs. (10-12) for one cell's particles in double (cells whose factors overflow float).
   void ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
                        double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
                        double fast_mass) const;
-  void Birth(std::span<const Measurement> z);
+  // Step 7 in two parts: the birth mass's prefix sums (true when births are to be drawn; false
+  // leaves zero-weight births once the team's next barrier is passed), then the births
+  // themselves. The sums: block totals `tot` and running sums at each cell chunk's start
+  // `chunk_acc`, either the thread's own (few blocks: each thread computes them) or the team's
+  // shared born_block_ / born_chunk_acc_.
+  struct BirthSums {
+    static constexpr int kBlocks = 8, kChunks = 256;  // own arrays: scan blocks, cell chunks
+    double own_tot[kBlocks + 1], own_chunk_acc[kChunks];
+    const double *tot = nullptr, *chunk_acc = nullptr;
+  };
+  bool BirthMass(const detail::Team& t, BirthSums& sums);
+  void DrawBirths(const detail::Team& t, std::span<const Measurement> z, const BirthSums& sums);
   // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
   void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
                       std::int64_t k_hi, double mass, double vmax);
-  void Resample();
+  // Step 8: ScanPersistent (serial) may run once the weights are final, beside DrawBirths (it
+  // starts the prefix sums over the persistent particles when they fit in one scan block);
+  // Resample finishes the sums and copies.
+  void ScanPersistent();
+  void Resample(const detail::Team& t);
 
   FilterParams params_;
   // params_ with the per-cycle factors of this cycle's dt (ForCycle): what steps 2-7 read.
@@ -249,6 +296,8 @@ class DynamicGrid {
   std::vector<std::int32_t> hist_;               // per-chunk histograms of the counting sort
   std::vector<std::int64_t> hist_total_;
   std::vector<double> scan_out_;    // resampling prefix sums of the source weights
+  std::vector<double> scan_base_;   // their block totals
+  double scan_persistent_ = 0.0;    // ScanPersistent's running sum
   std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
   // Cells with non-zero birth mass, per UpdateCells chunk (slots [chunk * size, + count)).
   std::vector<std::int64_t> born_cells_;

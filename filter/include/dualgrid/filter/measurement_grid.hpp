@@ -35,6 +35,9 @@ struct SensorCoverage {
 };
 
 class DynamicGrid;
+namespace detail {
+struct Team;
+}  // namespace detail
 
 }  // namespace dualgrid::filter
 
@@ -67,8 +70,9 @@ class MeasurementGrid {
 
   /// Builds the grid of one cycle for a filter grid centred on `centre` [m] (the position of the
   /// cycle's EgoInput, after any Reframe). Detections or sensors with non-finite values are
-  /// skipped, as in DynamicGrid::Update. O(cells + detections x cutoff area); parallel over rows
-  /// (OpenMP), results independent of the thread count. Throws std::invalid_argument for a
+  /// skipped, as in DynamicGrid::Update. O(cells + detections x cutoff area); in one OpenMP
+  /// parallel region (none when a region here would get one thread, OneThreadHere), results
+  /// independent of the thread count. Throws std::invalid_argument for a
   /// centre that is not finite or beyond FilterParams::kMaxCentre, or an invalid SensorCoverage
   /// (as DynamicGrid::Update).
   void Build(const Position& centre, std::span<const Measurement> z,
@@ -90,14 +94,31 @@ class MeasurementGrid {
   // this class instead of keeping a copy of it.
   friend class ::dualgrid::filter_ref::DynamicGrid;
 
-  void Stamp();  // nearest detection per cell centre and the detection buckets
-  void Bins(std::span<const SensorCoverage> cov);
-  void FieldOfView(std::span<const SensorCoverage> cov);
+  // Build in two parts. Prepare (serial): checks the inputs (throws), places the grid and the
+  // detections (PlaceDetections) and sizes every array the build writes. Fill: the tables, by
+  // the team t (detail::Team's contract: every thread of it calls Fill; no allocation, no throw).
+  // Fill ends without a barrier: the tables are complete for a reader only after the team's next
+  // barrier (Build: its region's end). DynamicGrid::Update runs Fill in the cycle's own region.
+  void Prepare(const Position& centre, std::span<const Measurement> z,
+               std::span<const SensorCoverage> coverage);
+  void Fill(const detail::Team& t, std::span<const SensorCoverage> coverage);
+  // Per detection its bucket (or -1: not near the grid) and stamp origin; the bucket counts.
+  void PlaceDetections();
+  // The detection buckets' ranges and contents in bucket order (serial).
+  void FillBuckets();
+  // Nearest detection per cell centre of the bands [band_lo, band_hi) of storage rows
+  // (kStampBands bands): resets the bands' cells of the last build, then stamps every
+  // detection's cells in them in detection order (ties to the lower index whatever the bands
+  // or thread).
+  void StampBands(int band_lo, int band_hi);
+  void Bins(std::span<const SensorCoverage> cov);               // the bins' ranges (serial)
+  void FieldOfViewTables(std::span<const SensorCoverage> cov);  // per-sensor constants (serial)
+  void FieldOfViewRow(int ly, std::span<const SensorCoverage> cov);  // view_ of logical row ly
   // Per detection the unit line of sight and the signed radial speed into det_los_.
   void ComputeLinesOfSight();
   // Per detection the tangential velocity a robust fit to its neighbours' Doppler gives, and its
-  // standard deviation (inf: no fit).
-  void FitDetectionVelocities();
+  // standard deviation (inf: no fit), by the team t; no barrier at the end.
+  void FitDetectionVelocities(const detail::Team& t);
   // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
   // every cell holding particles.
   std::pair<int, int> BucketOf(double px, double py) const;
@@ -114,10 +135,14 @@ class MeasurementGrid {
   std::vector<Measurement> z_;
 
   // Per cell (storage order: circular in both axes, as DynamicGrid's layers).
-  std::vector<std::uint8_t> view_;     // field-of-view / ray free-space bits (grid_internal.hpp)
-  std::vector<int> near_det_;          // nearest detection index or -1
-  std::vector<double> near_d2_;        // its squared distance to the cell centre [m^2]
-  std::vector<std::int64_t> touched_;  // cells with near_det_ set (reset next Build)
+  std::vector<std::uint8_t> view_;  // field-of-view / ray free-space bits (grid_internal.hpp)
+  std::vector<int> near_det_;       // nearest detection index or -1
+  std::vector<double> near_d2_;     // its squared distance to the cell centre [m^2]
+  // Cells with near_det_ set (reset by the next Build), per band of storage rows: band b holds
+  // rows [b ny / kStampBands, (b + 1) ny / kStampBands).
+  static constexpr int kStampBands = 8;
+  std::vector<std::int64_t> touched_[kStampBands];
+  std::vector<int> band_of_row_;  // per storage row
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff + one cell).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
@@ -126,6 +151,9 @@ class MeasurementGrid {
   std::vector<int> bucket_items_;
   std::vector<double> det_x_, det_y_;     // detection positions in bucket order [m]
   std::vector<std::int64_t> det_bucket_;  // bucket per detection or -1 (not near the grid)
+  // Per detection with a bucket: logical cell (lx, ly) and the storage row of its stamp's first
+  // row max(0, ly - rc).
+  std::vector<std::array<int, 3>> det_stamp_;
 
   // Per-sensor bearing bins for the ray free space.
   std::vector<double> bin_range_;
