@@ -156,9 +156,12 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     for (int m : schedule.scores(t)) score(m);
     if (t == schedule.truth_thread()) {  // the other slot: no race
       guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
-      // The next step's measurement grid, in the time this thread would wait for the others:
-      // only when it runs fewer filters than they do (3 modes on 2 threads); otherwise there is
-      // no such time and Advance builds it with every thread.
+      // The next step (SUMO's step and the radar scan, or a recorded source's twin) and its
+      // measurement grid, in the time this thread would wait for the others: only when it runs
+      // fewer filters than they do (3 modes on 2 threads); otherwise there is no such time and
+      // Advance does it all between the regions. After the truth (this thread's, above): nothing
+      // in this region reads the source or ids() afterwards, and every reader of the step reads
+      // the pipeline's copy of it.
       if (read_ahead_ && team > 1 && schedule.filters(t).size() < schedule.filters(0).size())
         pipeline_.PrepareAhead();
     }
@@ -221,7 +224,7 @@ const ModeSchedule& CoSimulation::ScheduleFor(int modes, int team) {
 
 bool CoSimulation::finished() const {
   const sim::SumoSimulation* sumo = pipeline_.sumo();
-  return pipeline_.started() && steps_ > 0 && pipeline_.source().reached_end() &&
+  return pipeline_.started() && steps_ > 0 && pipeline_.reached_end() &&
          !(sumo && sumo->ego_left());
 }
 
