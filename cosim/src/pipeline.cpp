@@ -267,7 +267,6 @@ Position Pipeline::FilterInputs(const StepData& step, const radar::RadarModel& r
 }
 
 void Pipeline::PrepareAhead() noexcept {
-  ahead_.ready = false;
   if (filters_.empty() || advances_ == 0 || ahead_.given_up) return;
   if (source_->can_run_ahead())
     RunAhead();
@@ -276,7 +275,8 @@ void Pipeline::PrepareAhead() noexcept {
 }
 
 void Pipeline::RunAhead() noexcept {
-  if (ahead_.read != Ahead::Read::kNothing) return;  // one step ahead at most
+  if (ahead_.read != Ahead::Read::kNothing) return;  // one step ahead at most (and its grid)
+  ahead_.ready = false;
   try {
     if (!ReadStep(*source_, ids_, &ahead_.step)) {
       ahead_.read = Ahead::Read::kEnd;
@@ -299,6 +299,7 @@ void Pipeline::RunAhead() noexcept {
 }
 
 void Pipeline::ReadTwinAhead() noexcept {
+  ahead_.ready = false;
   try {
     if (!ahead_.source) {
       ahead_.source = source_->Twin();
