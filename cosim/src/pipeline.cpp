@@ -266,16 +266,9 @@ Position Pipeline::FilterInputs(const StepData& step, const radar::RadarModel& r
   return g.ToGrid(ego).position + centre_offset_;
 }
 
-void Pipeline::PrepareAhead() noexcept {
-  if (filters_.empty() || advances_ == 0 || ahead_.given_up) return;
-  if (source_->can_run_ahead())
-    RunAhead();
-  else
-    ReadTwinAhead();
-}
-
-void Pipeline::RunAhead() noexcept {
-  if (ahead_.read != Ahead::Read::kNothing) return;  // one step ahead at most (and its grid)
+void Pipeline::ReadAhead() noexcept {
+  if (filters_.empty() || advances_ == 0 || !source_->can_run_ahead()) return;
+  if (ahead_.read != Ahead::Read::kNothing) return;  // one step ahead at most
   ahead_.ready = false;
   try {
     if (!ReadStep(*source_, ids_, &ahead_.step)) {
@@ -284,12 +277,22 @@ void Pipeline::RunAhead() noexcept {
     }
     ahead_.read = Ahead::Read::kStep;
     ahead_.advances = advances_ + 1;
+    ++ahead_.read_steps;
   } catch (...) {
     // The run's own error, for the next Advance() to throw: what reading this step there throws.
     ahead_.error = std::current_exception();
     ahead_.read = Ahead::Read::kError;
+  }
+}
+
+void Pipeline::PrepareAhead() noexcept {
+  if (filters_.empty() || advances_ == 0 || ahead_.given_up) return;
+  if (!source_->can_run_ahead()) {
+    ReadTwinAhead();
     return;
   }
+  ReadAhead();
+  if (ahead_.read != Ahead::Read::kStep || ahead_.ready) return;  // nothing to build, or built
   try {
     BuildAhead(radar());
   } catch (...) {

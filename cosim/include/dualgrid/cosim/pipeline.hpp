@@ -75,7 +75,7 @@ class Pipeline {
 
   /// Advances SUMO one step, scans the due radars and prepares the filters' inputs, with their
   /// shared measurement grid (step 4, built once for every mode). False at the end (the duration
-  /// reached, or the ego left the network). Needs Start(). When PrepareAhead() has read this step
+  /// reached, or the ego left the network). Needs Start(). When ReadAhead() has read this step
   /// already (a source that can_run_ahead()), the step is taken from there, and so is what
   /// happened reading it: the end (false) or the source's exception, thrown here, at the step it
   /// belongs to, as if the source had been read now.
@@ -90,24 +90,29 @@ class Pipeline {
   /// slot, and it reads no filter). UpdateFilter reads them when they match its cycle and draws
   /// its own otherwise, so calling this only saves work. No-op without filters or when drawn.
   void DrawNoise(bool ahead);
-  /// Reads the source one step ahead and builds the next step's measurement grid (step 4), for
-  /// Advance() to take instead of building it: call it on a thread with time to spare while the
-  /// filters of a step run, after the step's last TruthObjects() call (it writes the source,
-  /// ids() and its own buffers; it reads none of the filters and writes nothing the step's
-  /// readers see: frame(), ego_motion(), detections(), scanned(), labels(), grid_frame() and
-  /// reached_end() keep describing the current step). Two ways, by the source:
-  /// - can_run_ahead() (SUMO): the source itself advances and scans the next step (at most one
-  ///   step ahead; a second call does nothing). That step is the run's: Advance() hands it out,
-  ///   and an exception or the end met reading it surfaces there (see Advance()). The source
-  ///   (sumo()) then stands one step beyond frame() until that Advance(), and when the run stops
-  ///   before it (a stop request, Finish()), SUMO has simulated that one step more.
-  /// - a Twin() (recorded data): a second source over the same data, made at the first call,
-  ///   reads the next step; errors are not thrown (the speculation stops for the run, and
-  ///   Advance() meets any error of the data at its own step).
-  /// Either way Advance() takes the grid built here only when its own inputs (measurements,
-  /// coverage, centre) are the same bits, so results never depend on it. Costs a second
-  /// measurement grid (as large as the first), made at the first call. Other sources: no-op.
+  /// For a source that can_run_ahead() (SUMO): reads the next step from the source itself (its
+  /// Advance and Scan: SUMO's step and the radar scan), at most one step ahead (a second call
+  /// does nothing). Call it on a thread with time to spare while the filters of a step run,
+  /// after the step's last TruthObjects() call: it writes the source, ids() and its own buffers,
+  /// reads none of the filters, and writes nothing the step's readers see (frame(),
+  /// ego_motion(), detections(), scanned(), labels(), grid_frame() and reached_end() keep
+  /// describing the current step). That step is the run's: the next Advance() hands it out, and
+  /// an exception or the end met reading it surfaces there (see Advance()). Until then the
+  /// source (sumo()) stands one step beyond frame(); when the run stops before it (a stop
+  /// request, Finish()), SUMO has simulated that one step more. Other sources: no-op.
+  void ReadAhead() noexcept;
+  /// Builds the next step's measurement grid (step 4) for Advance() to take instead of building
+  /// it, under the same conditions as ReadAhead(): for a source that can_run_ahead(), of the step
+  /// ReadAhead() read (reading it first if needed); for a source with a Twin() (recorded data),
+  /// of the next step read from that twin, a second source over the same data made at the first
+  /// call (the source itself is read in Advance(); errors are not thrown: the speculation stops
+  /// for the run, and Advance() meets any error of the data at its own step). Advance() takes
+  /// the grid only when its own inputs (measurements, coverage, centre) are the same bits, so
+  /// results never depend on it. Costs a second measurement grid (as large as the first), made
+  /// at the first call. Other sources: no-op.
   void PrepareAhead() noexcept;
+  /// Steps ReadAhead() read (not counting an end or an error met).
+  std::uint64_t ahead_read() const { return ahead_.read_steps; }
   /// Steps whose measurement grid PrepareAhead() built, and those of them Advance() took.
   std::uint64_t ahead_prepared() const { return ahead_.prepared; }
   std::uint64_t ahead_hits() const { return ahead_hits_; }
@@ -122,7 +127,7 @@ class Pipeline {
   /// SUMO; throws std::logic_error for a source without it (recorded data): see sumo().
   const sim::SumoSimulation& simulation() const;
   /// SUMO, or nullptr for a recorded sequence. SUMO's own state (its clock, ego_left()) may stand
-  /// one step beyond frame() while a step is read ahead (PrepareAhead).
+  /// one step beyond frame() while a step is read ahead (ReadAhead).
   const sim::SumoSimulation* sumo() const { return source_->sumo(); }
   const DetectionSource& source() const { return *source_; }
   /// The radars as mounted on the ego's box as SUMO simulates it: built once, at the ego's
@@ -182,11 +187,9 @@ class Pipeline {
   // Advances `source` and scans its new step into `step`; false at the source's end (`step`
   // untouched). Exceptions of the source propagate (`step` may then hold part of the step).
   static bool ReadStep(DetectionSource& source, IdRegistry& ids, StepData* step);
-  // The next step into current_: the one PrepareAhead read (or its end or exception), else the
+  // The next step into current_: the one ReadAhead read (or its end or exception), else the
   // source's next.
   bool NextStep();
-  // PrepareAhead for a source that can_run_ahead(): reads its next step into ahead_.step.
-  void RunAhead() noexcept;
   // PrepareAhead for a source with a Twin(): reads the twin's next step into ahead_.step.
   void ReadTwinAhead() noexcept;
   // Builds the measurement grid of ahead_.step (seen by `radar`) into ahead_.grid, in the grid
@@ -225,13 +228,13 @@ class Pipeline {
   // source's twin, with its own ids, `advances` calls), and its inputs and measurement grid, for
   // Advance() number `advances` when `ready`.
   struct Ahead {
-    // What RunAhead read from the source itself, for the next Advance() to hand out.
+    // What ReadAhead read from the source itself, for the next Advance() to hand out.
     enum class Read { kNothing, kStep, kEnd, kError };
     Read read = Read::kNothing;
     std::exception_ptr error;  // with kError
     std::unique_ptr<DetectionSource> source;
     IdRegistry ids;
-    std::uint64_t advances = 0, prepared = 0;
+    std::uint64_t advances = 0, prepared = 0, read_steps = 0;
     bool given_up = false;  // no twin, the end reached, or an error: no more reading ahead
     bool ready = false;
     StepData step;
