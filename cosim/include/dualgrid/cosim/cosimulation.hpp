@@ -34,11 +34,12 @@ struct CoSimOptions {
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
   /// threads), it reads the next step while the others filter (SUMO's step and the radar scan;
   /// for recorded data a twin of the source) and builds that step's measurement grid there
-  /// (Pipeline::PrepareAhead). Results do not depend on it: the grid is taken only for the same
-  /// inputs, and an error or the end met reading ahead surfaces at the next Step(), where it
-  /// would have without it. SUMO then stands one step ahead between steps: a run stopped early
-  /// has simulated that step too (sumo(), SUMO's own outputs). Its gain is measured in
-  /// docs/performance.md.
+  /// (Pipeline::ReadAhead, PrepareAhead; for SUMO the grid only while another thread still
+  /// filters, else Advance builds it with every thread). Results do not depend on it: the grid is
+  /// taken only for the same inputs, and an error or the end met reading ahead surfaces at the next
+  /// Step(), where it would have without it. SUMO then stands one step ahead between steps: a run
+  /// stopped early has simulated that step too (sumo(), SUMO's own outputs). Its gain is measured
+  /// in docs/performance.md.
   bool read_ahead = true;
 };
 
@@ -90,8 +91,9 @@ class CoSimulation {
 
   /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's region),
   /// every mode's filter cycle, the shared ground truth and every mode's scoring (one parallel
-  /// region; with read_ahead, the next step's SUMO step, radar scan and measurement grid on a
-  /// thread with time to spare in it), then the observers. False at the end of the run (nothing
+  /// region; with read_ahead, the next step's SUMO step and radar scan, and its measurement grid
+  /// while another thread still filters, on a thread with time to spare in it), then the
+  /// observers. False at the end of the run (nothing
   /// done then). An exception of SUMO or the radar is thrown by the Step() of the step it belongs
   /// to, after the observers of every earlier step ran.
   bool Step();

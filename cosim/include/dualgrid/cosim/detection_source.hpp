@@ -79,7 +79,7 @@ class DetectionSource {
   /// one simulation per process).
   virtual std::unique_ptr<DetectionSource> Twin() const { return nullptr; }
   /// The Pipeline may advance this very source one step before the run needs that step
-  /// (Pipeline::PrepareAhead, on a thread with time to spare while the filters run) and hand it
+  /// (Pipeline::ReadAhead, on a thread with time to spare while the filters run) and hand it
   /// out at the next Pipeline::Advance. The Pipeline copies each step out (frame, ego, labels,
   /// detections, scanned sensors, reached_end), so a source that says true must keep nothing
   /// else that the run reads per step: radar() must not change after the first Advance().
