@@ -156,11 +156,22 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     for (int m : schedule.scores(t)) score(m);
     if (t == schedule.truth_thread()) {  // the other slot: no race
       guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
-      // The next step's measurement grid, in the time this thread would wait for the others:
-      // only when it runs fewer filters than they do (3 modes on 2 threads); otherwise there is
-      // no such time and Advance builds it with every thread.
-      if (read_ahead_ && team > 1 && schedule.filters(t).size() < schedule.filters(0).size())
-        pipeline_.PrepareAhead();
+      // In the time this thread would wait for the others, only when it runs fewer filters
+      // than they do (3 modes on 2 threads; otherwise there is no such time and Advance does
+      // it all between the regions): the next step from a source that can run ahead (SUMO's
+      // step and the radar scan), then its measurement grid while another thread still filters
+      // (once they are all done, Advance builds it faster with every thread than this one
+      // alone would); for recorded data the grid of the next step read from a twin of the
+      // source (reading it is cheap), in every step. After the truth (this
+      // thread's, above): nothing in this region reads the source or ids() afterwards, and
+      // every reader of the step reads the pipeline's copy of it.
+      if (read_ahead_ && team > 1 && schedule.filters(t).size() < schedule.filters(0).size()) {
+        pipeline_.ReadAhead();
+        const bool others_filtering = std::any_of(
+            filtered.begin(), filtered.end(),
+            [](const std::atomic<int>& done) { return done.load(std::memory_order_acquire) == 0; });
+        if (others_filtering || !pipeline_.source().can_run_ahead()) pipeline_.PrepareAhead();
+      }
     }
   };
   if (team == 1) {
@@ -221,7 +232,7 @@ const ModeSchedule& CoSimulation::ScheduleFor(int modes, int team) {
 
 bool CoSimulation::finished() const {
   const sim::SumoSimulation* sumo = pipeline_.sumo();
-  return pipeline_.started() && steps_ > 0 && pipeline_.source().reached_end() &&
+  return pipeline_.started() && steps_ > 0 && pipeline_.reached_end() &&
          !(sumo && sumo->ego_left());
 }
 

@@ -130,11 +130,12 @@ const sim::SumoSimulation& Pipeline::simulation() const {
 void Pipeline::UpdateFilter(std::size_t i) {
   // The grid is centred on ego + offset (filter.ahead / filter.left); the filter reads only the
   // position of EgoInput's pose, to place the grid.
-  const Pose2 pose = grid_frame_.ToGrid(ego_.pose);
+  const radar::EgoMotion& ego_motion = current_.ego;
+  const Pose2 pose = grid_frame_.ToGrid(ego_motion.pose);
   const Position centre = pose.position + centre_offset_;
   filter::DynamicGrid& grid = *filters_[i];
   if (realign_angle_ != 0.0) grid.Reframe(realign_angle_, centre);
-  const filter::EgoInput ego{{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_.velocity)};
+  const filter::EgoInput ego{{centre, pose.yaw}, grid_frame_.VectorToGrid(ego_motion.velocity)};
   if (measurement_->SharesGeometry(grid.params())) {
     // Only this cycle's slot: a filter behind the others (after an error) draws its own, never
     // reading the slot that DrawNoise(true) may be writing.
@@ -165,19 +166,47 @@ void Pipeline::FixFrame(const sim::Frame& f) {
   using Frame = scenario::GridPlacement::Frame;
   const Frame frame = config_.grid.frame;
   grid_frame_ = GridFrame(frame == Frame::kWorld     ? 0.0
-                          : frame == Frame::kHeading ? GridYawAlong(ego_.pose.yaw)
+                          : frame == Frame::kHeading ? GridYawAlong(current_.ego.pose.yaw)
                                                      : GridYawAlong(f.ego.lane_yaw));
   centre_offset_ = config_.grid.CentreOffset(config_.filter.length_x, config_.filter.width_y);
+}
+
+bool Pipeline::ReadStep(DetectionSource& source, IdRegistry& ids, StepData* step) {
+  if (!source.Advance(ids)) return false;
+  source.Scan(ids, &step->detections, &step->scanned);
+  step->frame = source.frame();
+  step->ego = source.ego();
+  step->labels = source.labels();
+  step->reached_end = source.reached_end();
+  return true;
+}
+
+bool Pipeline::NextStep() {
+  using Read = Ahead::Read;
+  switch (std::exchange(ahead_.read, Read::kNothing)) {
+    case Read::kStep:
+      std::swap(current_, ahead_.step);
+      return true;
+    case Read::kEnd:
+      return false;
+    case Read::kError:
+      std::rethrow_exception(std::exchange(ahead_.error, nullptr));
+    case Read::kNothing:
+      break;
+  }
+  return ReadStep(*source_, ids_, &current_);
 }
 
 bool Pipeline::Advance() {
   if (!source_->started()) throw std::logic_error("Pipeline::Advance before Start");
   // Whatever happens below, a grid read ahead is for this step or never (PrepareAhead).
   const bool ahead_ready = std::exchange(ahead_.ready, false);
-  if (!source_->Advance(ids_)) return false;
+  if (!NextStep()) {
+    current_.reached_end = source_->reached_end();
+    return false;
+  }
   ++advances_;
-  const sim::Frame& f = frame();
-  ego_ = source_->ego();
+  const sim::Frame& f = current_.frame;
   // The first filter cycle (the ego may depart late) predicts over one step.
   dt_ = !first_step_ ? f.time - last_time_ : source_->first_dt();
   realign_angle_ = 0.0;
@@ -192,12 +221,9 @@ bool Pipeline::Advance() {
   first_step_ = false;
   last_time_ = f.time;
 
-  source_->Scan(ids_, &detections_, &scanned_);
-
   if (filters_.empty()) return true;
   // The grid frame has already turned (above).
-  const Position centre =
-      FilterInputs(*source_, grid_frame_, detections_, scanned_, &measurements_, &coverage_);
+  const Position centre = FilterInputs(current_, radar(), grid_frame_, &measurements_, &coverage_);
   // The grid read ahead is taken only for the very same inputs, bit for bit: Build is a function
   // of them (and of the geometry, the same), so the filters see what Build would give here.
   if (ahead_ready && ahead_.advances == advances_ && SameBits(centre, ahead_.centre) &&
@@ -215,26 +241,24 @@ std::optional<double> Pipeline::TurnedYaw(const sim::Frame& f) const {
   return RealignedYaw(grid_frame_.yaw(), f.ego.lane_yaw, DegToRad(config_.grid.realign_deg));
 }
 
-Position Pipeline::FilterInputs(const DetectionSource& source, const GridFrame& g,
-                                std::span<const radar::Detection> detections,
-                                std::span<const int> scanned,
-                                std::vector<filter::Measurement>* measurements,
+Position Pipeline::FilterInputs(const StepData& step, const radar::RadarModel& radar,
+                                const GridFrame& g, std::vector<filter::Measurement>* measurements,
                                 std::vector<filter::SensorCoverage>* coverage) const {
   measurements->clear();
   // Nothing but the ego can be inside the ego's own footprint: returns there (clutter drawn down
   // to the sensors' minimum range) would feed particles that ride along with the ego.
-  const BoxTest ego_box(source.frame().ego.box);
+  const BoxTest ego_box(step.frame.ego.box);
   // The filter works in the grid frame.
-  for (const radar::Detection& d : detections) {
+  for (const radar::Detection& d : step.detections) {
     if (ego_box.Contains(d.position_world)) continue;
     measurements->push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world),
                              g.ToGrid(d.sensor_position_world)});
   }
   coverage->clear();
-  const Pose2& ego = source.ego().pose;
-  for (int s : scanned) {
-    const radar::SensorParams& p = source.radar().sensors()[s];
-    const Pose2 pose = source.radar().SensorPose(s, ego);
+  const Pose2& ego = step.ego.pose;
+  for (int s : step.scanned) {
+    const radar::SensorParams& p = radar.sensors()[s];
+    const Pose2 pose = radar.SensorPose(s, ego);
     coverage->push_back(
         {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * p.fov, p.min_range, p.max_range});
   }
@@ -242,9 +266,43 @@ Position Pipeline::FilterInputs(const DetectionSource& source, const GridFrame& 
   return g.ToGrid(ego).position + centre_offset_;
 }
 
-void Pipeline::PrepareAhead() noexcept {
+void Pipeline::ReadAhead() noexcept {
+  if (filters_.empty() || advances_ == 0 || !source_->can_run_ahead()) return;
+  if (ahead_.read != Ahead::Read::kNothing) return;  // one step ahead at most
   ahead_.ready = false;
+  try {
+    if (!ReadStep(*source_, ids_, &ahead_.step)) {
+      ahead_.read = Ahead::Read::kEnd;
+      return;
+    }
+    ahead_.read = Ahead::Read::kStep;
+    ahead_.advances = advances_ + 1;
+    ++ahead_.read_steps;
+  } catch (...) {
+    // The run's own error, for the next Advance() to throw: what reading this step there throws.
+    ahead_.error = std::current_exception();
+    ahead_.read = Ahead::Read::kError;
+  }
+}
+
+void Pipeline::PrepareAhead() noexcept {
   if (filters_.empty() || advances_ == 0 || ahead_.given_up) return;
+  if (!source_->can_run_ahead()) {
+    ReadTwinAhead();
+    return;
+  }
+  ReadAhead();
+  if (ahead_.read != Ahead::Read::kStep || ahead_.ready) return;  // nothing to build, or built
+  try {
+    BuildAhead(radar());
+  } catch (...) {
+    // Only the grid failed: Advance builds it itself and meets any error there.
+    ahead_.ready = false;
+  }
+}
+
+void Pipeline::ReadTwinAhead() noexcept {
+  ahead_.ready = false;
   try {
     if (!ahead_.source) {
       ahead_.source = source_->Twin();
@@ -252,25 +310,16 @@ void Pipeline::PrepareAhead() noexcept {
         ahead_.given_up = true;
         return;
       }
-      ahead_.grid = std::make_unique<filter::MeasurementGrid>(measurement_params_);
     }
     // The twin reads the step after the last Advance() (it catches up if a call was skipped).
     while (ahead_.advances <= advances_) {
-      if (!ahead_.source->Advance(ahead_.ids)) {
+      if (!ReadStep(*ahead_.source, ahead_.ids, &ahead_.step)) {
         ahead_.given_up = true;  // the sequence ends: nothing left to read ahead
         return;
       }
-      ahead_.source->Scan(ahead_.ids, &ahead_.detections, &ahead_.scanned);
       ++ahead_.advances;
     }
-    const sim::Frame& f = ahead_.source->frame();
-    const std::optional<double> yaw = TurnedYaw(f);
-    const GridFrame g = yaw ? GridFrame(*yaw) : grid_frame_;
-    ahead_.centre = FilterInputs(*ahead_.source, g, ahead_.detections, ahead_.scanned,
-                                 &ahead_.measurements, &ahead_.coverage);
-    ahead_.grid->Build(ahead_.centre, ahead_.measurements, ahead_.coverage);
-    ahead_.ready = true;
-    ++ahead_.prepared;
+    BuildAhead(ahead_.source->radar());
   } catch (...) {
     // Only speculation failed: Advance builds the step's grid itself and reports any error of
     // the data at its own step. The twin's state is unknown now, so it is not used again.
@@ -279,9 +328,19 @@ void Pipeline::PrepareAhead() noexcept {
   }
 }
 
+void Pipeline::BuildAhead(const radar::RadarModel& radar) {
+  if (!ahead_.grid) ahead_.grid = std::make_unique<filter::MeasurementGrid>(measurement_params_);
+  const std::optional<double> yaw = TurnedYaw(ahead_.step.frame);
+  const GridFrame g = yaw ? GridFrame(*yaw) : grid_frame_;
+  ahead_.centre = FilterInputs(ahead_.step, radar, g, &ahead_.measurements, &ahead_.coverage);
+  ahead_.grid->Build(ahead_.centre, ahead_.measurements, ahead_.coverage);
+  ahead_.ready = true;
+  ++ahead_.prepared;
+}
+
 OrientedBox Pipeline::GridFootprint() const {
   const double length = config_.filter.length_x, width = config_.filter.width_y;
-  Position centre = grid_frame_.ToGrid(ego_.pose.position) + centre_offset_;
+  Position centre = grid_frame_.ToGrid(current_.ego.pose.position) + centre_offset_;
   if (!filters_.empty() && filters_[0]->initialized()) {
     const filter::DynamicGrid& g = *filters_[0];
     const auto [gx, gy] = g.origin_index();
@@ -293,11 +352,11 @@ OrientedBox Pipeline::GridFootprint() const {
 
 std::vector<eval::TruthObject> Pipeline::TruthObjects(const filter::DynamicGrid& grid) const {
   std::vector<eval::TruthObject> out;
-  const auto poses = radar().SensorPoses(ego_.pose);
+  const auto poses = radar().SensorPoses(current_.ego.pose);
   // Sources of this step's detections inside the grid: the t_d clock starts at a vehicle's first.
   std::vector<int> detected;
   const GridFrame& g = grid_frame_;
-  for (const radar::Detection& d : detections_)
+  for (const radar::Detection& d : current_.detections)
     if (grid.CellOf(g.ToGrid(d.position_world))) detected.push_back(d.source_id);
   std::sort(detected.begin(), detected.end());
   for (const sim::VehicleState& v : frame().vehicles) {

@@ -6,6 +6,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <string>
+#include <typeinfo>
 
 #include <nlohmann/json.hpp>
 
@@ -148,4 +151,135 @@ TEST_CASE("CoSimulation without modes: SUMO and the radar only", "[cosim][sumo]"
   CHECK(cs.Metrics().empty());
   CHECK(cs.pipeline().has_radar());
   CHECK(cs.pipeline().radar().sensors().size() == cs.config().radar.sensors.size());
+}
+
+namespace {
+
+// What a run shows of its end; the tests below compare it with reading ahead on and off.
+struct Ending {
+  int steps = 0;
+  bool finished = false, ego_left = false;
+  double last_time = 0.0;
+  std::string error;  // the exception's type and message, empty without one
+  std::vector<double> observed_times;
+  std::vector<nlohmann::json> metrics;
+  std::uint64_t read = 0, hits = 0;
+  double sumo_time = 0.0;  // SUMO's own frame after the run
+};
+
+// Runs `config` on two threads with three modes (one thread has time to spare) until its end,
+// an exception, or `stop_after` steps (a stop request between steps), then Finish().
+Ending RunUntilEnd(const scenario::ScenarioConfig& config, bool read_ahead, const std::string& work,
+                   int stop_after = -1) {
+  cosim::CoSimulation cs(config, {.threads = 2, .read_ahead = read_ahead});
+  cs.Start(sim::DefaultNetworkDir(), WorkDir(work));
+  Recorder r;
+  cs.AddObserver(&r);
+  Ending e;
+  try {
+    while ((stop_after < 0 || cs.steps() < stop_after) && cs.Step()) {
+    }
+  } catch (const std::exception& x) {
+    e.error = std::string(typeid(x).name()) + ": " + x.what();
+  }
+  cs.Finish();
+  e.steps = cs.steps();
+  e.finished = cs.finished();
+  e.ego_left = cs.pipeline().simulation().ego_left();
+  e.last_time = cs.pipeline().frame().time;
+  e.observed_times = r.times;
+  for (const auto& m : cs.Metrics()) e.metrics.emplace_back(m);
+  e.read = cs.pipeline().ahead_read();
+  e.hits = cs.pipeline().ahead_hits();
+  e.sumo_time = cs.pipeline().simulation().frame().time;
+  return e;
+}
+
+// Small filters: these tests are about the order of the step's parts, not about tracking.
+scenario::ScenarioConfig Small(scenario::ScenarioConfig config) {
+  config.filter.num_particles = 3000;
+  config.filter.num_birth = 300;
+  return config;
+}
+
+void CheckSameEnding(const Ending& off, const Ending& on) {
+  CHECK(on.steps == off.steps);
+  CHECK(on.finished == off.finished);
+  CHECK(on.ego_left == off.ego_left);
+  CHECK(on.last_time == off.last_time);
+  CHECK(on.error == off.error);
+  CHECK(on.observed_times == off.observed_times);
+  REQUIRE(on.metrics.size() == off.metrics.size());
+  for (std::size_t m = 0; m < on.metrics.size(); ++m) CHECK(on.metrics[m] == off.metrics[m]);
+  CHECK(off.read == 0u);
+  CHECK(off.hits == 0u);
+  // The grid read ahead is built only while another thread still filters (timing): taken or not.
+  CHECK(on.hits <= on.read);
+}
+
+}  // namespace
+
+TEST_CASE("CoSimulation reading SUMO ahead: the same steps, ends, errors and stops",
+          "[cosim][sumo]") {
+  const double dt = Highway(1.0).sim.step_length;
+  SECTION("the end of the duration") {
+    const auto config = Small(Highway(2.0));
+    const Ending off = RunUntilEnd(config, false, "end_off");
+    const Ending on = RunUntilEnd(config, true, "end_on");
+    CheckSameEnding(off, on);
+    CHECK(on.steps == config.sim.StepCount());
+    CHECK(on.finished);
+    // SUMO's step and the scan were read ahead for every step but the first.
+    CHECK(on.read == static_cast<std::uint64_t>(on.steps - 1));
+    CHECK(on.sumo_time == off.sumo_time);
+  }
+  SECTION("a SUMO error (an action naming a vehicle not on the road yet) at its own step") {
+    auto config = Small(Highway(3.0));
+    // left_car departs at 36 s: the action at 1.0 s (the 20th step) fails in SUMO's step.
+    sim::ActionSpec action;
+    action.time = 1.0;
+    action.vehicle = "left_car";
+    action.set_speed = 30.0;
+    config.sim.actions.insert(config.sim.actions.begin(), action);
+    const Ending off = RunUntilEnd(config, false, "err_off");
+    const Ending on = RunUntilEnd(config, true, "err_on");
+    CheckSameEnding(off, on);
+    CHECK(off.error.find("action at run time 1 s names vehicle 'left_car'") != std::string::npos);
+    // Every step before it was done and observed (nothing lost); the error came with the 20th.
+    CHECK(on.steps == 19);
+    CHECK(on.observed_times.size() == 19u);
+    CHECK(on.last_time == Approx(19 * dt));
+    CHECK(on.read == 18u);
+    CHECK_FALSE(on.finished);
+  }
+  SECTION("the ego leaving the network") {
+    const auto dir = WorkDir("short_route");
+    // The route ends about 450 m ahead of the ego, at 27.78 m/s: SUMO ends near 16 s, before 20 s.
+    std::ofstream(dir / "short.yaml")
+        << "network: highway\nduration: 20.0\nroutes: {short: [east_1, east_2]}\n"
+           "ego: {type: car, route: short, lane: 1, position: 1350, speed: 27.78,\n"
+           "      speed_policy: {mode: fixed, speed: 27.78}}\n";
+    const auto config = Small(scenario::LoadScenario(dir / "short.yaml"));
+    const Ending off = RunUntilEnd(config, false, "left_off");
+    const Ending on = RunUntilEnd(config, true, "left_on");
+    CheckSameEnding(off, on);
+    CHECK(on.ego_left);
+    CHECK_FALSE(on.finished);
+    CHECK(on.error.empty());
+    CHECK(on.steps > 100);
+    CHECK(on.steps < config.sim.StepCount());
+    CHECK(on.read == static_cast<std::uint64_t>(on.steps - 1));
+  }
+  SECTION("a stop between steps") {
+    const auto config = Small(Highway(3.0));
+    const Ending off = RunUntilEnd(config, false, "stop_off", 25);
+    const Ending on = RunUntilEnd(config, true, "stop_on", 25);
+    CheckSameEnding(off, on);
+    CHECK(on.steps == 25);
+    CHECK_FALSE(on.finished);
+    CHECK(on.last_time == Approx(25 * dt));
+    // As documented (CoSimOptions::read_ahead): SUMO itself had simulated the step after.
+    CHECK(off.sumo_time == Approx(25 * dt));
+    CHECK(on.sumo_time == Approx(26 * dt));
+  }
 }

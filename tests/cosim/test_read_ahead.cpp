@@ -8,6 +8,9 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <stdexcept>
+#include <string>
+#include <typeinfo>
 
 #include <nlohmann/json.hpp>
 
@@ -214,5 +217,160 @@ TEST_CASE("Reading ahead: a twin that reads other data is never taken", "[cosim]
     CHECK(lied_to.hits == (other == &moved_points ? empty : 0u));
     CHECK(lied_to.digest == off.digest);
     for (std::size_t m = 0; m < 3; ++m) CHECK(lied_to.metrics[m] == off.metrics[m]);
+  }
+}
+
+namespace {
+
+// A source that can run ahead (as SUMO's can; no twin), over a recorded sequence, that fails on
+// demand at its `at`-th Advance: that Advance or the Scan after it throws, or the source ends
+// there. `advanced` counts its Advance calls, shared with the test.
+class RunningAheadSource : public cosim::RecordedSource {
+ public:
+  enum class Fault { kNone, kAdvance, kScan, kEnd };
+  RunningAheadSource(const cosim::RecordedSequence& s, cosim::RecordedOptions o, Fault fault,
+                     int at, int* advanced)
+      : RecordedSource(s, o), fault_(fault), at_(at), advanced_(advanced) {}
+  bool can_run_ahead() const override { return true; }
+  std::unique_ptr<cosim::DetectionSource> Twin() const override { return nullptr; }
+  bool Advance(cosim::IdRegistry& ids) override {
+    ++*advanced_;
+    if (*advanced_ == at_ && fault_ == Fault::kEnd) return false;
+    if (*advanced_ == at_ && fault_ == Fault::kAdvance)
+      throw std::runtime_error("source failed at step " + std::to_string(at_));
+    return RecordedSource::Advance(ids);
+  }
+  void Scan(cosim::IdRegistry& ids, std::vector<radar::Detection>* detections,
+            std::vector<int>* scanned) override {
+    if (*advanced_ == at_ && fault_ == Fault::kScan)
+      throw std::invalid_argument("radar failed at step " + std::to_string(at_));
+    RecordedSource::Scan(ids, detections, scanned);
+  }
+
+ private:
+  Fault fault_;
+  int at_;
+  int* advanced_;
+};
+
+// Per observed step: how many steps the source had read by then, and the step's time and
+// detection count as the observers see them.
+struct SourceWatch : cosim::StepObserver {
+  const int* advanced = nullptr;
+  std::vector<int> read_by_then;
+  std::vector<double> times;
+  std::vector<std::size_t> detections;
+  void OnStep(const cosim::StepView& v) override {
+    read_by_then.push_back(*advanced);
+    times.push_back(v.frame.time);
+    detections.push_back(v.pipeline.detections().size());
+  }
+};
+
+struct FaultOutcome {
+  Outcome run;
+  std::uint64_t read = 0;  // steps read ahead
+  std::string error;       // type and message
+  bool finished = false;
+  SourceWatch watch;
+};
+
+FaultOutcome RunWithFault(const cosim::RecordedSequence& seq, RunningAheadSource::Fault fault,
+                          int at, bool read_ahead, int threads = 2) {
+  scenario::ScenarioConfig config = cosim::DefaultRecordedConfig();
+  config.filter.num_particles = 4000;
+  config.filter.num_birth = 400;
+  const cosim::RecordedOptions o = cosim::FitConfig(seq, 0.001, &config);
+  int advanced = 0;
+  cosim::CoSimulation cs(config, {.threads = threads, .read_ahead = read_ahead},
+                         [&](const scenario::ScenarioConfig&, cosim::IdRegistry&) {
+                           return std::make_unique<RunningAheadSource>(seq, o, fault, at,
+                                                                       &advanced);
+                         });
+  FaultOutcome out;
+  Digest digest;
+  out.watch.advanced = &advanced;
+  cs.AddObserver(&digest);
+  cs.AddObserver(&out.watch);
+  cs.Start({}, {});
+  try {
+    while (cs.Step()) {
+    }
+  } catch (const std::exception& e) {
+    out.error = std::string(typeid(e).name()) + ": " + e.what();
+  }
+  out.run = {digest.h,
+             {},
+             cs.pipeline().ahead_prepared(),
+             cs.pipeline().ahead_hits(),
+             cs.steps(),
+             cs.pipeline().grid_realignments()};
+  for (const auto& m : cs.Metrics()) out.run.metrics.emplace_back(m);
+  out.finished = cs.finished();
+  out.read = cs.pipeline().ahead_read();
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Running a source ahead: its end and its errors surface at their own step",
+          "[cosim][recorded]") {
+  using Fault = RunningAheadSource::Fault;
+  const cosim::RecordedSequence seq = MakeSequence(1.5, 0.0);
+  struct Case {
+    const char* name;
+    Fault fault;
+    const char* message;
+  };
+  constexpr int kAt = 30;  // the 30th step fails: 29 are done
+  for (const Case c :
+       {Case{"the source's step throws", Fault::kAdvance, "source failed at step 30"},
+        Case{"the scan throws (bad input)", Fault::kScan, "radar failed at step 30"},
+        Case{"the source ends early", Fault::kEnd, ""}}) {
+    SECTION(c.name) {
+      const FaultOutcome off = RunWithFault(seq, c.fault, kAt, false);
+      const FaultOutcome on = RunWithFault(seq, c.fault, kAt, true);
+      // Read ahead: after every step, the source stood one step further than without.
+      REQUIRE(on.watch.read_by_then.size() == static_cast<std::size_t>(kAt - 1));
+      for (std::size_t k = 0; k < on.watch.read_by_then.size(); ++k) {
+        CHECK(off.watch.read_by_then[k] == static_cast<int>(k) + 1);
+        CHECK(on.watch.read_by_then[k] == static_cast<int>(k) + 2);
+      }
+      CHECK(on.read == static_cast<std::uint64_t>(kAt - 2));
+      CHECK(off.read == 0u);
+      // Its grid is built ahead only while another thread still filters: taken or not.
+      CHECK(on.run.hits <= on.read);
+      CHECK(off.run.hits == 0u);
+      // The same steps done and seen, the same error at the same step, nothing lost.
+      CHECK(on.run.steps == kAt - 1);
+      CHECK(off.run.steps == kAt - 1);
+      CHECK(on.error == off.error);
+      CHECK(on.error.find(c.message) != std::string::npos);
+      CHECK(on.error.empty() == (c.fault == Fault::kEnd));
+      CHECK(on.watch.times == off.watch.times);
+      CHECK(on.watch.detections == off.watch.detections);
+      CHECK(on.run.digest == off.run.digest);
+      REQUIRE(on.run.metrics.size() == 3u);
+      for (std::size_t m = 0; m < 3; ++m) CHECK(on.run.metrics[m] == off.run.metrics[m]);
+      CHECK_FALSE(on.finished);
+      CHECK_FALSE(off.finished);
+    }
+  }
+  SECTION("to the sequence's end, on one, two and three threads") {
+    const FaultOutcome one = RunWithFault(seq, Fault::kNone, 0, true, 1);
+    const FaultOutcome two = RunWithFault(seq, Fault::kNone, 0, true, 2);
+    const FaultOutcome three = RunWithFault(seq, Fault::kNone, 0, true, 3);
+    CHECK(one.read == 0u);  // no thread with time to spare: read in Advance
+    CHECK(three.read == 0u);
+    CHECK(two.read == static_cast<std::uint64_t>(two.run.steps - 1));
+    REQUIRE(two.run.steps > 60);
+    for (const FaultOutcome* o : {&one, &three}) {
+      CHECK(o->run.steps == two.run.steps);
+      CHECK(o->run.digest == two.run.digest);
+      CHECK(o->finished);
+      for (std::size_t m = 0; m < 3; ++m) CHECK(o->run.metrics[m] == two.run.metrics[m]);
+    }
+    CHECK(two.finished);
+    CHECK(two.error.empty());
   }
 }

@@ -32,9 +32,13 @@ struct CoSimOptions {
   /// depend on it.
   int threads = 0;
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
-  /// threads), it reads a recorded source one step ahead while the others filter, and builds
-  /// the next step's measurement grid there (Pipeline::PrepareAhead: taken only for the same
-  /// inputs, so results do not depend on it; SUMO runs cannot be read ahead). Its gain is measured
+  /// threads), it reads the next step while the others filter (SUMO's step and the radar scan;
+  /// for recorded data a twin of the source) and builds that step's measurement grid there
+  /// (Pipeline::ReadAhead, PrepareAhead; for SUMO the grid only while another thread still
+  /// filters, else Advance builds it with every thread). Results do not depend on it: the grid is
+  /// taken only for the same inputs, and an error or the end met reading ahead surfaces at the next
+  /// Step(), where it would have without it. SUMO then stands one step ahead between steps: a run
+  /// stopped early has simulated that step too (sumo(), SUMO's own outputs). Its gain is measured
   /// in docs/performance.md.
   bool read_ahead = true;
 };
@@ -85,8 +89,13 @@ class CoSimulation {
   /// `observer` is not owned and must outlive the run.
   void AddObserver(StepObserver* observer);
 
-  /// One step: SUMO, radar, every mode's filter cycle, the shared ground truth and every mode's
-  /// scoring, then the observers. False at the end of the run (nothing done then).
+  /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's region),
+  /// every mode's filter cycle, the shared ground truth and every mode's scoring (one parallel
+  /// region; with read_ahead, the next step's SUMO step and radar scan, and its measurement grid
+  /// while another thread still filters, on a thread with time to spare in it), then the
+  /// observers. False at the end of the run (nothing
+  /// done then). An exception of SUMO or the radar is thrown by the Step() of the step it belongs
+  /// to, after the observers of every earlier step ran.
   bool Step();
   /// Ends the run: SUMO closes and writes its own outputs (Pipeline::Finish). Results, the last
   /// frame and the end state stay readable; Step() must not be called again.

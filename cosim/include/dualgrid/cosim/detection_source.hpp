@@ -78,6 +78,13 @@ class DetectionSource {
   /// (Pipeline::PrepareAhead). nullptr (the default) when the data cannot be read twice (SUMO:
   /// one simulation per process).
   virtual std::unique_ptr<DetectionSource> Twin() const { return nullptr; }
+  /// The Pipeline may advance this very source one step before the run needs that step
+  /// (Pipeline::ReadAhead, on a thread with time to spare while the filters run) and hand it
+  /// out at the next Pipeline::Advance. The Pipeline copies each step out (frame, ego, labels,
+  /// detections, scanned sensors, reached_end), so a source that says true must keep nothing
+  /// else that the run reads per step: radar() must not change after the first Advance().
+  /// False (the default): only a Twin() is read ahead.
+  virtual bool can_run_ahead() const { return false; }
 };
 
 /// The co-simulation: SUMO steps, the radar model scans the ground truth. The radars are mounted
@@ -100,6 +107,8 @@ class SumoSource : public DetectionSource {
   double first_dt() const override { return config_.sim.step_length; }
   const sim::SumoSimulation* sumo() const override { return simulation_.get(); }
   bool reached_end() const override { return simulation_ && simulation_->reached_end(); }
+  /// SUMO cannot be twinned (one per process), but it can run one step ahead of the run.
+  bool can_run_ahead() const override { return true; }
 
  private:
   const scenario::ScenarioConfig& config_;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <exception>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -74,7 +75,10 @@ class Pipeline {
 
   /// Advances SUMO one step, scans the due radars and prepares the filters' inputs, with their
   /// shared measurement grid (step 4, built once for every mode). False at the end (the duration
-  /// reached, or the ego left the network). Needs Start().
+  /// reached, or the ego left the network). Needs Start(). When ReadAhead() has read this step
+  /// already (a source that can_run_ahead()), the step is taken from there, and so is what
+  /// happened reading it: the end (false) or the source's exception, thrown here, at the step it
+  /// belongs to, as if the source had been read now.
   bool Advance();
   /// Updates filter `i` with the inputs of the last Advance(). Independent per filter, so callers
   /// may run the filters concurrently (a filter's loops then run on its thread alone, without an
@@ -86,27 +90,44 @@ class Pipeline {
   /// slot, and it reads no filter). UpdateFilter reads them when they match its cycle and draws
   /// its own otherwise, so calling this only saves work. No-op without filters or when drawn.
   void DrawNoise(bool ahead);
-  /// Reads the source one step ahead and builds the next step's measurement grid (step 4), for
-  /// Advance() to take instead of building it: call it on a thread with time to spare while the
-  /// filters of a step run (it writes only its own buffers and reads none of the filters).
-  /// Advance() takes that grid only when its own inputs (measurements, coverage, centre) are
-  /// the same bits, so results never depend on it. Only for sources with a twin
-  /// (DetectionSource::Twin: recorded data; SUMO has none and this does nothing); costs a second
-  /// source and a second measurement grid (as large as the first), made at the first call. Errors
-  /// are not thrown: the speculation stops for the run, and Advance() meets any error of the data
-  /// at its own step.
+  /// For a source that can_run_ahead() (SUMO): reads the next step from the source itself (its
+  /// Advance and Scan: SUMO's step and the radar scan), at most one step ahead (a second call
+  /// does nothing). Call it on a thread with time to spare while the filters of a step run,
+  /// after the step's last TruthObjects() call: it writes the source, ids() and its own buffers,
+  /// reads none of the filters, and writes nothing the step's readers see (frame(),
+  /// ego_motion(), detections(), scanned(), labels(), grid_frame() and reached_end() keep
+  /// describing the current step). That step is the run's: the next Advance() hands it out, and
+  /// an exception or the end met reading it surfaces there (see Advance()). Until then the
+  /// source (sumo()) stands one step beyond frame(); when the run stops before it (a stop
+  /// request, Finish()), SUMO has simulated that one step more. Other sources: no-op.
+  void ReadAhead() noexcept;
+  /// Builds the next step's measurement grid (step 4) for Advance() to take instead of building
+  /// it, under the same conditions as ReadAhead(): for a source that can_run_ahead(), of the step
+  /// ReadAhead() read (reading it first if needed); for a source with a Twin() (recorded data),
+  /// of the next step read from that twin, a second source over the same data made at the first
+  /// call (the source itself is read in Advance(); errors are not thrown: the speculation stops
+  /// for the run, and Advance() meets any error of the data at its own step). Advance() takes
+  /// the grid only when its own inputs (measurements, coverage, centre) are the same bits, so
+  /// results never depend on it. Costs a second measurement grid (as large as the first), made
+  /// at the first call. Other sources: no-op.
   void PrepareAhead() noexcept;
+  /// Steps ReadAhead() read (not counting an end or an error met).
+  std::uint64_t ahead_read() const { return ahead_.read_steps; }
   /// Steps whose measurement grid PrepareAhead() built, and those of them Advance() took.
   std::uint64_t ahead_prepared() const { return ahead_.prepared; }
   std::uint64_t ahead_hits() const { return ahead_hits_; }
 
   /// The scenario as given: never rewritten (the rig as mounted is radar().sensors()).
   const scenario::ScenarioConfig& config() const { return config_; }
-  /// Ground truth of the last Advance(). Needs Start().
-  const sim::Frame& frame() const { return source_->frame(); }
+  /// Ground truth of the last Advance() (a copy: the source may be read ahead). Needs Start().
+  const sim::Frame& frame() const { return current_.frame; }
+  /// The source had reached its own end (DetectionSource::reached_end) with the last Advance()'s
+  /// step, or when Advance() returned false; what the source says now may be a step ahead.
+  bool reached_end() const { return current_.reached_end; }
   /// SUMO; throws std::logic_error for a source without it (recorded data): see sumo().
   const sim::SumoSimulation& simulation() const;
-  /// SUMO, or nullptr for a recorded sequence.
+  /// SUMO, or nullptr for a recorded sequence. SUMO's own state (its clock, ego_left()) may stand
+  /// one step beyond frame() while a step is read ahead (ReadAhead).
   const sim::SumoSimulation* sumo() const { return source_->sumo(); }
   const DetectionSource& source() const { return *source_; }
   /// The radars as mounted on the ego's box as SUMO simulates it: built once, at the ego's
@@ -115,12 +136,12 @@ class Pipeline {
   const radar::RadarModel& radar() const { return source_->radar(); }
   bool has_radar() const { return source_->has_radar(); }
   /// Labels of the last step's detections (recorded data; empty otherwise).
-  const PointLabels& labels() const { return source_->labels(); }
+  const PointLabels& labels() const { return current_.labels; }
   /// Detections of the last step (only sensors that were due), world frame.
-  const std::vector<radar::Detection>& detections() const { return detections_; }
+  const std::vector<radar::Detection>& detections() const { return current_.detections; }
   /// Sensors that scanned in the last step.
-  const std::vector<int>& scanned() const { return scanned_; }
-  const radar::EgoMotion& ego_motion() const { return ego_; }
+  const std::vector<int>& scanned() const { return current_.scanned; }
+  const radar::EgoMotion& ego_motion() const { return current_.ego; }
   std::size_t num_filters() const { return filters_.size(); }
   filter::WeightMode mode(std::size_t i) const { return modes_[i]; }
   const filter::DynamicGrid& grid(std::size_t i) const { return *filters_[i]; }
@@ -153,10 +174,30 @@ class Pipeline {
   // With `filter.frame: follow`, the grid frame's new yaw when the road of frame `f` has turned
   // from the current grid frame; nullopt otherwise. Reads only.
   std::optional<double> TurnedYaw(const sim::Frame& f) const;
-  // Step 4's inputs of `source`'s current step (its frame, ego, and the detections and sensors
-  // of its last Scan) in the grid frame `g`; returns the grid centre. Reads only.
-  Position FilterInputs(const DetectionSource& source, const GridFrame& g,
-                        std::span<const radar::Detection> detections, std::span<const int> scanned,
+  // One step as read from a source: everything the run reads of it per step, copied out, so
+  // that the source may run a step ahead (current_ and ahead_.step: a double buffer).
+  struct StepData {
+    sim::Frame frame;
+    radar::EgoMotion ego;
+    std::vector<radar::Detection> detections;
+    std::vector<int> scanned;
+    PointLabels labels;
+    bool reached_end = false;
+  };
+  // Advances `source` and scans its new step into `step`; false at the source's end (`step`
+  // untouched). Exceptions of the source propagate (`step` may then hold part of the step).
+  static bool ReadStep(DetectionSource& source, IdRegistry& ids, StepData* step);
+  // The next step into current_: the one ReadAhead read (or its end or exception), else the
+  // source's next.
+  bool NextStep();
+  // PrepareAhead for a source with a Twin(): reads the twin's next step into ahead_.step.
+  void ReadTwinAhead() noexcept;
+  // Builds the measurement grid of ahead_.step (seen by `radar`) into ahead_.grid, in the grid
+  // frame that step will have. Throws what FilterInputs and Build throw.
+  void BuildAhead(const radar::RadarModel& radar);
+  // Step 4's inputs of `step` (seen by `radar`) in the grid frame `g`; returns the grid centre.
+  // Reads only.
+  Position FilterInputs(const StepData& step, const radar::RadarModel& radar, const GridFrame& g,
                         std::vector<filter::Measurement>* measurements,
                         std::vector<filter::SensorCoverage>* coverage) const;
 
@@ -172,9 +213,7 @@ class Pipeline {
   // Prediction normals shared by the modes, by cycle parity (DrawNoise).
   std::array<filter::PredictionNoise, 2> noise_;
   std::uint64_t noise_cycle_ = 0;  // the filters' cycle at the last DrawNoise(false)
-  radar::EgoMotion ego_;
-  std::vector<radar::Detection> detections_;
-  std::vector<int> scanned_;
+  StepData current_;               // the step of the last Advance()
   std::vector<filter::Measurement> measurements_;
   std::vector<filter::SensorCoverage> coverage_;
   double last_time_ = 0.0;
@@ -185,17 +224,20 @@ class Pipeline {
   int realignments_ = 0;
   Vector2 centre_offset_ = Vector2::Zero();  // ego -> grid centre, grid frame [m]
   std::uint64_t advances_ = 0;               // Advance() calls that returned true
-  // PrepareAhead's state: the source's twin, read one step ahead with its own ids (`advances`
-  // calls), and the next step's inputs and measurement grid, for Advance() number `advances`
-  // when `ready`.
+  // PrepareAhead's state: the next step (read from the source itself, `read`; or from the
+  // source's twin, with its own ids, `advances` calls), and its inputs and measurement grid, for
+  // Advance() number `advances` when `ready`.
   struct Ahead {
+    // What ReadAhead read from the source itself, for the next Advance() to hand out.
+    enum class Read { kNothing, kStep, kEnd, kError };
+    Read read = Read::kNothing;
+    std::exception_ptr error;  // with kError
     std::unique_ptr<DetectionSource> source;
     IdRegistry ids;
-    std::uint64_t advances = 0, prepared = 0;
+    std::uint64_t advances = 0, prepared = 0, read_steps = 0;
     bool given_up = false;  // no twin, the end reached, or an error: no more reading ahead
     bool ready = false;
-    std::vector<radar::Detection> detections;
-    std::vector<int> scanned;
+    StepData step;
     std::vector<filter::Measurement> measurements;
     std::vector<filter::SensorCoverage> coverage;
     Position centre = Position::Zero();
