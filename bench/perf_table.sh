@@ -181,7 +181,7 @@ for b in "${BUILDS[@]}"; do
   busy_stop
 done
 
-med() { tr ' ' '\n' <<<"${SAMPLES[$1|$2]:-}" | grep -v '^$' | median; }
+med() { tr ' ' '\n' <<<"${SAMPLES[$1|$2]:-}" | { grep -v '^$' || true; } | median; }
 fmt() { awk -v v="$1" -v k="$2" 'BEGIN {
   if (v == "") { print "-"; exit }
   if (k == "xrt") printf "%.1fx (%.2f s)", 60 / v, v
