@@ -32,7 +32,9 @@ Exit status: 0 done; 2 bad input (a missing folder or page, an unreadable table:
 the file and what was expected). Standard library only.
 """
 import csv
+import io
 import json
+import math
 import os
 import re
 import signal
@@ -94,6 +96,26 @@ def fail(message):
     sys.exit(2)
 
 
+def printable(text):
+    """TEXT with control characters escaped (an error line stays one line of text)."""
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii")
+                   for c in text)
+
+
+def read_text(path):
+    """The UTF-8 text of the regular file PATH; exits 2 naming it otherwise (a FIFO or a device is
+    never opened: reading one could block or never end)."""
+    if not os.path.isfile(path):
+        fail(f"{path}: expected a regular file")
+    try:
+        with open(path, encoding="utf-8") as f:
+            return f.read()
+    except OSError as e:
+        fail(f"{path}: cannot read ({e.strerror})")
+    except UnicodeDecodeError:
+        fail(f"{path}: expected UTF-8 text")
+
+
 # ---------------------------------------------------------------------------------------------
 # Reading an OUT folder: values {(scenario, experiment, metric, mode): (mean|None, ci|None,
 # decimals)}, paper {(scenario, metric, mode): the paper's value}, seeds {(scenario, experiment):
@@ -102,21 +124,24 @@ def fail(message):
 
 def read_experiment(folder):
     """The rows of FOLDER/table.csv, or None (with a note) when the experiment did not finish."""
-    try:
-        with open(os.path.join(folder, "summary.json"), encoding="utf-8") as f:
-            complete = json.load(f).get("complete") is True
-    except (OSError, ValueError):
-        complete = False
+    summary = os.path.join(folder, "summary.json")
+    complete = False
+    if os.path.isfile(summary):  # a FIFO or a device is not opened: not complete
+        try:
+            with open(summary, encoding="utf-8") as f:
+                data = json.load(f)
+            complete = isinstance(data, dict) and data.get("complete") is True
+        except (OSError, ValueError):  # UnicodeDecodeError is a ValueError
+            complete = False
     if not complete:
         print(f"results_tables.py: {folder}: not complete (summary.json), left out",
               file=sys.stderr)
         return None
     path = os.path.join(folder, "table.csv")
     try:
-        with open(path, newline="", encoding="utf-8") as f:
-            rows = list(csv.DictReader(f))
-    except OSError as e:
-        fail(f"{path}: cannot read ({e.strerror})")
+        rows = list(csv.DictReader(io.StringIO(read_text(path), newline="")))
+    except csv.Error as e:
+        fail(f"{path}: expected CSV ({e})")
     need = {"metric", "mode", "n", "mean", "ci95_half_width", "paper"}
     if not rows or not need <= set(rows[0]):
         fail(f"{path}: expected a header with {', '.join(sorted(need))}")
@@ -124,12 +149,17 @@ def read_experiment(folder):
 
 
 def number(text, path, key):
+    if text is None:  # csv.DictReader's value for a row shorter than the header
+        fail(f"{path}: {key}: missing (a row shorter than the header)")
     if text == "":
         return None
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
-        fail(f"{path}: {key}: expected a number, got '{text}'")
+        fail(f"{path}: {key}: expected a number, got '{printable(text)}'")
+    if not math.isfinite(value):
+        fail(f"{path}: {key}: expected a finite number, got '{printable(text)}'")
+    return value
 
 
 def load_out(out):
@@ -145,13 +175,18 @@ def load_out(out):
                 continue
             path = os.path.join(folder, "table.csv")
             for r in rows:
+                if not r["metric"] or not r["mode"]:
+                    fail(f"{path}: expected a metric and a mode on every row")
                 key = (scen, exp, r["metric"], r["mode"])
                 values[key] = (number(r["mean"], path, "mean"),
                                number(r["ci95_half_width"], path, "ci95_half_width"), 6)
                 p = number(r["paper"], path, "paper")
                 if p is not None:
                     paper[(scen, r["metric"], r["mode"])] = p
-            seeds[(scen, exp)] = max(int(r["n"] or 0) for r in rows)
+            counts = [number(r["n"], path, "n") or 0 for r in rows]
+            if any(c != int(c) or c < 0 for c in counts):
+                fail(f"{path}: n: expected a whole number of seeds")
+            seeds[(scen, exp)] = int(max(counts))
     for (scen, exp, metric, mode), v in list(values.items()):
         for alias, same in FALLBACK.items():
             if exp == same and (scen, alias, metric, mode) not in values:
@@ -397,11 +432,7 @@ def parse_table(values, section, scen, context, lines):
 
 
 def load_page(path):
-    try:
-        with open(path, encoding="utf-8") as f:
-            lines = f.read().splitlines()
-    except OSError as e:
-        fail(f"{path}: cannot read ({e.strerror})")
+    lines = read_text(path).splitlines()
     values, section, scen, context, i = {}, None, None, "", 0
     while i < len(lines):
         line = lines[i]
