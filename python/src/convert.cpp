@@ -1,6 +1,7 @@
 #include "convert.hpp"
 
 #include <cmath>
+#include <string>
 
 namespace dualgrid::python {
 
@@ -192,3 +193,20 @@ Vector2 ReadVector2(py::handle obj, const char* arg, const char* unit) {
 }
 
 }  // namespace dualgrid::python
+
+namespace pybind11::detail {
+
+bool type_caster<dualgrid::python::Seed>::load(handle src, bool) {
+  constexpr const char* kExpected = "seed: expected an integer in [0, 2**64 - 1], got ";
+  if (!PyLong_Check(src.ptr()) || PyBool_Check(src.ptr()))
+    throw type_error(kExpected + std::string(Py_TYPE(src.ptr())->tp_name));
+  const unsigned long long v = PyLong_AsUnsignedLongLong(src.ptr());
+  if (v == static_cast<unsigned long long>(-1) && PyErr_Occurred()) {
+    PyErr_Clear();  // negative or too large: our message instead of Python's
+    throw value_error(kExpected + std::string(str(src)));
+  }
+  value.value = v;
+  return true;
+}
+
+}  // namespace pybind11::detail

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,9 +101,29 @@ using ArrayArg = Arg<ArrayTag>;
 using EgoArg = Arg<EgoTag>;
 using SceneArg = Arg<SceneTag>;
 
+/// A random seed argument: any Python int in [0, 2**64 - 1]. Another value raises one line naming
+/// the argument "seed" (ValueError when out of range, TypeError for a non-integer, bool included),
+/// instead of pybind11's list of every overload.
+struct Seed {
+  std::uint64_t value = 0;
+};
+/// The seed of an optional `seed` argument (None: the scenario's own).
+inline std::optional<std::uint64_t> SeedValue(const std::optional<Seed>& s) {
+  return s ? std::optional<std::uint64_t>(s->value) : std::nullopt;
+}
+
 }  // namespace dualgrid::python
 
 namespace pybind11::detail {
+template <>
+struct type_caster<dualgrid::python::Seed> {
+  PYBIND11_TYPE_CASTER(dualgrid::python::Seed, const_name("int"));
+  bool load(handle src, bool);  // throws value_error / type_error (convert.cpp)
+  static handle cast(const dualgrid::python::Seed& v, return_value_policy, handle) {
+    return PyLong_FromUnsignedLongLong(v.value);
+  }
+};
+
 template <typename Tag>
 struct type_caster<dualgrid::python::Arg<Tag>> {
   PYBIND11_TYPE_CASTER(dualgrid::python::Arg<Tag>, Tag::name);

@@ -55,8 +55,8 @@ void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config
   outputs::WriteRunFolder(cs, config, folder);
 }
 
-py::dict RunScenario(const fs::path& path, std::optional<std::uint64_t> seed,
-                     std::optional<double> duration, const std::vector<std::string>& modes,
+py::dict RunScenario(const fs::path& path, std::optional<Seed> seed, std::optional<double> duration,
+                     const std::vector<std::string>& modes,
                      const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
                      std::optional<fs::path> work_dir, int threads, std::optional<fs::path> out,
                      bool force) {

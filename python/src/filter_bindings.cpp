@@ -338,11 +338,11 @@ in it and centred on the ego position given to update(). Cell (ix, iy): ix along
 Results are deterministic in (params, seed, inputs) whatever the thread count. Every method
 returns copies (no views into the grid). Calls from several Python threads on one grid are
 serialised; update() releases the GIL.)doc");
-  cls.def(py::init([](const FilterParams& params, std::uint64_t seed) {
+  cls.def(py::init([](const FilterParams& params, Seed seed) {
             std::string error;
             if (!params.IsValid(&error)) throw py::value_error("FilterParams: " + error);
             CheckGridMemory(params);
-            return std::make_unique<Grid>(params, seed);
+            return std::make_unique<Grid>(params, seed.value);
           }),
           py::arg("params") = FilterParams(), py::arg("seed") = 0,
           "ValueError when params is not valid (see FilterParams.validate()).");

@@ -484,9 +484,8 @@ Detections come back as a dict of equally long numpy columns (pandas.DataFrame(d
   direct, 1 type 1, 2 type 2), bounces (1 direct, 2 or 3), reflector_id (the mirror's id, -1
   direct), ghost_of (the real object's id, -1 direct).
 detections_to_measurements() turns it into DynamicGrid.update()'s (N, 6) array.)doc");
-  cls.def(py::init([](std::vector<SensorParams> sensors, const ModelOptions& options,
-                      std::uint64_t seed) {
-            return std::make_unique<Radar>(std::move(sensors), options, seed);
+  cls.def(py::init([](std::vector<SensorParams> sensors, const ModelOptions& options, Seed seed) {
+            return std::make_unique<Radar>(std::move(sensors), options, seed.value);
           }),
           py::arg("sensors"), py::arg("options") = ModelOptions(), py::arg("seed") = 0);
   cls.def_property_readonly(

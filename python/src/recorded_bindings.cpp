@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 
 py::dict RunRecorded(const fs::path& path, std::optional<fs::path> sensors,
                      std::optional<fs::path> scenario_file,
-                     const std::vector<std::string>& overrides, std::optional<std::uint64_t> seed,
+                     const std::vector<std::string>& overrides, std::optional<Seed> seed,
                      const std::vector<std::string>& modes, double batch_window, int threads) {
   const RecordedSetup setup =
       LoadRecorded(path, sensors, scenario_file, overrides, seed, batch_window, "run_recorded");

@@ -18,14 +18,14 @@ namespace fs = std::filesystem;
 using namespace recorded;  // NOLINT(google-build-using-namespace)
 using namespace cosim;     // NOLINT(google-build-using-namespace)
 
-scenario::ScenarioConfig LoadRunConfig(const fs::path& path, std::optional<std::uint64_t> seed,
+scenario::ScenarioConfig LoadRunConfig(const fs::path& path, std::optional<Seed> seed,
                                        std::optional<double> duration,
                                        const std::vector<std::string>& overrides, const char* fn) {
   if (duration && !(*duration > 0.0 && *duration <= 3600.0))
     throw py::value_error(std::string(fn) + ": duration must be in (0, 3600] s, got " +
                           std::to_string(*duration));
   // The command line's loader: the same configuration as `dualgrid run` with these options.
-  return outputs::LoadRunConfig(path, overrides, seed, duration);
+  return outputs::LoadRunConfig(path, overrides, SeedValue(seed), duration);
 }
 
 cosim::CoSimOptions RunOptions(const std::vector<std::string>& modes, int threads, const char* fn) {
@@ -45,8 +45,8 @@ cosim::CoSimOptions RunOptions(const std::vector<std::string>& modes, int thread
 
 RecordedSetup LoadRecorded(const fs::path& path, const std::optional<fs::path>& sensors,
                            const std::optional<fs::path>& scenario_file,
-                           const std::vector<std::string>& overrides,
-                           std::optional<std::uint64_t> seed, double batch_window, const char* fn) {
+                           const std::vector<std::string>& overrides, std::optional<Seed> seed,
+                           double batch_window, const char* fn) {
   RecordedSetup s;
   if (scenario_file) {
     std::vector<scenario::Override> sets;
@@ -58,7 +58,7 @@ RecordedSetup LoadRecorded(const fs::path& path, const std::optional<fs::path>& 
       throw py::value_error(std::string(fn) + ": overrides need a scenario file");
     s.config = DefaultRecordedConfig();
   }
-  if (seed) s.config.sim.seed = *seed;
+  if (seed) s.config.sim.seed = seed->value;
   if (!(batch_window >= 0.0 && batch_window <= 1.0))
     throw py::value_error(std::string(fn) + ": batch_window must be in [0, 1] s");
   s.input = recorded::ReadRecordedInput(path, sensors);

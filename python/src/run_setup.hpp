@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "dualgrid/cosim/cosimulation.hpp"
 #include "dualgrid/cosim/recorded_source.hpp"
 #include "dualgrid/recorded/recorded_run.hpp"
@@ -20,8 +21,7 @@ namespace dualgrid::python {
 /// A scenario file with the caller's seed [-], duration [s] and "KEY=VALUE" overrides. `fn`
 /// names the calling function in messages. Throws ValueError (scenario::ConfigError or
 /// py::value_error) for bad input.
-scenario::ScenarioConfig LoadRunConfig(const std::filesystem::path& path,
-                                       std::optional<std::uint64_t> seed,
+scenario::ScenarioConfig LoadRunConfig(const std::filesystem::path& path, std::optional<Seed> seed,
                                        std::optional<double> duration,
                                        const std::vector<std::string>& overrides, const char* fn);
 
@@ -38,8 +38,8 @@ struct RecordedSetup {
 RecordedSetup LoadRecorded(const std::filesystem::path& path,
                            const std::optional<std::filesystem::path>& sensors,
                            const std::optional<std::filesystem::path>& scenario_file,
-                           const std::vector<std::string>& overrides,
-                           std::optional<std::uint64_t> seed, double batch_window, const char* fn);
+                           const std::vector<std::string>& overrides, std::optional<Seed> seed,
+                           double batch_window, const char* fn);
 
 /// The "input" entry of run_recorded's result (kind, sequence, scans, detections, ...).
 py::dict RecordedInputInfo(const recorded::RecordedInput& in);

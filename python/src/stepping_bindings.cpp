@@ -280,7 +280,7 @@ otherwise).)doc") + kCommonDoc)
                                                      .c_str());
   cls.def(
       py::init([](const fs::path& scenario, const std::vector<std::string>& modes,
-                  std::optional<std::uint64_t> seed, std::optional<double> duration,
+                  std::optional<Seed> seed, std::optional<double> duration,
                   const std::vector<std::string>& overrides, std::optional<fs::path> network_dir,
                   std::optional<fs::path> work_dir, int threads, bool velocities) {
         const scenario::ScenarioConfig config =
@@ -304,7 +304,7 @@ run_recorded's.)doc") + kCommonDoc)
                                                      .c_str());
   rec.def(py::init([](const fs::path& path, std::optional<fs::path> sensors,
                       std::optional<fs::path> scenario, const std::vector<std::string>& overrides,
-                      std::optional<std::uint64_t> seed, const std::vector<std::string>& modes,
+                      std::optional<Seed> seed, const std::vector<std::string>& modes,
                       double batch_window, int threads, bool velocities) {
             auto setup = std::make_unique<RecordedSetup>(LoadRecorded(
                 path, sensors, scenario, overrides, seed, batch_window, "RecordedSimulation"));

@@ -39,6 +39,33 @@ class SimulationMisuseTest(unittest.TestCase):
         with self.assertRaisesRegex(TypeError, "No constructor|Base of|cannot be instantiated"):
             dualgrid.Simulation()
 
+    def test_bad_seeds(self):
+        # Every entry point with a seed: one line naming it, ValueError out of [0, 2**64 - 1],
+        # TypeError for a non-integer (bool too); the largest seed is accepted.
+        # The arguments are converted before anything is read: a missing sequence folder is
+        # never reached.
+        radarscenes = "no/such/sequence"
+        makers = {
+            "CoSimulation": lambda s: dualgrid.CoSimulation(SCENARIO, seed=s, duration=0.1),
+            "run_scenario": lambda s: dualgrid.run_scenario(SCENARIO, seed=s, duration=0.1),
+            "DynamicGrid": lambda s: dualgrid.DynamicGrid(seed=s),
+            "RadarModel": lambda s: dualgrid.RadarModel([dualgrid.SensorParams()], seed=s),
+            "run_recorded": lambda s: dualgrid.run_recorded(radarscenes, seed=s),
+            "RecordedSimulation": lambda s: dualgrid.RecordedSimulation(radarscenes, seed=s),
+        }
+        for name, make in makers.items():
+            for bad, error in [(-1, ValueError), (2**64, ValueError), (-2**70, ValueError),
+                               (1.5, TypeError), (True, TypeError), ("1", TypeError)]:
+                with self.subTest(entry=name, seed=bad):
+                    with self.assertRaises(error) as caught:
+                        make(bad)
+                    text = str(caught.exception)
+                    self.assertRegex(text, r"^seed: expected an integer in \[0, 2\*\*64 - 1\]")
+                    self.assertNotIn("\n", text)
+        self.assertEqual(dualgrid.RadarModel([dualgrid.SensorParams()], seed=2**64 - 1).seed,
+                         2**64 - 1)
+        dualgrid.DynamicGrid(seed=2**64 - 1)
+
     def test_nan_and_bad_values(self):
         with self.assertRaisesRegex(ValueError, "duration must be in"):
             dualgrid.CoSimulation(SCENARIO, duration=math.nan)
