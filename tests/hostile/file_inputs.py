@@ -16,6 +16,7 @@ Usage:
 import argparse
 import concurrent.futures
 import glob
+import hashlib
 import os
 import re
 import shutil
@@ -34,6 +35,10 @@ KINDS = {
     "numbers": ["nan", "inf", "absurd"],
     "folder": ["fifo", "dev_null", "regular", "loop", "dangling"],
 }
+# Kinds that leave the input as it is and put the command's output ({O}) on it: the output equal
+# to the row's file or folder, and inside it (under a file: a path that cannot be made). Refused
+# by the output guard (docs/reliability.md, "Output folders") with the input left byte for byte.
+OUTPUT_KINDS = ["out_is_input", "out_inside_input"]
 # A number of a text file: not part of a word (radar_1, v1.0-mini keep their digits).
 NUMBER = re.compile(r"(?<![\w.\-])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])")
 REPLACEMENT = {"nan": "nan", "inf": "inf", "absurd": "1e300"}
@@ -59,6 +64,9 @@ def read_table():
             words = kinds.split()
             kind_list = [k for g in words if not g.startswith("-") for k in KINDS[g]]
             kind_list = [k for k in kind_list if "-" + k not in words]
+            # An output on the input (every row with an output path): the output guard's kinds.
+            if "{O}" in command:
+                kind_list += [k for k in OUTPUT_KINDS if "-" + k not in words]
             rows.append(dict(id=rid, arg=arg, fixture=fixture, file=path, kinds=kind_list,
                              command=command))
             args[arg] = "row"
@@ -197,6 +205,22 @@ def make_hostile(path, kind, good):
             f.write("\n".join(lines[:first] + [body]) if first else body)
 
 
+def tree_digest(root):
+    """Every path under ROOT with its kind and, for regular files, its bytes' digest."""
+    h = hashlib.sha1()
+    for folder, dirs, files in sorted(os.walk(root)):
+        dirs.sort()
+        for name in sorted(dirs + files):
+            path = os.path.join(folder, name)
+            h.update(os.path.relpath(path, root).encode())
+            if os.path.isfile(path) and not os.path.islink(path):
+                with open(path, "rb") as f:
+                    h.update(hashlib.sha1(f.read()).digest())
+            else:
+                h.update(b"link" if os.path.islink(path) else b"dir")
+    return h.hexdigest()
+
+
 def run_case(row, kind, fx, work, opts):
     case = os.path.join(work, "cases", f"{row['id']}.{kind}")
     out = case + ".out"
@@ -208,7 +232,12 @@ def run_case(row, kind, fx, work, opts):
     if os.path.isfile(target):
         with open(target, "rb") as f:
             good = f.read()
-    make_hostile(target, kind, good)
+    before = None
+    if kind in OUTPUT_KINDS:
+        out = target if kind == "out_is_input" else os.path.join(target, "run")
+        before = tree_digest(case)
+    else:
+        make_hostile(target, kind, good)
     command = (row["command"].replace("{C}", case).replace("{F}", target)
                .replace("{O}", out).replace("{N}", opts.networks))
     if row["arg"].startswith("py:"):
@@ -242,6 +271,10 @@ def run_case(row, kind, fx, work, opts):
         why = "not a 'dualgrid: error:' line"
     elif name not in lines[0]:
         why = f"the line does not name {name}"
+    elif before is not None and tree_digest(case) != before:
+        why = "the input changed"
+    if before is not None:
+        out = case + ".out"  # the output was the input: nothing else to remove
     for path in (case, out, out + ".png"):  # the case itself may now be a FIFO or a link
         if os.path.isdir(path) and not os.path.islink(path):
             shutil.rmtree(path, ignore_errors=True)
@@ -259,6 +292,7 @@ def main():
     ap.add_argument("--python", default=sys.executable)
     ap.add_argument("--only", choices=["cli", "py"])
     ap.add_argument("--rows", help="a regular expression: only the rows whose id matches")
+    ap.add_argument("--kinds", help="a regular expression: only the kinds that match")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--check-complete", action="store_true")
     opts = ap.parse_args()
@@ -273,7 +307,8 @@ def main():
     try:
         fx = make_fixtures(work, opts.dualgrid, opts.networks, opts.fixture_python)
         os.makedirs(os.path.join(work, "cases"))
-        cases = [(r, k) for r in rows for k in r["kinds"]]
+        cases = [(r, k) for r in rows for k in r["kinds"]
+                 if opts.kinds is None or re.search(opts.kinds, k)]
         failed, slowest = 0, (0.0, "")
         with concurrent.futures.ThreadPoolExecutor(max_workers=opts.jobs) as pool:
             futures = [pool.submit(run_case, r, k, fx, work, opts) for r, k in cases]
