@@ -123,6 +123,7 @@ void MeasurementGrid::Prepare(const Position& centre, std::span<const Measuremen
     det_fit_sd_.resize(nz);
   }
   if (det_los_.size() < 3 * nz) det_los_.resize(3 * nz);
+  if (with_fit_ && det_los_b_.size() < 3 * nz) det_los_b_.resize(3 * nz);
   // Bearing bins per sensor: range of the closest detection shadowing each bin (Bins).
   const int ns = static_cast<int>(coverage.size());
   bin_offset_.assign(ns + 1, 0);  // small vectors; capacity is reused across cycles
@@ -485,6 +486,12 @@ void MeasurementGrid::ComputeLinesOfSight() {
     det_los_[3 * j] = u.x();
     det_los_[3 * j + 1] = u.y();
     det_los_[3 * j + 2] = z_[j].radial_velocity.dot(u);
+  }
+  if (!with_fit_) return;
+  const std::int64_t nb = static_cast<std::int64_t>(nbx_) * nby_;
+  for (std::int64_t k = 0; k < bucket_start_[nb]; ++k) {  // FillBuckets ran before
+    const int j = bucket_items_[k];
+    std::copy_n(det_los_.begin() + 3 * j, 3, det_los_b_.begin() + 3 * k);
   }
 }
 
