@@ -12,6 +12,8 @@
 #include <cmath>
 #include <limits>
 
+#include <hwy/highway.h>
+
 #include "dualgrid/filter/measurement_grid.hpp"
 #include "grid_internal.hpp"
 #include "team.hpp"
@@ -53,6 +55,63 @@ bool Solve(const double* ux, const double* uy, const double* y, const double* w,
   f->a01 = a01;
   f->a11 = a11;
   return true;
+}
+
+namespace hn = hwy::HWY_NAMESPACE;
+using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
+
+// r[i] = |u_i . v - y_i| as the scalar expression computes it, lane by lane (the same IEEE
+// operations in the same order); returns how many r[i] <= bound, and in *unordered whether any is
+// NaN.
+int Residuals(const double* ux, const double* uy, const double* y, int n, double vx, double vy,
+              double bound, double* r, bool* unordered) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const auto vvx = hn::Set(d, vx), vvy = hn::Set(d, vy), vb = hn::Set(d, bound);
+  auto nan = hn::Zero(d);
+  std::size_t below = 0;
+  int i = 0;
+  for (; i + lanes <= n; i += lanes) {
+    const auto e =
+        hn::Sub(hn::Add(hn::Mul(hn::LoadU(d, ux + i), vvx), hn::Mul(hn::LoadU(d, uy + i), vvy)),
+                hn::LoadU(d, y + i));
+    const auto a = hn::Abs(e);
+    hn::StoreU(a, d, r + i);
+    below += hn::CountTrue(d, hn::Le(a, vb));
+    nan = hn::Or(nan, hn::VecFromMask(d, hn::Ne(a, a)));
+  }
+  bool any_nan = !hn::AllFalse(d, hn::MaskFromVec(nan));
+  for (; i < n; ++i) {
+    r[i] = std::abs(ux[i] * vx + uy[i] * vy - y[i]);
+    below += r[i] <= bound;
+    any_nan |= std::isnan(r[i]);
+  }
+  *unordered = any_nan;
+  return static_cast<int>(below);
+}
+
+// Tukey's weights w[i] = (1 - q^2)^2 for q = r[i] / c < 1, else 0 (lane by lane as the scalar
+// expression); returns the inliers (q < 1).
+int TukeyWeights(const double* r, int n, double c, double* w) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const auto vc = hn::Set(d, c), one = hn::Set(d, 1.0);
+  std::size_t inliers = 0;
+  int i = 0;
+  for (; i + lanes <= n; i += lanes) {
+    const auto q = hn::Div(hn::LoadU(d, r + i), vc);
+    const auto t = hn::Sub(one, hn::Mul(q, q));
+    const auto in = hn::Lt(q, one);
+    hn::StoreU(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + i);
+    inliers += hn::CountTrue(d, in);
+  }
+  for (; i < n; ++i) {
+    const double q = r[i] / c;
+    const double t = 1.0 - q * q;
+    w[i] = q < 1.0 ? t * t : 0.0;
+    inliers += q < 1.0;
+  }
+  return static_cast<int>(inliers);
 }
 
 // Which values NearRank ranks: those >= g (the smallest first), those < g (the largest first) or
@@ -173,13 +232,8 @@ bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n
   const int k = n / 2;
   double guess = floor_bound;  // the last median selected
   for (int it = 0; it < kIterations; ++it) {
-    int at_floor = 0;  // residuals <= floor_bound
-    bool unordered = false;
-    for (int i = 0; i < n; ++i) {
-      r[i] = std::abs(ux[i] * f->vx + uy[i] * f->vy - y[i]);
-      at_floor += r[i] <= floor_bound;
-      unordered |= std::isnan(r[i]);
-    }
+    bool unordered = false;  // a NaN residual
+    const int at_floor = Residuals(ux, uy, y, n, f->vx, f->vy, floor_bound, r, &unordered);
     if (unordered) {
       f->scale = std::max(floor, kMadToSigma * NthElement(r, n, k));
     } else if (at_floor > k) {
@@ -188,15 +242,7 @@ bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n
       guess = SelectRank(r, n, k, guess);
       f->scale = std::max(floor, kMadToSigma * guess);
     }
-    const double c = kTukey * f->scale;
-    int inliers = 0;
-    for (int i = 0; i < n; ++i) {  // branch-free: vectorises
-      const double q = r[i] / c;
-      const double t = 1.0 - q * q;
-      w[i] = q < 1.0 ? t * t : 0.0;
-      inliers += q < 1.0;
-    }
-    f->inliers = inliers;
+    f->inliers = TukeyWeights(r, n, kTukey * f->scale, w);
     if (f->inliers < 3 || !Solve(ux, uy, y, w, n, f)) return false;
   }
   return true;
