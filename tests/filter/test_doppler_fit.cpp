@@ -14,6 +14,7 @@
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/filter/doppler_fit.hpp"
+#include "dualgrid/filter/fast_atan2.hpp"
 #include "reference/doppler_fit.hpp"
 
 using namespace dualgrid;
@@ -150,6 +151,35 @@ TEST_CASE("RobustDopplerFit with non-finite inputs fails or matches the plain fi
       CHECK(Bits(got.vx) == Bits(want.vx));
       CHECK(Bits(got.vy) == Bits(want.vy));
       CHECK(Bits(got.scale) == Bits(want.scale));
+    }
+  }
+}
+
+TEST_CASE("FastAtan2 on SIMD lanes gives the scalar bearing bit for bit", "[filter][fov]") {
+  // The field of view's batched exact test (measurement_grid.cpp) takes its bearings from the
+  // lanes: every octant, the axes, the origin, both zeros, octant boundaries and odd tails.
+  std::vector<double> y, x;
+  for (const double a : {0.0, -0.0, 1.0, -1.0, 1e-300, 5.0, -5.0}) {
+    for (const double b : {0.0, -0.0, 1.0, -1.0, 1e-300, 5.0, -5.0}) {
+      y.push_back(a);
+      x.push_back(b);
+    }
+  }
+  const std::size_t special = y.size();  // signed zeros: FastAtan2's own convention
+  CounterRng rng(5, RngPurpose::kTest, 0, 0);
+  for (int i = 0; i < 4001; ++i) {
+    const double angle = rng.Uniform(-kPi, kPi), range = rng.Uniform(0.0, 300.0);
+    y.push_back(range * std::sin(angle));
+    x.push_back(range * std::cos(angle));
+  }
+  for (const int n : {static_cast<int>(y.size()), 1, 3, 0}) {
+    std::vector<double> out(y.size(), -7.0);
+    filter::detail::FastAtan2Lanes(y.data(), x.data(), n, out.data());
+    for (int i = 0; i < n; ++i) {
+      INFO("y " << y[i] << " x " << x[i]);
+      REQUIRE(Bits(out[i]) == Bits(filter::detail::FastAtan2(y[i], x[i])));
+      if (static_cast<std::size_t>(i) >= special)
+        REQUIRE(std::abs(out[i] - std::atan2(y[i], x[i])) < 2.1e-4);
     }
   }
 }
