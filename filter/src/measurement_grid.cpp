@@ -91,18 +91,6 @@ void ExactGeometry(const RowSensor& c, const int* lx, int m, double* d2, double*
 
 }  // namespace
 
-// std::atan2 per cell and sensor dominated the free-space pass.
-double detail::FastAtan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  const double mx = std::max(ax, ay), mn = std::min(ax, ay);
-  if (mx == 0.0) return 0.0;
-  const double a = mn / mx, s = a * a;
-  double r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a;
-  if (ay > ax) r = 0.5 * kPi - r;
-  if (x < 0.0) r = kPi - r;
-  return y < 0.0 ? -r : r;
-}
-
 void detail::FastAtan2Lanes(const double* y, const double* x, int n, double* out) {
   const DD d;
   const int lanes = static_cast<int>(hn::Lanes(d));
