@@ -12,7 +12,6 @@
 //   bench_floor_e2e --benchmark_filter=FloorE2E
 #include <benchmark/benchmark.h>
 
-#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -32,12 +31,6 @@ using namespace dualgrid;
 
 namespace {
 
-double ProcessCpu() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 struct Totals {
   double source = 0.0, mgrid = 0.0, rest = 0.0, simulated = 0.0;
   std::int64_t steps = 0, detections = 0;
@@ -52,9 +45,9 @@ void RunFloor(cosim::CoSimulation& cs, const filter::FilterParams& fp, double dt
   std::vector<filter::SensorCoverage> coverage;
   Position centre;
   for (;;) {
-    const double c0 = ProcessCpu();
+    const double c0 = bench::ProcessCpu();
     if (!cs.Step()) break;
-    t.source += ProcessCpu() - c0;
+    t.source += bench::ProcessCpu() - c0;
     bench::PipelineInputs(cs.pipeline(), &z, &coverage, &centre);
     floor.Run(centre, z, coverage, dt);
     t.detections += static_cast<std::int64_t>(z.size());

@@ -9,7 +9,6 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
-#include <ctime>
 #include <filesystem>
 #include <vector>
 
@@ -24,12 +23,6 @@
 using namespace dualgrid;
 
 namespace {
-
-double ProcessCpu() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 struct StepInputs {
   std::vector<filter::Measurement> z;
@@ -76,11 +69,11 @@ void BM_MeasurementGrid(benchmark::State& state) {
   for (const StepInputs& s : run.steps) grid.Build(s.centre, s.z, s.coverage);  // warm-up
   double cpu = 0.0, wall = 0.0;
   for (auto _ : state) {
-    const double c0 = ProcessCpu();
+    const double c0 = bench::ProcessCpu();
     const auto w0 = std::chrono::steady_clock::now();
     for (const StepInputs& s : run.steps) grid.Build(s.centre, s.z, s.coverage);
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-    cpu += ProcessCpu() - c0;
+    cpu += bench::ProcessCpu() - c0;
   }
   std::int64_t detections = 0;
   for (const StepInputs& s : run.steps) detections += static_cast<std::int64_t>(s.z.size());

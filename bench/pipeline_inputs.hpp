@@ -1,8 +1,8 @@
-// The filters' inputs of a co-simulation's last step (bench_floor_e2e, bench_measurement_grid):
-// the detections outside the ego's box, the scanned sensors' fields of view and the grid centre,
-// in the grid frame, as Pipeline::FilterInputs makes them for the filters.
+// What the benchmarks on a co-simulation's own inputs share (bench_floor_e2e,
+// bench_measurement_grid): the filters' inputs of its last step, and the process's CPU time.
 #pragma once
 
+#include <ctime>
 #include <vector>
 
 #include "dualgrid/cosim/pipeline.hpp"
@@ -10,6 +10,16 @@
 
 namespace dualgrid::bench {
 
+/// The process's CPU time so far, all threads [s].
+inline double ProcessCpu() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// The filters' inputs of the last step of `p`: the detections outside the ego's box, the
+/// scanned sensors' fields of view and the grid centre, in the grid frame, as
+/// Pipeline::FilterInputs makes them for the filters.
 inline void PipelineInputs(const cosim::Pipeline& p, std::vector<filter::Measurement>* z,
                            std::vector<filter::SensorCoverage>* coverage, Position* centre) {
   const GridFrame& g = p.grid_frame();
