@@ -1,7 +1,8 @@
-// The Doppler fit's fast median (filter/src/doppler_fit.cpp) against its definition: SelectRank
-// against std::nth_element, MadFloorBound against its defining property, and RobustDopplerFit
-// against the plain fit (reference/doppler_fit.hpp), bit for bit, on random neighbourhoods that
-// take every path (the floor, a median near the last one, the quickselect, failures, NaN).
+// The measurement grid's fast paths against their definitions, bit for bit: the Doppler fit's
+// median (filter/src/doppler_fit.cpp: SelectRank against std::nth_element, MadFloorBound against
+// its defining property, RobustDopplerFit against the plain fit of reference/doppler_fit.hpp on
+// random neighbourhoods that take every path: the floor, a median near the last one, the
+// quickselect, failures, NaN) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
