@@ -52,9 +52,15 @@ hn::Vec<DD> FastAtan2V(hn::Vec<DD> y, hn::Vec<DD> x) {
 
 // One sensor's constants along one logical row (FieldOfViewRow): cell lx's centre lies at
 // dx = x0 + (lx + 0.5) r - ox, dy from the sensor; cb, sb: cos, sin of the boresight.
+// bins[0, nbins): the sensor's bearing bins' ranges [m], inv_bin their inverse width [1/rad]; the
+// row starts at view + row in storage, logical column 0 at storage column sx0 of nx.
 struct RowSensor {
   double x0, r, ox, dy, cb, sb, tan_hf, half_fov, min2, max2;
   bool narrow;
+  const double* bins;
+  int nbins;
+  double inv_bin;
+  std::int64_t row, sx0, nx;
 };
 
 // Cells per batch of ExactGeometry.
@@ -89,6 +95,27 @@ void ExactGeometry(const RowSensor& c, const int* lx, int m, double* d2, double*
     hn::StoreU(dd, d, d2 + i);
     hn::StoreU(a, d, rel + i);
     hn::StoreU(hn::IfThenElseZero(ok, hn::Set(d, 1.0)), d, in + i);
+  }
+}
+
+// The exact per-cell test (the reference definition of the bits) of cells lx[0, m) (m <=
+// kExactBatch; lx holds kExactBatch + 1 entries): their geometry on lanes (ExactGeometry), then
+// the bin of each cell inside, OR-ed into `view`.
+void ExactCells(const RowSensor& c, int* lx, int m, std::uint8_t* view) {
+  if (m == 0) return;
+  lx[m] = lx[m - 1];  // whole lanes
+  double d2[kExactBatch + 1], rel[kExactBatch + 1], in[kExactBatch + 1];
+  ExactGeometry(c, lx, m, d2, rel, in);
+  for (int i = 0; i < m; ++i) {
+    if (in[i] == 0.0) continue;
+    const std::int64_t sx = c.sx0 + lx[i];
+    const std::int64_t s = c.row + (sx >= c.nx ? sx - c.nx : sx);
+    const int b = std::clamp(static_cast<int>((rel[i] + c.half_fov) * c.inv_bin), 0, c.nbins - 1);
+    const double br = c.bins[b];
+    // Free in front of the bin's closest detection, unknown behind it; a bin without any
+    // detection is weakly free over the whole range.
+    view[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
+                                         (br != kInf && d2[i] < br * br ? kFreeRay : 0));
   }
 }
 
@@ -419,32 +446,17 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
     const double inv_bin = 1.0 / params_.free_angle_bin;
     const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
-    // Exact per-cell test (the reference definition of the bits), in batches: the geometry on
-    // lanes (ExactGeometry), then the bin of each cell inside.
-    const RowSensor rs{x0, r, sc.origin.x(), dy, cb, sb, tan_hf, sc.half_fov, min2, max2, narrow};
+    // Cells left to the exact per-cell test, in batches (ExactCells).
+    const RowSensor rs{x0,   r,      sc.origin.x(), dy,    cb,      sb,  tan_hf, sc.half_fov, min2,
+                       max2, narrow, bins,          nbins, inv_bin, row, sx0,    nx_};
     int pending[kExactBatch + 1];
     int np = 0;
-    const auto flush = [&] {
-      if (np == 0) return;
-      pending[np] = pending[np - 1];  // whole lanes
-      double d2[kExactBatch + 1], rel[kExactBatch + 1], in[kExactBatch + 1];
-      ExactGeometry(rs, pending, np, d2, rel, in);
-      for (int i = 0; i < np; ++i) {
-        if (in[i] == 0.0) continue;
-        const std::int64_t sx = sx0 + pending[i];
-        const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-        const int b = std::clamp(static_cast<int>((rel[i] + sc.half_fov) * inv_bin), 0, nbins - 1);
-        const double br = bins[b];
-        // Free in front of the bin's closest detection, unknown behind it; a bin without any
-        // detection is weakly free over the whole range.
-        view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
-                                              (br != kInf && d2[i] < br * br ? kFreeRay : 0));
-      }
-      np = 0;
-    };
     const auto exact = [&](int lx) {
       pending[np++] = lx;
-      if (np == kExactBatch) flush();
+      if (np == kExactBatch) {
+        ExactCells(rs, pending, np, view_.data());
+        np = 0;
+      }
     };
     int lo_x = lx_lo, hi_x = lx_hi;
     // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
@@ -562,7 +574,7 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
         }
       }
     }
-    flush();
+    ExactCells(rs, pending, np, view_.data());
   }
 }
 
