@@ -12,7 +12,6 @@
 //   bench_floor_e2e --benchmark_filter=FloorE2E
 #include <benchmark/benchmark.h>
 
-#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -25,39 +24,12 @@
 #include "dualgrid/scenario/loader.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
 #include "floor_cycle.hpp"
+#include "pipeline_inputs.hpp"
 #include "recorded_sequence.hpp"
 
 using namespace dualgrid;
 
 namespace {
-
-double ProcessCpu() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-// The filters' inputs of the pipeline's last step, as Pipeline::FilterInputs makes them.
-void Inputs(const cosim::Pipeline& p, std::vector<filter::Measurement>* z,
-            std::vector<filter::SensorCoverage>* coverage, Position* centre) {
-  const GridFrame& g = p.grid_frame();
-  const BoxTest ego_box(p.frame().ego.box);
-  z->clear();
-  for (const radar::Detection& d : p.detections()) {
-    if (ego_box.Contains(d.position_world)) continue;
-    z->push_back({g.ToGrid(d.position_world), g.VectorToGrid(d.radial_velocity_world),
-                  g.ToGrid(d.sensor_position_world)});
-  }
-  coverage->clear();
-  const Pose2& ego = p.source().ego().pose;
-  for (int s : p.scanned()) {
-    const radar::SensorParams& sp = p.radar().sensors()[s];
-    const Pose2 pose = p.radar().SensorPose(s, ego);
-    coverage->push_back(
-        {g.ToGrid(pose.position), g.YawToGrid(pose.yaw), 0.5 * sp.fov, sp.min_range, sp.max_range});
-  }
-  *centre = g.ToGrid(p.GridFootprint().center);
-}
 
 struct Totals {
   double source = 0.0, mgrid = 0.0, rest = 0.0, simulated = 0.0;
@@ -73,10 +45,10 @@ void RunFloor(cosim::CoSimulation& cs, const filter::FilterParams& fp, double dt
   std::vector<filter::SensorCoverage> coverage;
   Position centre;
   for (;;) {
-    const double c0 = ProcessCpu();
+    const double c0 = bench::ProcessCpu();
     if (!cs.Step()) break;
-    t.source += ProcessCpu() - c0;
-    Inputs(cs.pipeline(), &z, &coverage, &centre);
+    t.source += bench::ProcessCpu() - c0;
+    bench::PipelineInputs(cs.pipeline(), &z, &coverage, &centre);
     floor.Run(centre, z, coverage, dt);
     t.detections += static_cast<std::int64_t>(z.size());
     ++t.steps;

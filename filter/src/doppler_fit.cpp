@@ -5,9 +5,14 @@
 // enough: v with u_i . v = v_r,i for every detection i near it. Fitted robustly (Tukey's biweight
 // by iteratively reweighted least squares), since detections of another object, of the ground or
 // clutter may lie within reach.
+#include "dualgrid/filter/doppler_fit.hpp"
+
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
+
+#include <hwy/highway.h>
 
 #include "dualgrid/filter/measurement_grid.hpp"
 #include "grid_internal.hpp"
@@ -19,23 +24,21 @@ using namespace detail;
 
 namespace {
 
-constexpr int kMaxNeighbours = 64;  // nearest-first is not needed: the first 64 in bucket order
 // Candidates looked at per detection at most (docs/algorithm.md, step 4a): bounds a fit's cost
 // when thousands of detections crowd its buckets, so that a cycle's cost stays linear in them.
-constexpr int kMaxCandidates = 8 * kMaxNeighbours;
+constexpr int kMaxCandidates = 8 * kFitMaxNeighbours;
 constexpr int kIterations = 6;
 constexpr double kTukey = 4.685;  // 95 % efficiency at Gaussian noise
 constexpr double kMadToSigma = 1.4826;
-
-struct Fit {
-  double vx = 0.0, vy = 0.0, scale = 0.0;
-  double a00 = 0.0, a01 = 0.0, a11 = 0.0;  // sum of w u u^T at the solution
-  int inliers = 0;
-};
+// SelectRank's short path: ranks this close to its guess's count are kept in a sorted buffer.
+constexpr int kNearRanks = 4;
+// Bucket columns and rows of a fit's window whose gaps are tabled (reach <= 3 buckets).
+constexpr int kWindow = 7;
 
 // Solves sum_i w_i u_i u_i^T v = sum_i w_i u_i y_i; false when the lines of sight (weighted) do
 // not span the plane.
-bool Solve(const double* ux, const double* uy, const double* y, const double* w, int n, Fit* f) {
+bool Solve(const double* ux, const double* uy, const double* y, const double* w, int n,
+           DopplerFit* f) {
   double a00 = 0.0, a01 = 0.0, a11 = 0.0, b0 = 0.0, b1 = 0.0;
   for (int i = 0; i < n; ++i) {
     a00 += w[i] * ux[i] * ux[i];
@@ -54,41 +57,203 @@ bool Solve(const double* ux, const double* uy, const double* y, const double* w,
   return true;
 }
 
+namespace hn = hwy::HWY_NAMESPACE;
+using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
+
+// r[i] = |u_i . v - y_i| as the scalar expression computes it, lane by lane (the same IEEE
+// operations in the same order); returns how many r[i] <= bound, and in *unordered whether any is
+// NaN.
+int Residuals(const double* ux, const double* uy, const double* y, int n, double vx, double vy,
+              double bound, double* r, bool* unordered) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const auto vvx = hn::Set(d, vx), vvy = hn::Set(d, vy), vb = hn::Set(d, bound);
+  auto nan = hn::Zero(d);
+  std::size_t below = 0;
+  int i = 0;
+  for (; i + lanes <= n; i += lanes) {
+    const auto e =
+        hn::Sub(hn::Add(hn::Mul(hn::LoadU(d, ux + i), vvx), hn::Mul(hn::LoadU(d, uy + i), vvy)),
+                hn::LoadU(d, y + i));
+    const auto a = hn::Abs(e);
+    hn::StoreU(a, d, r + i);
+    below += hn::CountTrue(d, hn::Le(a, vb));
+    nan = hn::Or(nan, hn::VecFromMask(d, hn::Ne(a, a)));
+  }
+  bool any_nan = !hn::AllFalse(d, hn::MaskFromVec(nan));
+  for (; i < n; ++i) {
+    r[i] = std::abs(ux[i] * vx + uy[i] * vy - y[i]);
+    below += r[i] <= bound;
+    any_nan |= std::isnan(r[i]);
+  }
+  *unordered = any_nan;
+  return static_cast<int>(below);
+}
+
+// Tukey's weights w[i] = (1 - q^2)^2 for q = r[i] / c < 1, else 0 (lane by lane as the scalar
+// expression); returns the inliers (q < 1).
+int TukeyWeights(const double* r, int n, double c, double* w) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const auto vc = hn::Set(d, c), one = hn::Set(d, 1.0);
+  std::size_t inliers = 0;
+  int i = 0;
+  for (; i + lanes <= n; i += lanes) {
+    const auto q = hn::Div(hn::LoadU(d, r + i), vc);
+    const auto t = hn::Sub(one, hn::Mul(q, q));
+    const auto in = hn::Lt(q, one);
+    hn::StoreU(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + i);
+    inliers += hn::CountTrue(d, in);
+  }
+  for (; i < n; ++i) {
+    const double q = r[i] / c;
+    const double t = 1.0 - q * q;
+    w[i] = q < 1.0 ? t * t : 0.0;
+    inliers += q < 1.0;
+  }
+  return static_cast<int>(inliers);
+}
+
+// Which values NearRank ranks: those >= g (the smallest first), those < g (the largest first) or
+// all (the largest first).
+enum class Among { kAtLeast, kBelow, kAllLargest };
+
+// The m-th extreme (M = m + 1) of the values of a[0, n) that `among` names, of which there are
+// more than m: a sorted buffer of the M extreme ones, one compare-exchange chain per value, no
+// branch.
+template <int M, Among kAmong>
+double NearRank(const double* a, int n, double g) {
+  constexpr bool kSmallest = kAmong == Among::kAtLeast;
+  constexpr double kFill = kSmallest ? kInf : -kInf;
+  double b[M];
+  std::fill_n(b, M, kFill);
+  for (int i = 0; i < n; ++i) {
+    const bool in = kAmong == Among::kAtLeast ? !(a[i] < g)
+                    : kAmong == Among::kBelow ? a[i] < g
+                                              : true;
+    double x = in ? a[i] : kFill;
+    for (int l = 0; l < M; ++l) {
+      const double keep = kSmallest ? std::min(b[l], x) : std::max(b[l], x);
+      x = kSmallest ? std::max(b[l], x) : std::min(b[l], x);
+      b[l] = keep;
+    }
+  }
+  return b[M - 1];
+}
+
+template <Among kAmong>
+double NearRank(const double* a, int n, double g, int m) {
+  switch (m) {
+    case 0:
+      return NearRank<1, kAmong>(a, n, g);
+    case 1:
+      return NearRank<2, kAmong>(a, n, g);
+    case 2:
+      return NearRank<3, kAmong>(a, n, g);
+    default:
+      return NearRank<4, kAmong>(a, n, g);
+  }
+}
+
+// Rank k of a[0, n) (SelectRank's preconditions) by quickselect with branch-free partitions
+// (median-of-three pivots) down to a rank within kNearRanks of either end.
+double QuickSelect(const double* a, int n, int k) {
+  double buf[2][2][kFitMaxNeighbours];  // [pass parity][below, above the pivot]
+  for (int pass = 0;; pass ^= 1) {
+    if (k < kNearRanks) return NearRank<Among::kAtLeast>(a, n, -kInf, k);
+    if (n - 1 - k < kNearRanks) return NearRank<Among::kAllLargest>(a, n, 0.0, n - 1 - k);
+    const double x0 = a[0], x1 = a[n / 2], x2 = a[n - 1];
+    const double p = std::max(std::min(x0, x1), std::min(std::max(x0, x1), x2));
+    double* lo = buf[pass][0];
+    double* hi = buf[pass][1];
+    int nl = 0, nh = 0;
+    for (int i = 0; i < n; ++i) {
+      lo[nl] = a[i];
+      hi[nh] = a[i];
+      nl += a[i] < p;
+      nh += p < a[i];
+    }
+    if (k < nl) {
+      a = lo;
+      n = nl;
+    } else if (k >= n - nh) {
+      k -= n - nh;
+      a = hi;
+      n = nh;
+    } else {
+      return p;  // ranks [nl, n - nh) hold p
+    }
+  }
+}
+
+// The median's rank of the residuals r (finite or not): the old definition, a sorted copy.
+double NthElement(const double* r, int n, int k) {
+  double sorted[kFitMaxNeighbours];
+  std::copy_n(r, n, sorted);
+  std::nth_element(sorted, sorted + k, sorted + n);
+  return sorted[k];
+}
+
+}  // namespace
+
+namespace detail {
+
+double MadFloorBound(double floor) {
+  assert(floor >= 0.0 && std::isfinite(floor));
+  const auto fits = [floor](double m) { return kMadToSigma * m <= floor; };
+  double m = floor / kMadToSigma;
+  while (!fits(m)) m = std::nextafter(m, 0.0);
+  while (fits(std::nextafter(m, kInf))) m = std::nextafter(m, kInf);
+  return m;
+}
+
+double SelectRank(const double* a, int n, int k, double guess) {
+  assert(0 <= k && k < n && n <= kFitMaxNeighbours);
+  int below = 0;  // values < guess
+  for (int i = 0; i < n; ++i) below += a[i] < guess;
+  // Rank k is the (k - below)-th smallest of the values >= guess, or the (below - 1 - k)-th
+  // largest of those < guess.
+  if (below <= k && k - below < kNearRanks)
+    return NearRank<Among::kAtLeast>(a, n, guess, k - below);
+  if (below > k && below - 1 - k < kNearRanks)
+    return NearRank<Among::kBelow>(a, n, guess, below - 1 - k);
+  return QuickSelect(a, n, k);
+}
+
 // Tukey-weighted fit starting from ordinary least squares; the scale is the residuals' MAD, at
-// least `floor` (the radars' noise).
-bool RobustFit(const double* ux, const double* uy, const double* y, int n, double floor, Fit* f) {
-  double w[kMaxNeighbours], r[kMaxNeighbours];
+// least `floor` (the radars' noise). The median is only selected where it exceeds floor_bound
+// (otherwise the scale is `floor` whatever its value), near the last one selected.
+bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n, double floor,
+                      double floor_bound, DopplerFit* f) {
+  assert(n >= 3 && n <= kFitMaxNeighbours);
+  double w[kFitMaxNeighbours], r[kFitMaxNeighbours];
   std::fill_n(w, n, 1.0);
   if (!Solve(ux, uy, y, w, n, f)) return false;
+  const int k = n / 2;
+  double guess = floor_bound;  // the last median selected
   for (int it = 0; it < kIterations; ++it) {
-    for (int i = 0; i < n; ++i) r[i] = std::abs(ux[i] * f->vx + uy[i] * f->vy - y[i]);
-    double sorted[kMaxNeighbours];
-    std::copy_n(r, n, sorted);
-    std::nth_element(sorted, sorted + n / 2, sorted + n);
-    f->scale = std::max(floor, kMadToSigma * sorted[n / 2]);
-    const double c = kTukey * f->scale;
-    f->inliers = 0;
-    for (int i = 0; i < n; ++i) {
-      const double q = r[i] / c;
-      w[i] = q < 1.0 ? (1.0 - q * q) * (1.0 - q * q) : 0.0;
-      f->inliers += q < 1.0;
+    bool unordered = false;  // a NaN residual
+    const int at_floor = Residuals(ux, uy, y, n, f->vx, f->vy, floor_bound, r, &unordered);
+    if (unordered) {
+      f->scale = std::max(floor, kMadToSigma * NthElement(r, n, k));
+    } else if (at_floor > k) {
+      f->scale = floor;  // = std::max(floor, kMadToSigma * median): median <= floor_bound
+    } else {
+      guess = SelectRank(r, n, k, guess);
+      f->scale = std::max(floor, kMadToSigma * guess);
     }
+    f->inliers = TukeyWeights(r, n, kTukey * f->scale, w);
     if (f->inliers < 3 || !Solve(ux, uy, y, w, n, f)) return false;
   }
   return true;
 }
 
-}  // namespace
+}  // namespace detail
 
-double MeasurementGrid::BucketDistance2(const Position& p, int bx, int by) const {
+double MeasurementGrid::BucketGap(double p, int b, int nb, double origin) const {
   const double edge = 1.0 / bucket_inv_;
-  const double x0 = static_cast<double>(origin_gx_) * params_.resolution + bx * edge;
-  const double y0 = static_cast<double>(origin_gy_) * params_.resolution + by * edge;
-  const double lo_x = bx == 0 ? -kInf : x0, hi_x = bx == nbx_ - 1 ? kInf : x0 + edge;
-  const double lo_y = by == 0 ? -kInf : y0, hi_y = by == nby_ - 1 ? kInf : y0 + edge;
-  const double dx = std::max({lo_x - p.x(), 0.0, p.x() - hi_x});
-  const double dy = std::max({lo_y - p.y(), 0.0, p.y() - hi_y});
-  return dx * dx + dy * dy;
+  const double lo = origin + b * edge;
+  return std::max({(b == 0 ? -kInf : lo) - p, 0.0, p - (b == nb - 1 ? kInf : lo + edge)});
 }
 
 void MeasurementGrid::FitDetectionVelocities(const Team& t) {
@@ -98,7 +263,11 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const int reach = static_cast<int>(
       std::ceil(params_.doppler_fit_radius / (bucket_cells_ * params_.resolution)));
   const double floor = params_.doppler_fit_sigma;
+  const double floor_bound = MadFloorBound(floor);
+  const double ox = static_cast<double>(origin_gx_) * params_.resolution;
+  const double oy = static_cast<double>(origin_gy_) * params_.resolution;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
+  const double* const los_b = det_los_b_.data();
   const auto fit = [&](std::int64_t jj) {
     const int j = static_cast<int>(jj);
     det_fit_t_[j] = 0.0;
@@ -106,29 +275,47 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
     if (det_bucket_[j] < 0) return;  // not near the grid: no birth from it
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
-    double ux[kMaxNeighbours], uy[kMaxNeighbours], y[kMaxNeighbours];
+    const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(nbx_ - 1, bx + reach);
+    const int cy_lo = std::max(0, by - reach), cy_hi = std::min(nby_ - 1, by + reach);
+    // The squared gaps of the window's bucket columns and rows, once per detection (per bucket
+    // beyond kWindow of them: a radius of many buckets).
+    double gx2[kWindow], gy2[kWindow];
+    const bool tabled = cx_hi - cx_lo < kWindow && cy_hi - cy_lo < kWindow;
+    for (int cx = cx_lo; tabled && cx <= cx_hi; ++cx) {
+      const double g = BucketGap(p.x(), cx, nbx_, ox);
+      gx2[cx - cx_lo] = g * g;
+    }
+    for (int cy = cy_lo; tabled && cy <= cy_hi; ++cy) {
+      const double g = BucketGap(p.y(), cy, nby_, oy);
+      gy2[cy - cy_lo] = g * g;
+    }
+    const auto distance2 = [&](int cx, int cy) {  // from p to bucket (cx, cy) [m^2]
+      if (tabled) return gx2[cx - cx_lo] + gy2[cy - cy_lo];
+      const double gx = BucketGap(p.x(), cx, nbx_, ox), gy = BucketGap(p.y(), cy, nby_, oy);
+      return gx * gx + gy * gy;
+    };
+    double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
     int n = 0, looked = 0;
-    for (int cy = std::max(0, by - reach); cy <= std::min(nby_ - 1, by + reach); ++cy) {
-      for (int cx = std::max(0, bx - reach); cx <= std::min(nbx_ - 1, bx + reach); ++cx) {
+    for (int cy = cy_lo; cy <= cy_hi; ++cy) {
+      for (int cx = cx_lo; cx <= cx_hi; ++cx) {
         // No neighbour can lie there (a relative margin for the rounding of BucketOf's edges).
-        if (BucketDistance2(p, cx, cy) > radius2 * (1.0 + 1e-9)) continue;
+        if (distance2(cx, cy) > radius2 * (1.0 + 1e-9)) continue;
         const std::int64_t b = static_cast<std::int64_t>(cy) * nbx_ + cx;
-        for (std::int64_t k = bucket_start_[b];
-             k < bucket_start_[b + 1] && n < kMaxNeighbours && looked < kMaxCandidates;
-             ++k, ++looked) {
-          // det_x_/det_y_: the positions in bucket order (contiguous, unlike z[i]).
+        for (std::int64_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k, ++looked) {
+          // The first kFitMaxNeighbours within the radius of the first kMaxCandidates looked at.
+          if (n == kFitMaxNeighbours || looked == kMaxCandidates) goto gathered;
+          // det_x_/det_y_, los_b: the positions and lines of sight in bucket order (contiguous).
           const double ex = det_x_[k] - p.x(), ey = det_y_[k] - p.y();
-          if (ex * ex + ey * ey > radius2) continue;
-          const int i = bucket_items_[k];
-          ux[n] = los[3 * i];
-          uy[n] = los[3 * i + 1];
-          y[n] = los[3 * i + 2];
-          ++n;
+          ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
+          uy[n] = los_b[3 * k + 1];
+          y[n] = los_b[3 * k + 2];
+          n += !(ex * ex + ey * ey > radius2);
         }
       }
     }
-    Fit f;
-    if (n < 3 || !RobustFit(ux, uy, y, n, floor, &f)) return;
+  gathered:
+    DopplerFit f;
+    if (n < 3 || !RobustDopplerFit(ux, uy, y, n, floor, floor_bound, &f)) return;
     // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
     // t^T (scale^2 A^-1) t.
     const double tx = -los[3 * j + 1], ty = los[3 * j];

@@ -8,8 +8,11 @@
 #include <string>
 #include <utility>
 
+#include <hwy/highway.h>
+
 #include "dualgrid/core/parallel.hpp"
 #include "dualgrid/core/text.hpp"
+#include "dualgrid/filter/fast_atan2.hpp"
 #include "grid_internal.hpp"
 #include "team.hpp"
 
@@ -19,22 +22,113 @@ using namespace detail;
 
 namespace {
 
-// std::atan2 per cell and sensor dominated the free-space pass.
-inline double FastAtan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  const double mx = std::max(ax, ay), mn = std::min(ax, ay);
-  if (mx == 0.0) return 0.0;
-  const double a = mn / mx, s = a * a;
-  double r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a;
-  if (ay > ax) r = 0.5 * kPi - r;
-  if (x < 0.0) r = kPi - r;
-  return y < 0.0 ? -r : r;
-}
+// Columns of a detection's stamp whose squared x offsets StampBands tables at once.
+constexpr int kStampColumns = 32;
 
 // Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
 constexpr double kAtanError = 5e-4;
 
+namespace hn = hwy::HWY_NAMESPACE;
+using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
+
+// detail::FastAtan2 on lanes: its IEEE operations in its order, lane by lane (same bits).
+hn::Vec<DD> FastAtan2V(hn::Vec<DD> y, hn::Vec<DD> x) {
+  const DD d;
+  const auto ax = hn::Abs(x), ay = hn::Abs(y);
+  const auto mx = hn::Max(ax, ay), mn = hn::Min(ax, ay);
+  const auto a = hn::Div(mn, mx), s = hn::Mul(a, a);
+  auto r = hn::Add(hn::Mul(hn::Mul(hn::Sub(hn::Mul(hn::Add(hn::Mul(hn::Set(d, -0.0464964749), s),
+                                                           hn::Set(d, 0.15931422)),
+                                                   s),
+                                           hn::Set(d, 0.327622764)),
+                                   s),
+                           a),
+                   a);
+  r = hn::IfThenElse(hn::Gt(ay, ax), hn::Sub(hn::Set(d, 0.5 * kPi), r), r);
+  r = hn::IfThenElse(hn::Lt(x, hn::Zero(d)), hn::Sub(hn::Set(d, kPi), r), r);
+  r = hn::IfThenElse(hn::Lt(y, hn::Zero(d)), hn::Neg(r), r);
+  return hn::IfThenZeroElse(hn::Eq(mx, hn::Zero(d)), r);
+}
+
+// One sensor's constants along one logical row (FieldOfViewRow): cell lx's centre lies at
+// dx = x0 + (lx + 0.5) r - ox, dy from the sensor; cb, sb: cos, sin of the boresight.
+// bins[0, nbins): the sensor's bearing bins' ranges [m], inv_bin their inverse width [1/rad]; the
+// row starts at view + row in storage, logical column 0 at storage column sx0 of nx.
+struct RowSensor {
+  double x0, r, ox, dy, cb, sb, tan_hf, half_fov, min2, max2;
+  bool narrow;
+  const double* bins;
+  int nbins;
+  double inv_bin;
+  std::int64_t row, sx0, nx;
+};
+
+// Cells per batch of ExactGeometry.
+constexpr int kExactBatch = 32;
+
+// The exact per-cell test's geometry for cells lx[0, m) (m <= kExactBatch; lx, d2, rel and in
+// hold kExactBatch entries, lx set up to m rounded up to whole lanes): each cell's squared
+// distance d2 [m^2], bearing rel [rad] (FastAtan2) and in = 1 when it lies within the range and
+// the field of view (0 otherwise), on lanes: the scalar test's operations, same bits.
+void ExactGeometry(const RowSensor& c, const int* lx, int m, double* d2, double* rel, double* in) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const hn::Rebind<std::int32_t, DD> di;
+  const auto x0 = hn::Set(d, c.x0), r = hn::Set(d, c.r), ox = hn::Set(d, c.ox);
+  const auto half = hn::Set(d, 0.5), dydy = hn::Set(d, c.dy * c.dy);
+  const auto cb = hn::Set(d, c.cb), sb = hn::Set(d, c.sb), tan_hf = hn::Set(d, c.tan_hf);
+  const auto dysb = hn::Set(d, c.dy * c.sb), dycb = hn::Set(d, c.dy * c.cb);
+  const auto min2 = hn::Set(d, c.min2), max2 = hn::Set(d, c.max2);
+  const auto hf = hn::Set(d, c.half_fov);
+  for (int i = 0; i < m; i += lanes) {  // lx, d2, rel, in: kExactBatch entries (a whole tail)
+    const auto l = hn::PromoteTo(d, hn::LoadU(di, lx + i));
+    const auto dx = hn::Sub(hn::Add(x0, hn::Mul(hn::Add(l, half), r)), ox);
+    const auto dd = hn::Add(hn::Mul(dx, dx), dydy);
+    auto ok = hn::And(hn::Not(hn::Lt(dd, min2)), hn::Not(hn::Gt(dd, max2)));
+    const auto fx = hn::Add(hn::Mul(dx, cb), dysb), fy = hn::Sub(dycb, hn::Mul(dx, sb));
+    if (c.narrow) {
+      ok =
+          hn::AndNot(hn::Or(hn::Le(fx, hn::Zero(d)), hn::Gt(hn::Abs(fy), hn::Mul(fx, tan_hf))), ok);
+    }
+    const auto a = FastAtan2V(fy, fx);
+    ok = hn::AndNot(hn::Gt(hn::Abs(a), hf), ok);
+    hn::StoreU(dd, d, d2 + i);
+    hn::StoreU(a, d, rel + i);
+    hn::StoreU(hn::IfThenElseZero(ok, hn::Set(d, 1.0)), d, in + i);
+  }
+}
+
+// The exact per-cell test (the reference definition of the bits) of cells lx[0, m) (m <=
+// kExactBatch; lx holds kExactBatch + 1 entries): their geometry on lanes (ExactGeometry), then
+// the bin of each cell inside, OR-ed into `view`.
+void ExactCells(const RowSensor& c, int* lx, int m, std::uint8_t* view) {
+  if (m == 0) return;
+  lx[m] = lx[m - 1];  // whole lanes
+  double d2[kExactBatch + 1], rel[kExactBatch + 1], in[kExactBatch + 1];
+  ExactGeometry(c, lx, m, d2, rel, in);
+  for (int i = 0; i < m; ++i) {
+    if (in[i] == 0.0) continue;
+    const std::int64_t sx = c.sx0 + lx[i];
+    const std::int64_t s = c.row + (sx >= c.nx ? sx - c.nx : sx);
+    const int b = std::clamp(static_cast<int>((rel[i] + c.half_fov) * c.inv_bin), 0, c.nbins - 1);
+    const double br = c.bins[b];
+    // Free in front of the bin's closest detection, unknown behind it; a bin without any
+    // detection is weakly free over the whole range.
+    view[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
+                                         (br != kInf && d2[i] < br * br ? kFreeRay : 0));
+  }
+}
+
 }  // namespace
+
+void detail::FastAtan2Lanes(const double* y, const double* x, int n, double* out) {
+  const DD d;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  int i = 0;
+  for (; i + lanes <= n; i += lanes)
+    hn::StoreU(FastAtan2V(hn::LoadU(d, y + i), hn::LoadU(d, x + i)), d, out + i);
+  for (; i < n; ++i) out[i] = FastAtan2(y[i], x[i]);
+}
 
 MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
   std::string error;
@@ -123,6 +217,7 @@ void MeasurementGrid::Prepare(const Position& centre, std::span<const Measuremen
     det_fit_sd_.resize(nz);
   }
   if (det_los_.size() < 3 * nz) det_los_.resize(3 * nz);
+  if (with_fit_ && det_los_b_.size() < 3 * nz) det_los_b_.resize(3 * nz);
   // Bearing bins per sensor: range of the closest detection shadowing each bin (Bins).
   const int ns = static_cast<int>(coverage.size());
   bin_offset_.assign(ns + 1, 0);  // small vectors; capacity is reused across cycles
@@ -241,21 +336,33 @@ void MeasurementGrid::StampBands(int band_lo, int band_hi) {
     // Its storage rows row_lo .. end - 1 (mod ny): skip it unless they meet [row_a, row_b).
     const int end = row_lo + cy_hi - cy_lo + 1;
     if (!((row_lo < row_b && std::min(end, ny_) > row_a) || end - ny_ > row_a)) continue;
-    for (int cy = cy_lo, srow = row_lo; cy <= cy_hi; ++cy, srow = srow + 1 == ny_ ? 0 : srow + 1) {
-      if (srow < row_a || srow >= row_b) continue;
-      std::vector<std::int64_t>& touched = touched_[band_of_row_[srow]];
-      const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
-      const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
-      for (int cx = std::max(0, lx - rc); cx <= std::min(nx_ - 1, lx + rc); ++cx) {
+    // The stamp's columns in chunks of kStampColumns: their squared x offsets once per chunk, not
+    // per row (a cell's update does not depend on the order of the detection's cells).
+    const int cx_lo = std::max(0, lx - rc), cx_hi = std::min(nx_ - 1, lx + rc);
+    for (int c0 = cx_lo; c0 <= cx_hi; c0 += kStampColumns) {
+      const int c1 = std::min(cx_hi, c0 + kStampColumns - 1);
+      double exx[kStampColumns];
+      for (int cx = c0; cx <= c1; ++cx) {
         const double ex = (static_cast<double>(origin_gx_ + cx) + 0.5) * r - p.x();
-        const double d2 = ex * ex + ey * ey;
-        if (d2 > cutoff2) continue;
-        const std::int64_t sx = sx0 + cx;
-        const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-        if (near_det_[s] < 0) touched.push_back(s);
-        if (d2 < near_d2_[s]) {
-          near_d2_[s] = d2;
-          near_det_[s] = j;
+        exx[cx - c0] = ex * ex;
+      }
+      for (int cy = cy_lo, srow = row_lo; cy <= cy_hi;
+           ++cy, srow = srow + 1 == ny_ ? 0 : srow + 1) {
+        if (srow < row_a || srow >= row_b) continue;
+        std::vector<std::int64_t>& touched = touched_[band_of_row_[srow]];
+        const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
+        const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
+        const double eyy = ey * ey;
+        for (int cx = c0; cx <= c1; ++cx) {
+          const double d2 = exx[cx - c0] + eyy;
+          if (d2 > cutoff2) continue;
+          const std::int64_t sx = sx0 + cx;
+          const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
+          if (near_det_[s] < 0) touched.push_back(s);
+          if (d2 < near_d2_[s]) {
+            near_d2_[s] = d2;
+            near_det_[s] = j;
+          }
         }
       }
     }
@@ -339,23 +446,17 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
     const double inv_bin = 1.0 / params_.free_angle_bin;
     const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
-    // Exact per-cell test (the reference definition of the bits).
+    // Cells left to the exact per-cell test, in batches (ExactCells).
+    const RowSensor rs{x0,   r,      sc.origin.x(), dy,    cb,      sb,  tan_hf, sc.half_fov, min2,
+                       max2, narrow, bins,          nbins, inv_bin, row, sx0,    nx_};
+    int pending[kExactBatch + 1];
+    int np = 0;
     const auto exact = [&](int lx) {
-      const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
-      const double d2 = dx * dx + dy * dy;
-      if (d2 < min2 || d2 > max2) return;
-      const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-      if (narrow && (fx <= 0.0 || std::abs(fy) > fx * tan_hf)) return;
-      const double rel = FastAtan2(fy, fx);
-      if (std::abs(rel) > sc.half_fov) return;
-      const std::int64_t sx = sx0 + lx;
-      const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-      const int b = std::clamp(static_cast<int>((rel + sc.half_fov) * inv_bin), 0, nbins - 1);
-      const double br = bins[b];
-      // Free in front of the bin's closest detection, unknown behind it; a bin without any
-      // detection is weakly free over the whole range.
-      view_[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
-                                            (br != kInf && d2 < br * br ? kFreeRay : 0));
+      pending[np++] = lx;
+      if (np == kExactBatch) {
+        ExactCells(rs, pending, np, view_.data());
+        np = 0;
+      }
     };
     int lo_x = lx_lo, hi_x = lx_hi;
     // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
@@ -473,6 +574,7 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
         }
       }
     }
+    ExactCells(rs, pending, np, view_.data());
   }
 }
 
@@ -485,6 +587,12 @@ void MeasurementGrid::ComputeLinesOfSight() {
     det_los_[3 * j] = u.x();
     det_los_[3 * j + 1] = u.y();
     det_los_[3 * j + 2] = z_[j].radial_velocity.dot(u);
+  }
+  if (!with_fit_) return;
+  const std::int64_t nb = static_cast<std::int64_t>(nbx_) * nby_;
+  for (std::int64_t k = 0; k < bucket_start_[nb]; ++k) {  // FillBuckets ran before
+    const int j = bucket_items_[k];
+    std::copy_n(det_los_.begin() + 3 * j, 3, det_los_b_.begin() + 3 * k);
   }
 }
 

@@ -114,7 +114,8 @@ class MeasurementGrid {
   void Bins(std::span<const SensorCoverage> cov);               // the bins' ranges (serial)
   void FieldOfViewTables(std::span<const SensorCoverage> cov);  // per-sensor constants (serial)
   void FieldOfViewRow(int ly, std::span<const SensorCoverage> cov);  // view_ of logical row ly
-  // Per detection the unit line of sight and the signed radial speed into det_los_.
+  // Per detection the unit line of sight and the signed radial speed into det_los_ (and, with
+  // the fit, in bucket order into det_los_b_: after FillBuckets).
   void ComputeLinesOfSight();
   // Per detection the tangential velocity a robust fit to its neighbours' Doppler gives, and its
   // standard deviation (inf: no fit), by the team t; no barrier at the end.
@@ -122,9 +123,10 @@ class MeasurementGrid {
   // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
   // every cell holding particles.
   std::pair<int, int> BucketOf(double px, double py) const;
-  /// Squared distance [m^2] from `p` to the area of bucket (bx, by); the edge buckets reach out
-  /// without end (BucketOf clamps to them).
-  double BucketDistance2(const Position& p, int bx, int by) const;
+  // Distance [m] along one axis from coordinate p to bucket b of nb along it, whose axis starts
+  // at `origin` [m]; the edge buckets reach out without end (BucketOf clamps to them). The
+  // squared distance of a point to a bucket is the sum of its two axes' squared gaps.
+  double BucketGap(double p, int b, int nb, double origin) const;
 
   FilterParams params_;
   bool with_fit_ = false;
@@ -162,6 +164,7 @@ class MeasurementGrid {
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
 
   std::vector<double> det_los_;                 // per detection: unit line of sight, v_r . u
+  std::vector<double> det_los_b_;               // det_los_ in bucket order (the fit's gathering)
   std::vector<double> det_fit_t_, det_fit_sd_;  // per detection: the fit [m/s] (4a)
 };
 

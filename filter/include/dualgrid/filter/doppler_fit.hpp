@@ -1,0 +1,41 @@
+// The robust velocity fit of step 4a (docs/algorithm.md, "The Doppler fit"): one velocity v with
+// u_i . v = v_r,i for the detections i near a detection, by Tukey's biweight (iteratively
+// reweighted least squares from ordinary least squares). Internal to the filter
+// (MeasurementGrid::FitDetectionVelocities); public so that tests/filter can check it, bit for
+// bit, against its definition.
+#pragma once
+
+namespace dualgrid::filter::detail {
+
+/// Neighbours per fit at most (the first ones in bucket order).
+constexpr int kFitMaxNeighbours = 64;
+
+/// The fit's result: the velocity [m/s], the scale sigma [m/s] and A = sum_i w_i u_i u_i^T at
+/// the solution (its entries a00, a01, a11), and the inliers of the last reweighting.
+struct DopplerFit {
+  double vx = 0.0, vy = 0.0, scale = 0.0;
+  double a00 = 0.0, a01 = 0.0, a11 = 0.0;
+  int inliers = 0;
+};
+
+/// The largest m >= 0 with 1.4826 * m (rounded as double) <= floor: the fit's scale
+/// max(floor, 1.4826 * median) is `floor` exactly when the median is <= this bound. floor >= 0,
+/// finite.
+double MadFloorBound(double floor);
+
+/// The value of rank k (0-based) of a[0, n) in ascending order: what std::nth_element puts at
+/// a + k, without changing a. `guess` [any value] only steers the work (a value near the result
+/// makes it cheaper). Preconditions: 0 <= k < n <= kFitMaxNeighbours, no NaN, and equal values
+/// are bitwise equal (no -0.0 beside +0.0; e.g. results of std::abs).
+double SelectRank(const double* a, int n, int k, double guess);
+
+/// Fits v to the n lines of sight (ux, uy) [unit vectors] and radial speeds y [m/s] (the
+/// residuals' scale is 1.4826 x their median absolute deviation, at least floor [m/s];
+/// floor_bound = MadFloorBound(floor)). False when fewer than 3 inliers remain or the weighted
+/// lines of sight do not span the plane (f then holds partial values). 3 <= n <=
+/// kFitMaxNeighbours. Same result, bit for bit, as the plain definition (tests/filter:
+/// reference/doppler_fit.hpp), for any input including non-finite ones.
+bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n, double floor,
+                      double floor_bound, DopplerFit* f);
+
+}  // namespace dualgrid::filter::detail
