@@ -23,19 +23,6 @@ struct WeightTrace {
   std::vector<double> tangential_share;
 };
 
-/// The particles' weights in one box at one step (WeightTraces::Add: a vehicle's box grown by
-/// 1 m): over the particles inside `box` [m, grid frame], the sums of w_position, w_velocity and
-/// weight, and of the first two over those whose velocity is within WeightTrace::kGoodVelocity
-/// of `velocity` [m/s, grid frame].
-struct BoxWeights {
-  OrientedBox box;
-  Velocity velocity = Velocity::Zero();
-  double wp = 0.0, wv = 0.0, w = 0.0, wp_good = 0.0, wv_good = 0.0;
-};
-/// Adds every particle of `particles` to the sums of each box holding it, in one pass: each sum
-/// takes its particles in index order, so it is the same bits as a pass per box.
-void SumBoxWeights(const filter::ParticleSet& particles, std::vector<BoxWeights>& boxes);
-
 /// Weight traces of every vehicle in the grid (paper Fig. 4), from one filter's particles.
 /// Only traces that can still become the focus are kept: the requested vehicle's, those of the
 /// vehicles in the grid now, and the current leader's (most frames in the grid); a trace whose
