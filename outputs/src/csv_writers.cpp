@@ -1,13 +1,61 @@
 #include "dualgrid/outputs/csv_writers.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/recorded/run_folder_columns.hpp"
 
 namespace dualgrid::outputs {
+
+namespace {
+
+// One CSV row at a time appended to a file's buffer, the numbers as printf writes them but
+// without a std::string or a stream per number (the run writes ~600 numbers per step).
+class CsvRow {
+ public:
+  explicit CsvRow(std::string& out) : out_(out) {}
+  CsvRow& Int(long long v) { return Chars(std::to_chars(buf_, buf_ + sizeof buf_, v)); }
+  /// printf's "%.<decimals>f" (FormatFixed): std::to_chars writes the same digits.
+  CsvRow& Fixed(double v, int decimals) {
+    const auto r = std::to_chars(buf_, buf_ + sizeof buf_, v, std::chars_format::fixed, decimals);
+    return r.ec == std::errc() ? Chars(r) : Text(FormatFixed(v, decimals));  // beyond ~1e60
+  }
+  /// printf's "%.<digits>g", as a stream with precision(digits) writes a double.
+  CsvRow& Significant(double v, int digits) {
+    const auto r = std::to_chars(buf_, buf_ + sizeof buf_, v, std::chars_format::general, digits);
+    return r.ec == std::errc() ? Chars(r) : Text(FormatSignificant(v, digits));
+  }
+  CsvRow& Text(std::string_view text) {
+    Comma();
+    out_ += text;
+    return *this;
+  }
+  void End() {
+    out_ += '\n';
+    first_ = true;
+  }
+
+ private:
+  void Comma() {
+    if (!first_) out_ += ',';
+    first_ = false;
+  }
+  CsvRow& Chars(const std::to_chars_result& r) {
+    Comma();
+    out_.append(buf_, r.ptr);
+    return *this;
+  }
+
+  std::string& out_;
+  char buf_[96];
+  bool first_ = true;
+};
+
+}  // namespace
 
 std::optional<std::filesystem::path> DetectionPath(const std::filesystem::path& dir,
                                                    const std::string& format) {
@@ -26,24 +74,19 @@ GroundTruthWriter::GroundTruthWriter(const std::filesystem::path& path) : out_(p
 
 void GroundTruthWriter::Write(const sim::Frame& f) {
   const Pose2 ego = f.EgoPose();
-  std::ostringstream os;
-  os.precision(10);
-  auto row = [&](const sim::VehicleState& v, bool is_ego) {
+  CsvRow row(out_.buffer());
+  auto vehicle = [&](const sim::VehicleState& v, bool is_ego) {
     const Position p = ego.ToLocal(v.box.center);
     const Velocity vr = ego.RotateToLocal(v.velocity);
-    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << v.id << ',' << v.type << ','
-       << (is_ego ? 1 : 0) << ',' << FormatFixed(v.box.center.x(), 4) << ','
-       << FormatFixed(v.box.center.y(), 4) << ',' << FormatFixed(v.box.yaw, 6) << ','
-       << FormatFixed(v.velocity.x(), 4) << ',' << FormatFixed(v.velocity.y(), 4) << ','
-       << FormatFixed(v.speed, 4) << ',' << FormatFixed(v.lateral_speed, 4) << ','
-       << FormatFixed(v.yaw_rate, 6) << ',' << FormatFixed(v.box.length, 3) << ','
-       << FormatFixed(v.box.width, 3) << ',' << v.lane << ',' << FormatFixed(p.x(), 4) << ','
-       << FormatFixed(p.y(), 4) << ',' << FormatFixed(vr.x(), 4) << ',' << FormatFixed(vr.y(), 4)
-       << ',' << FormatFixed(v.rcs_dbsm, 1) << '\n';
+    row.Int(f.step).Fixed(f.time, 3).Text(v.id).Text(v.type).Int(is_ego ? 1 : 0);
+    row.Fixed(v.box.center.x(), 4).Fixed(v.box.center.y(), 4).Fixed(v.box.yaw, 6);
+    row.Fixed(v.velocity.x(), 4).Fixed(v.velocity.y(), 4).Fixed(v.speed, 4);
+    row.Fixed(v.lateral_speed, 4).Fixed(v.yaw_rate, 6).Fixed(v.box.length, 3);
+    row.Fixed(v.box.width, 3).Text(v.lane).Fixed(p.x(), 4).Fixed(p.y(), 4).Fixed(vr.x(), 4);
+    row.Fixed(vr.y(), 4).Fixed(v.rcs_dbsm, 1).End();
   };
-  row(f.ego, true);
-  for (const auto& v : f.vehicles) row(v, false);
-  out_.buffer() += os.str();
+  vehicle(f.ego, true);
+  for (const auto& v : f.vehicles) vehicle(v, false);
   out_.MaybeFlush();
 }
 
@@ -159,22 +202,18 @@ void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::st
                           const cosim::IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
-  std::ostringstream os;
-  os.precision(10);
+  CsvRow row(out_.buffer());
   for (std::size_t c = 0; c < scorer.clusters().size(); ++c) {
     const eval::Cluster& cl = scorer.clusters()[c];
     const Position pos = g.ToWorld(cl.position);
     const Velocity vel = g.VectorToWorld(cl.velocity);
     const Position local = f.EgoPose().ToLocal(pos);
-    os << f.step << ',' << FormatFixed(f.time, 3) << ',' << mode << ',' << FormatFixed(pos.x(), 3)
-       << ',' << FormatFixed(pos.y(), 3) << ',' << FormatFixed(vel.x(), 3) << ','
-       << FormatFixed(vel.y(), 3) << ',' << cl.weight << ',' << cl.size << ','
-       << kRole[static_cast<int>(a.role[c])] << ','
-       << (a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id)
-                                       : std::string())
-       << ',' << FormatFixed(local.x(), 2) << ',' << FormatFixed(local.y(), 2) << '\n';
+    row.Int(f.step).Fixed(f.time, 3).Text(mode).Fixed(pos.x(), 3).Fixed(pos.y(), 3);
+    row.Fixed(vel.x(), 3).Fixed(vel.y(), 3).Significant(cl.weight, 10).Int(cl.size);
+    row.Text(kRole[static_cast<int>(a.role[c])]);
+    row.Text(a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id) : "");
+    row.Fixed(local.x(), 2).Fixed(local.y(), 2).End();
   }
-  out_.buffer() += os.str();
   out_.MaybeFlush();
 }
 

@@ -1,5 +1,7 @@
 #include "dualgrid/outputs/figures.hpp"
 
+#include "pictures.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -13,21 +15,30 @@
 
 namespace dualgrid::outputs {
 
-bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
-               std::vector<std::string>* warnings) {
+std::optional<std::string> DrawFigure(const std::filesystem::path& path,
+                                      const std::function<void()>& draw) {
   try {
     if (FaultInjected("figure:" + path.filename().string()))
       throw std::runtime_error("injected fault (DUALGRID_FAULT)");
     draw();
-    return true;
+    return std::nullopt;
   } catch (const std::exception& e) {
     std::string what = e.what();
     std::replace(what.begin(), what.end(), '\n', ' ');
-    const std::string warning = "figure " + path.string() + " not drawn: " + what;
-    std::cerr << "dualgrid: warning: " << warning << "\n";
-    if (warnings) warnings->push_back(warning);
-    return false;
+    return "figure " + path.string() + " not drawn: " + what;
   }
+}
+
+void PublishWarning(const std::string& warning, std::vector<std::string>* warnings) {
+  std::cerr << "dualgrid: warning: " << warning << "\n";
+  if (warnings) warnings->push_back(warning);
+}
+
+bool TryFigure(const std::filesystem::path& path, const std::function<void()>& draw,
+               std::vector<std::string>* warnings) {
+  const std::optional<std::string> failure = DrawFigure(path, draw);
+  if (failure) PublishWarning(*failure, warnings);
+  return !failure;
 }
 
 namespace {
@@ -46,18 +57,24 @@ constexpr double kArrowSeconds = 0.5;
 
 }  // namespace
 
-bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::string>& formats,
-                const std::function<void(const std::filesystem::path&)>& draw,
-                std::vector<std::string>* warnings) {
-  bool all = true;
+std::vector<std::string> DrawFigures(
+    const std::filesystem::path& png_path, const std::vector<std::string>& formats,
+    const std::function<void(const std::filesystem::path&)>& draw) {
+  std::vector<std::string> failures;
   for (const std::string& format : formats) {
     std::filesystem::path path = png_path;
     path.replace_extension("." + format);
-    all = TryFigure(
-              path, [&] { draw(path); }, warnings) &&
-          all;
+    if (auto failure = DrawFigure(path, [&] { draw(path); })) failures.push_back(*failure);
   }
-  return all;
+  return failures;
+}
+
+bool TryFigures(const std::filesystem::path& png_path, const std::vector<std::string>& formats,
+                const std::function<void(const std::filesystem::path&)>& draw,
+                std::vector<std::string>* warnings) {
+  const std::vector<std::string> failures = DrawFigures(png_path, formats, draw);
+  for (const std::string& failure : failures) PublishWarning(failure, warnings);
+  return failures.empty();
 }
 
 ReferenceWords WordsFor(const std::string& references) {
@@ -72,8 +89,8 @@ ReferenceWords WordsFor(const std::string& references) {
   return {};
 }
 
-void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
-                 double ahead, double half_width, bool captions, const ReferenceWords& words) {
+ScenePicture MakeScene(const cosim::Pipeline& pipeline, double behind, double ahead,
+                       double half_width, bool captions, const ReferenceWords& words) {
   const sim::Frame& f = pipeline.frame();
   const GridFrame& g = pipeline.grid_frame();
   // Drawn relative to the ego in the grid frame, like the grid figures: the axes read as metres
@@ -85,7 +102,9 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
     b.center -= ego;
     return b;
   };
-  viz::BirdsEyeOptions options;
+  ScenePicture s;
+  s.world = {Position(-behind, -half_width), Position(ahead, half_width)};
+  viz::BirdsEyeOptions& options = s.options;
   options.title = pipeline.config().sim.name + ", t = " + FormatFixed(f.time, 2) +
                   " s: radar view (" + std::to_string(pipeline.detections().size()) +
                   " detections)";
@@ -99,51 +118,63 @@ void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& p
       "radar (field of view outline, its detections). A label that finds no free place is left "
       "out; one set apart from its box has a leader line.";
   if (!captions) options.caption.clear();
-  viz::BirdsEyeView view({Position(-behind, -half_width), Position(ahead, half_width)}, options);
   auto to_rel = [&](std::vector<Position> points) {
     for (Position& p : points) p = rel(p);
     return points;
   };
   if (const sim::SumoSimulation* sumo = pipeline.sumo())  // recorded data have no lanes
-    for (const auto& lane : sumo->LaneShapes()) view.DrawLane(to_rel(lane.points), lane.width);
-  for (const auto& rail : pipeline.config().sim.guard_rails)
-    view.DrawGuardRail(to_rel(rail.points));
-  view.KeepLabelsOff(rel_box(f.ego.box));  // drawn last, on top; no label may cover it
+    for (const auto& lane : sumo->LaneShapes())
+      s.lanes.emplace_back(to_rel(lane.points), lane.width);
+  for (const auto& rail : pipeline.config().sim.guard_rails) s.rails.push_back(to_rel(rail.points));
+  s.ego_box = rel_box(f.ego.box);
   for (const auto& p : pipeline.config().sim.parked) {
     viz::VehicleStyle style;
     style.fill = viz::colors::kGuardRail;
     style.label = p.id;
     style.legend = "parked";
-    view.DrawVehicle(rel_box(p.box), style);
+    s.parked.emplace_back(rel_box(p.box), style);
   }
   const auto& radar = pipeline.radar();
   const auto poses = radar.SensorPoses(pipeline.ego_motion().pose);
-  for (std::size_t s = 0; s < poses.size(); ++s) {
-    const auto& p = radar.sensors()[s];
-    view.DrawSensorFov({rel(poses[s].position), g.YawToGrid(poses[s].yaw), 0.5 * p.fov, p.max_range,
-                        static_cast<int>(s), p.name});
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto& p = radar.sensors()[i];
+    s.fovs.push_back({rel(poses[i].position), g.YawToGrid(poses[i].yaw), 0.5 * p.fov, p.max_range,
+                      static_cast<int>(i), p.name});
   }
   for (const auto& v : f.vehicles) {
     viz::VehicleStyle style;
     style.label = v.id;
     style.velocity = g.VectorToGrid(v.velocity);  // over ground, as the detections' arrows
     style.arrow_scale = kArrowSeconds;
-    view.DrawVehicle(rel_box(v.box), style);
+    s.vehicles.emplace_back(rel_box(v.box), style);
   }
-  viz::VehicleStyle ego_style;  // no label: the green box at the axes' origin
-  ego_style.ego = true;
-  ego_style.velocity = g.VectorToGrid(f.ego.velocity);
-  ego_style.arrow_scale = kArrowSeconds;
-  view.DrawVehicle(rel_box(f.ego.box), ego_style);
-  std::vector<viz::DetectionMark> marks;
+  s.ego_style.ego = true;  // no label: the green box at the axes' origin
+  s.ego_style.velocity = g.VectorToGrid(f.ego.velocity);
+  s.ego_style.arrow_scale = kArrowSeconds;
   for (const auto& d : pipeline.detections())
-    marks.push_back(
+    s.detections.push_back(
         {rel(d.position_world), g.VectorToGrid(d.radial_velocity_world), d.sensor, d.is_clutter});
-  viz::DetectionStyle style;
-  style.coloring = viz::DetectionColoring::kBySensor;
-  style.arrow_scale = kArrowSeconds;
-  view.DrawDetections(marks, style);
+  s.detection_style.coloring = viz::DetectionColoring::kBySensor;
+  s.detection_style.arrow_scale = kArrowSeconds;
+  return s;
+}
+
+void DrawScene(const ScenePicture& s, const std::filesystem::path& path) {
+  viz::BirdsEyeView view(s.world, s.options);
+  for (const auto& [points, width] : s.lanes) view.DrawLane(points, width);
+  for (const auto& rail : s.rails) view.DrawGuardRail(rail);
+  view.KeepLabelsOff(s.ego_box);  // drawn last, on top; no label may cover it
+  for (const auto& [box, style] : s.parked) view.DrawVehicle(box, style);
+  for (const viz::SensorFov& fov : s.fovs) view.DrawSensorFov(fov);
+  for (const auto& [box, style] : s.vehicles) view.DrawVehicle(box, style);
+  view.DrawVehicle(s.ego_box, s.ego_style);
+  view.DrawDetections(s.detections, s.detection_style);
   view.Save(path.string());
+}
+
+void RenderScene(const cosim::Pipeline& pipeline, const std::filesystem::path& path, double behind,
+                 double ahead, double half_width, bool captions, const ReferenceWords& words) {
+  DrawScene(MakeScene(pipeline, behind, ahead, half_width, captions, words), path);
 }
 
 namespace {
@@ -155,11 +186,12 @@ viz::GridRaster ToRaster(const cosim::GridSnapshot& s) {
 
 }  // namespace
 
-void RenderGridFigure(const std::vector<std::string>& modes,
-                      const std::vector<cosim::GridSnapshot>& snapshots,
-                      const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
-                      const sim::Frame& frame, double time, const std::filesystem::path& path,
-                      bool captions, const ReferenceWords& words) {
+GridPicture MakeGridFigure(const std::vector<std::string>& modes,
+                           const std::vector<cosim::GridSnapshot>& snapshots,
+                           const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
+                           const sim::Frame& frame, double time, bool captions,
+                           const ReferenceWords& words) {
+  GridPicture picture;
   // Axes in metres from the ego, along the grid's axes: readers compare positions with the ego,
   // not with the network's (often UTM-sized) coordinates.
   const Position ego = g.ToGrid(frame.ego.box.center);
@@ -167,7 +199,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
     b.center -= ego;
     return b;
   };
-  std::vector<viz::GridPanel> panels;
+  std::vector<viz::GridPanel>& panels = picture.panels;
   for (std::size_t i = 0; i < modes.size(); ++i) {
     viz::GridPanel panel;
     panel.title = modes[i];
@@ -188,7 +220,7 @@ void RenderGridFigure(const std::vector<std::string>& modes,
     }
     panels.push_back(std::move(panel));
   }
-  viz::GridFigureOptions options;
+  viz::GridFigureOptions& options = picture.options;
   options.x_label = "x from the ego [m]";  // the grid frame's axes (its angle is in the caption)
   options.y_label = "y [m]";
   options.title = "Dynamic grids at t = " + FormatFixed(time, 2) + " s";
@@ -205,7 +237,17 @@ void RenderGridFigure(const std::vector<std::string>& modes,
       words.velocity + ". Arrows: motion over ground in " + FormatFixed(options.arrow_seconds, 1) +
       " s. " + AxesNote(g);
   if (!captions) options.caption.clear();
-  viz::RenderGridPanels(panels, path.string(), options);
+  return picture;
+}
+
+void RenderGridFigure(const std::vector<std::string>& modes,
+                      const std::vector<cosim::GridSnapshot>& snapshots,
+                      const std::vector<cosim::ModeScorer>& scorers, const GridFrame& g,
+                      const sim::Frame& frame, double time, const std::filesystem::path& path,
+                      bool captions, const ReferenceWords& words) {
+  const GridPicture picture =
+      MakeGridFigure(modes, snapshots, scorers, g, frame, time, captions, words);
+  viz::RenderGridPanels(picture.panels, path.string(), picture.options);
 }
 
 TrackedShares RunTrackedShares(const std::vector<eval::ScenarioMetrics>& metrics,

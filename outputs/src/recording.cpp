@@ -6,6 +6,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -90,7 +91,8 @@ double ParticleUnit(double extent_x, double extent_y) {
   return std::max(0.01, extent / 65000.0);
 }
 
-Writer::Writer(const fs::path& dir, Header header) : dir_(dir), header_(std::move(header)) {
+Writer::Writer(const fs::path& dir, Header header, OutputWorker& worker)
+    : dir_(dir), header_(std::move(header)), worker_(worker) {
   fs::create_directories(dir_);
   // A stale index from an earlier run must not describe this run's frames.
   fs::remove(dir_ / "index.json");
@@ -101,21 +103,26 @@ Writer::Writer(const fs::path& dir, Header header) : dir_(dir), header_(std::mov
 }
 
 Writer::~Writer() {
-  try {
-    Wait();
-  } catch (...) {  // NOLINT(bugprone-empty-catch): the owner gave up on this recording
+  while (!in_flight_.empty()) {
+    try {
+      WaitOldest();
+    } catch (...) {  // NOLINT(bugprone-empty-catch): the owner gave up on this recording
+    }
   }
 }
 
-void Writer::Wait() {
-  if (busy_.valid()) busy_.get();
+void Writer::WaitOldest() {
+  std::future<void> oldest = std::move(in_flight_.front());
+  in_flight_.pop_front();
+  oldest.get();
 }
 
 void Writer::Add(Frame frame) {
-  Wait();
-  pending_ = std::move(frame);
+  if (in_flight_.size() >= kFramesInFlight) WaitOldest();
   ++added_;
-  busy_ = std::async(std::launch::async, [this] { Write(pending_); });
+  // std::function needs a copyable callable: the frame travels in a shared_ptr.
+  auto owned = std::make_shared<const Frame>(std::move(frame));
+  in_flight_.push_back(worker_.Post([this, owned] { Write(*owned); }));
 }
 
 void Writer::Write(const Frame& f) {
@@ -177,8 +184,12 @@ void Writer::Write(const Frame& f) {
   index_.push_back(j.dump());
 }
 
+void Writer::Flush() {
+  while (!in_flight_.empty()) WaitOldest();
+}
+
 void Writer::Finish(const Header& final_header) {
-  Wait();
+  Flush();
   bin_.close();
   if (!bin_)
     throw std::runtime_error("cannot write " + (dir_ / "frames.bin").string() + ": " +

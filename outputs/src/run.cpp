@@ -61,14 +61,15 @@ namespace {
 struct RunObservers {
   RunObservers(cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
                const RunFolderOptions& o, std::vector<std::string>* warnings)
-      : trace_mode(TraceMode(cosim.mode_names())),
+      : worker(o.output_thread),
+        trace_mode(TraceMode(cosim.mode_names())),
         files(o.out, DetectionPath(o.out, o.detections), config.radar.options.multipath.enabled,
               trace_mode, config.evaluation.focus_object, ExactDetections(o.detections)),
-        pictures(o.out, SnapshotTimes(o.snapshots, config), o, warnings) {
+        pictures(o.out, SnapshotTimes(o.snapshots, config), o, warnings, worker) {
     cosim.AddObserver(&files);
     if (o.record) {
       recording.emplace(o.out, config, o.record_interval, o.record_particles,
-                        WordsFor(o.references).legend, warnings);
+                        WordsFor(o.references).legend, warnings, worker);
       cosim.AddObserver(&*recording);
     }
     if (o.check_invariants) {
@@ -83,6 +84,9 @@ struct RunObservers {
     return dual != modes.end() ? static_cast<std::size_t>(dual - modes.begin()) : modes.size() - 1;
   }
 
+  // First: destroyed last, after the observers whose jobs it may still run (an error ending the
+  // run early still finishes the pictures and frames handed over).
+  OutputWorker worker;
   std::size_t trace_mode;
   RunFilesObserver files;
   std::optional<RecordingObserver> recording;
@@ -313,6 +317,8 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   const nlohmann::json metrics_json = MetricsJson(cosim, config, metrics);
   r.table_markdown = WriteResults(cosim, config, o.out, recorded, metrics, metrics_json, r.status,
                                   observers.files.traces());
+  // The step pictures' warnings, then the recording's (as they came when drawn in line).
+  observers.pictures.Finish();
   // After the results, before the figures: a failure here costs only the replay.
   const bool recording = observers.recording &&
                          observers.recording->Finish(metrics_json["modes"], cosim.pipeline().ids(),

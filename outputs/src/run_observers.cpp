@@ -10,6 +10,8 @@
 #include "dualgrid/core/text.hpp"
 #include "dualgrid/outputs/figures.hpp"
 
+#include "pictures.hpp"
+
 namespace dualgrid::outputs {
 
 double ResidentMegabytes() {
@@ -54,13 +56,24 @@ void RunFilesObserver::Close() {
 RecordingObserver::RecordingObserver(const std::filesystem::path& out,
                                      const scenario::ScenarioConfig& config, double interval_s,
                                      int max_particles, std::string truth_label,
-                                     std::vector<std::string>* warnings)
+                                     std::vector<std::string>* warnings, OutputWorker& worker)
     : out_(out),
       every_(std::max(1, static_cast<int>(std::lround(interval_s / config.sim.step_length)))),
       step_count_(config.sim.StepCount()),
       max_particles_(max_particles),
       truth_label_(std::move(truth_label)),
-      warnings_(warnings) {}
+      warnings_(warnings),
+      worker_(worker) {}
+
+RecordingObserver::~RecordingObserver() {
+  if (!writer_) return;
+  // A run ended by an error before Finish: a frame that failed in the background is still said.
+  try {
+    writer_->Flush();
+  } catch (const std::exception& e) {
+    PublishWarning(std::string("replay recording stopped: ") + e.what(), warnings_);
+  }
+}
 
 // Every every_-th step, and the last one (a run shorter than the interval still has a frame).
 // Off for good once a recording write failed.
@@ -86,14 +99,13 @@ void RecordingObserver::OnStep(const cosim::StepView& v) {
       header_ = replay::MakeHeader(v.pipeline, v.mode_names,
                                    every_ * v.pipeline.config().sim.step_length, max_particles_);
       header_.truth_label = truth_label_;
-      writer_ = std::make_unique<replay::Writer>(out_ / "replay", header_);
+      writer_ = std::make_unique<replay::Writer>(out_ / "replay", header_, worker_);
     }
     writer_->Add(
         replay::Capture(v.pipeline, v.snapshots, v.scorers, counters_, live_, v.objects, header_));
     for (const auto& o : v.objects) ids_.insert(o.id);
   } catch (const std::exception& e) {
-    warnings_->push_back(std::string("replay recording stopped: ") + e.what());
-    std::cerr << "dualgrid: warning: " << warnings_->back() << "\n";
+    PublishWarning(std::string("replay recording stopped: ") + e.what(), warnings_);
     writer_.reset();
     failed_ = true;
   }
@@ -110,8 +122,7 @@ bool RecordingObserver::Finish(const nlohmann::json& metrics, const cosim::IdReg
     writer_->Finish(header_);
     return true;
   } catch (const std::exception& e) {
-    warnings_->push_back(std::string("replay recording not written: ") + e.what());
-    std::cerr << "dualgrid: warning: " << warnings_->back() << "\n";
+    PublishWarning(std::string("replay recording not written: ") + e.what(), warnings_);
     writer_.reset();
     return false;
   }
@@ -134,7 +145,7 @@ nlohmann::json InvariantObserver::Samples(double end_time) const {
 
 PictureObserver::PictureObserver(const std::filesystem::path& out, std::vector<double> times,
                                  const RunFolderOptions& options,
-                                 std::vector<std::string>* warnings)
+                                 std::vector<std::string>* warnings, OutputWorker& worker)
     : out_(out),
       times_(std::move(times)),
       figures_(options.figures),
@@ -142,7 +153,8 @@ PictureObserver::PictureObserver(const std::filesystem::path& out, std::vector<d
       formats_(options.figure_formats),
       captions_(options.figure_captions),
       words_(WordsFor(options.references)),
-      warnings_(warnings) {}
+      warnings_(warnings),
+      worker_(worker) {}
 
 bool PictureObserver::WantsVelocities(int, double time) {
   // Several requested times may fall into one step: one picture for all of them.
@@ -154,27 +166,79 @@ bool PictureObserver::WantsVelocities(int, double time) {
   return picture_ && (figures_ || particles_);
 }
 
+// One step's grid and scene pictures, taken on the stepping thread and drawn by the worker. What
+// could not be taken is drawn as a failure of every format, as drawing it in line would have.
+struct PictureJob {
+  std::filesystem::path grid_png, scene_png;
+  std::vector<std::string> formats;
+  std::optional<GridPicture> grid;
+  std::optional<ScenePicture> scene;
+  std::string grid_error, scene_error;
+  std::vector<std::string> failures;  // filled by Draw, read once its future is ready
+
+  void Draw() {
+    failures = DrawFigures(grid_png, formats, [&](const std::filesystem::path& p) {
+      if (!grid) throw std::runtime_error(grid_error);
+      viz::RenderGridPanels(grid->panels, p.string(), grid->options);
+    });
+    const auto scene_failures =
+        DrawFigures(scene_png, formats, [&](const std::filesystem::path& p) {
+          if (!scene) throw std::runtime_error(scene_error);
+          DrawScene(*scene, p);
+        });
+    failures.insert(failures.end(), scene_failures.begin(), scene_failures.end());
+  }
+};
+
 void PictureObserver::OnStep(const cosim::StepView& v) {
   if (!picture_) return;
+  // The previous picture's warnings now, at a point that does not depend on the worker's speed:
+  // the warnings' order is the same on one thread and on two.
+  Publish();
   const sim::Frame& f = v.frame;
   const std::string stamp = FormatFixed(f.time, 2);
   if (figures_) {
-    TryFigures(
-        out_ / "figures" / ("grid_t" + stamp + ".png"), formats_,
-        [&](const auto& p) {
-          RenderGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f, f.time,
-                           p, captions_, words_);
-        },
-        warnings_);
-    TryFigures(
-        out_ / "figures" / ("scene_t" + stamp + ".png"), formats_,
-        [&](const auto& p) { RenderScene(v.pipeline, p, 60, 140, 22, captions_, words_); },
-        warnings_);
+    auto job = std::make_shared<PictureJob>();
+    job->grid_png = out_ / "figures" / ("grid_t" + stamp + ".png");
+    job->scene_png = out_ / "figures" / ("scene_t" + stamp + ".png");
+    job->formats = formats_;
+    try {
+      job->grid = MakeGridFigure(v.mode_names, v.snapshots, v.scorers, v.pipeline.grid_frame(), f,
+                                 f.time, captions_, words_);
+    } catch (const std::exception& e) {
+      job->grid_error = e.what();
+    }
+    try {
+      job->scene = MakeScene(v.pipeline, 60, 140, 22, captions_, words_);
+    } catch (const std::exception& e) {
+      job->scene_error = e.what();
+    }
+    pending_.push_back({worker_.Post([job] { job->Draw(); }), job});
   }
   if (particles_)
     for (std::size_t m = 0; m < v.mode_names.size(); ++m)
       WriteParticles(v.pipeline, m, v.snapshots[m],
                      out_ / "figures" / ("particles_" + v.mode_names[m] + "_t" + stamp + ".csv"));
+}
+
+PictureObserver::~PictureObserver() {
+  // A run that ends by an error still reports its pictures' failures before that error, as
+  // drawing them in line did.
+  try {
+    Publish();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): the run's own error is on its way
+  }
+}
+
+void PictureObserver::Finish() { Publish(); }
+
+void PictureObserver::Publish() {
+  while (!pending_.empty()) {
+    auto& [done, job] = pending_.front();
+    done.get();  // DrawFigures catches what a figure throws; anything else is the run's error
+    for (const std::string& failure : job->failures) PublishWarning(failure, warnings_);
+    pending_.pop_front();
+  }
 }
 
 }  // namespace dualgrid::outputs

@@ -41,9 +41,10 @@ void RunToEnd(cosim::CoSimulation& cs, const fs::path& network_dir,
   work.Remove();
 }
 
-// The run folder `out`, as `dualgrid run` writes it with its default options.
+// The run folder `out`, as `dualgrid run` writes it with its default options (`threads` 1: the
+// outputs in line, as `--threads 1`).
 void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config,
-                 const fs::path& network_dir, const fs::path& out, bool force) {
+                 const fs::path& network_dir, const fs::path& out, bool force, int threads) {
   outputs::RunFolderOptions folder;
   folder.out = out;
   folder.force = force;
@@ -51,6 +52,7 @@ void RunToFolder(cosim::CoSimulation& cs, const scenario::ScenarioConfig& config
   folder.force_flag = "force=True";
   folder.network_dir = network_dir;
   folder.quiet = true;
+  folder.output_thread = threads != 1;
   py::gil_scoped_release release;
   outputs::WriteRunFolder(cs, config, folder);
 }
@@ -71,7 +73,7 @@ py::dict RunScenario(const fs::path& path, std::optional<Seed> seed, std::option
   cs.AddObserver(&clusters);
   const fs::path networks = NetworkDir(network_dir);
   if (out)
-    RunToFolder(cs, config, networks, *out, force);
+    RunToFolder(cs, config, networks, *out, force, threads);
   else
     RunToEnd(cs, networks, work_dir);
   return Results(cs, config, clusters);

@@ -203,6 +203,45 @@ TEST_CASE("A write past a file-size limit is an error naming the file", "[cli][n
   CHECK_FALSE(fs::exists(dir / "summary.json"));  // the run does not look finished
 }
 
+TEST_CASE("Outputs failing on the output worker say the same on one thread as on two",
+          "[cli][newcomer]") {
+  // 64 KiB per file (sh counts 512-byte blocks): the pictures and the recording's frames do not
+  // fit (warnings, exit 0); in the longer run ground_truth.csv does not either (an error, exit
+  // 1). With --threads 1 the
+  // recording and the pictures are written in line, with 2 by the output worker: the same lines
+  // in the same order, the same warnings in summary.json, and no summary.json after the error.
+  for (const int seconds : {2, 4}) {
+    std::string said[2];
+    std::string warnings[2];
+    for (const int threads : {1, 2}) {
+      const auto dir =
+          TempDir("worker_fails_" + std::to_string(seconds) + "_" + std::to_string(threads));
+      const Result r = Shell("ulimit -f 128; " + std::string(DUALGRID_EXE) +
+                             " run scenarios/simple_road.yaml --duration " +
+                             std::to_string(seconds) + " --snapshots 1,1.5 -q --threads " +
+                             std::to_string(threads) + " --out " + dir.string());
+      INFO(r.output);
+      CHECK(r.code == (seconds == 2 ? 0 : 1));
+      CHECK(r.output.find("dualgrid: warning: figure " +
+                          (dir / "figures" / "grid_t1.00.png").string() + " not drawn") !=
+            std::string::npos);
+      CHECK(r.output.find("dualgrid: warning: replay recording ") != std::string::npos);
+      said[threads - 1] = std::regex_replace(r.output, std::regex(dir.string()), "DIR");
+      if (seconds == 2) {
+        const auto listed = nlohmann::json::parse(Slurp(dir / "summary.json")).at("warnings");
+        CHECK(listed.size() >= 10);
+        warnings[threads - 1] = std::regex_replace(listed.dump(), std::regex(dir.string()), "DIR");
+      } else {
+        CHECK(r.output.find("dualgrid: error: cannot write " + (dir / "ground_truth.csv").string() +
+                            ": File too large") != std::string::npos);
+        CHECK_FALSE(fs::exists(dir / "summary.json"));
+      }
+    }
+    CHECK(said[0] == said[1]);
+    CHECK(warnings[0] == warnings[1]);
+  }
+}
+
 TEST_CASE("Every file a run and an experiment write is documented", "[cli][newcomer]") {
   const auto dir = TempDir("outputs");
   REQUIRE(Run("experiment scenarios/simple_road.yaml --seeds 1 --duration 2 --snapshots 1 "

@@ -1,17 +1,21 @@
-// The replay writer (outputs/recording.hpp) compresses and appends frames on a worker thread while
-// the run goes on: the frames read back in the order added and equal to what was added, and a
-// failed write still reaches the caller (from a later Add or from Finish), naming the file.
+// The replay writer (outputs/recording.hpp) compresses and appends frames on the run's output
+// worker while the run goes on: the frames read back in the order added and equal to what was
+// added, the same bytes with the worker on its own thread or in line, and a failed write still
+// reaches the caller (from a later Add or from Finish), naming the file.
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "dualgrid/outputs/recording.hpp"
 
 namespace fs = std::filesystem;
 using namespace dualgrid::outputs::replay;
+using dualgrid::outputs::OutputWorker;
 
 namespace {
 
@@ -69,11 +73,19 @@ fs::path FreshDir(const std::string& name) {
 
 }  // namespace
 
+std::string Bytes(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 TEST_CASE("the replay writer's frames read back in order, equal to those added", "[replay]") {
-  const fs::path run = FreshDir("order");
-  constexpr int kFrames = 7;
+  const bool threaded = GENERATE(true, false);
+  const fs::path run = FreshDir(threaded ? "order_thread" : "order_inline");
+  // More frames than may be in flight: Add waits for the oldest on the way.
+  constexpr int kFrames = 2 * static_cast<int>(Writer::kFramesInFlight) + 3;
   {
-    Writer w(run / "replay", TestHeader());
+    OutputWorker worker(threaded, 2);
+    Writer w(run / "replay", TestHeader(), worker);
     for (int k = 0; k < kFrames; ++k) {
       w.Add(TestFrame(k));
       CHECK(w.frames() == static_cast<std::size_t>(k + 1));
@@ -102,6 +114,21 @@ TEST_CASE("the replay writer's frames read back in order, equal to those added",
   fs::remove_all(run);
 }
 
+TEST_CASE("the replay writer writes the same bytes on the worker's thread as in line", "[replay]") {
+  const fs::path a = FreshDir("bytes_thread"), b = FreshDir("bytes_inline");
+  for (const bool threaded : {true, false}) {
+    OutputWorker worker(threaded);
+    Writer w((threaded ? a : b) / "replay", TestHeader(), worker);
+    for (int k = 0; k < 11; ++k) w.Add(TestFrame(k));
+    w.Finish(TestHeader());
+  }
+  CHECK(Bytes(a / "replay" / "frames.bin") == Bytes(b / "replay" / "frames.bin"));
+  CHECK(Bytes(a / "replay" / "index.json") == Bytes(b / "replay" / "index.json"));
+  CHECK_FALSE(Bytes(a / "replay" / "frames.bin").empty());
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
 TEST_CASE("a failed write of the recording reaches the caller, naming frames.bin", "[replay]") {
   REQUIRE(fs::exists("/dev/full"));  // Linux: every write to it fails with ENOSPC
   const fs::path run = FreshDir("full");
@@ -109,7 +136,8 @@ TEST_CASE("a failed write of the recording reaches the caller, naming frames.bin
   fs::create_symlink("/dev/full", run / "replay" / "frames.bin");
   std::string error;
   try {
-    Writer w(run / "replay", TestHeader());
+    OutputWorker worker(true);
+    Writer w(run / "replay", TestHeader(), worker);
     for (int k = 0; k < 3; ++k) w.Add(TestFrame(k));
     w.Finish(TestHeader());
   } catch (const std::runtime_error& e) {
@@ -117,5 +145,26 @@ TEST_CASE("a failed write of the recording reaches the caller, naming frames.bin
   }
   CHECK(error.find("frames.bin") != std::string::npos);
   CHECK_FALSE(fs::exists(run / "replay" / "index.json"));
+  fs::remove_all(run);
+}
+
+TEST_CASE("a failed frame's error comes from the Add that waits for it", "[replay]") {
+  REQUIRE(fs::exists("/dev/full"));
+  const bool threaded = GENERATE(true, false);
+  const fs::path run = FreshDir(threaded ? "late_thread" : "late_inline");
+  fs::create_directories(run / "replay");
+  fs::create_symlink("/dev/full", run / "replay" / "frames.bin");
+  OutputWorker worker(threaded);
+  Writer w(run / "replay", TestHeader(), worker);
+  // Frame 0 fails; Add waits for it once kFramesInFlight frames are in flight, on either thread.
+  std::size_t added = 0;
+  std::string error;
+  try {
+    for (; added < 3 * Writer::kFramesInFlight; ++added) w.Add(TestFrame(static_cast<int>(added)));
+  } catch (const std::runtime_error& e) {
+    error = e.what();
+  }
+  CHECK(added == Writer::kFramesInFlight);
+  CHECK(error.find("frames.bin") != std::string::npos);
   fs::remove_all(run);
 }

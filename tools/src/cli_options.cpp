@@ -15,6 +15,7 @@ outputs::RunFolderOptions FilterRunOptions::FolderOptions() const {
   f.force = run.force;
   f.network_dir = run.network_dir;
   f.quiet = run.quiet;
+  f.output_thread = threads != 1;  // one thread asked for: one core, outputs in line
   return f;
 }
 

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -20,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dualgrid/outputs/output_worker.hpp"
 #include "dualgrid/outputs/read_back.hpp"
 
 namespace dualgrid::outputs::replay {
@@ -113,18 +115,26 @@ struct Header {
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).
 double ParticleUnit(double extent_x, double extent_y);
 
-/// Writes a recording frame by frame. Add takes the frame over and returns at once: one worker
-/// thread at a time packs, compresses (zlib, the run's largest output cost) and appends it while
-/// the run goes on, in the order added, so the files are the same bytes as written in line. At
-/// most one frame waits (bounded memory). A failed write throws std::runtime_error naming the
-/// file, from the next Add or from Finish; the destructor waits for the worker and drops its error.
+/// Writes a recording frame by frame. Add takes the frame over and returns at once: `worker`
+/// packs, compresses (zlib, the run's largest output cost) and appends it while the run goes on,
+/// in the order added, so the files are the same bytes as written in line. At most
+/// kFramesInFlight frames wait or are being written (bounded memory): Add then waits for the
+/// oldest. A failed write throws std::runtime_error naming the file, from the Add that waits for
+/// that frame (the kFramesInFlight-th after it) or from Finish; the destructor waits for the
+/// frames in flight and drops their errors. `worker` must outlive the writer.
 class Writer {
  public:
-  Writer(const std::filesystem::path& dir, Header header);
+  /// Frames handed to the worker and not yet waited for: enough to ride out a picture the worker
+  /// draws in between (~0.1-0.2 s, while frames come every ~20 ms of a default run's wall time).
+  static constexpr std::size_t kFramesInFlight = 8;
+
+  Writer(const std::filesystem::path& dir, Header header, OutputWorker& worker);
   ~Writer();
   Writer(const Writer&) = delete;
   Writer& operator=(const Writer&) = delete;
   void Add(Frame frame);
+  /// Waits for every frame in flight; rethrows the first failure.
+  void Flush();
   /// Waits for the last frame, then writes index.json (header with `complete`, `status`,
   /// `metrics` and `names` as given now).
   void Finish(const Header& final_header);
@@ -132,24 +142,23 @@ class Writer {
   std::size_t frames() const { return added_; }
 
  private:
-  /// Packs, compresses and appends one frame and its index entry (on the worker thread).
+  /// Packs, compresses and appends one frame and its index entry (on the worker).
   void Write(const Frame& frame);
-  /// Waits for the frame in flight, if any; rethrows its error.
-  void Wait();
+  /// Waits for the oldest frame in flight; rethrows its error.
+  void WaitOldest();
 
   std::filesystem::path dir_;
   Header header_;
+  OutputWorker& worker_;
   std::ofstream bin_;
   std::uint64_t offset_ = 0;
   std::size_t added_ = 0;
   /// Each frame's index entry, already serialised: a JSON tree of a long run's detections would
   /// take ~6x the memory of its text.
   std::vector<std::string> index_;
+  /// Only the worker's jobs touch the members above (from bin_ on) while frames are in flight.
   std::vector<std::uint8_t> raw_, packed_;
-  /// The frame in flight and its worker's result; only the worker touches the members above
-  /// while it is valid.
-  Frame pending_;
-  std::future<void> busy_;
+  std::deque<std::future<void>> in_flight_;  // oldest first
 };
 
 /// A finished recording, read back through the checked reader (read_back.hpp). The constructor

@@ -60,6 +60,10 @@ struct RunFolderOptions {
   bool video = false;
   bool viewer = false;
   bool quiet = false;  ///< no table on stdout, no notes on stderr (warnings are still printed)
+  /// The recording's compression and the step pictures' drawing on one background thread
+  /// (OutputWorker), beside the co-simulation's step; false: in line on the calling thread (a run
+  /// given one thread, `--threads 1`, stays on one core). The files are the same bytes either way.
+  bool output_thread = true;
 
   /// Throws std::invalid_argument naming the option of the first bad field.
   void Validate() const;

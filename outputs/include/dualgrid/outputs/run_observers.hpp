@@ -3,7 +3,9 @@
 // files; WriteRunFolder (run.hpp) wires them to the CoSimulation.
 #pragma once
 
+#include <deque>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <set>
 #include <string>
@@ -15,6 +17,7 @@
 #include "dualgrid/outputs/capture.hpp"
 #include "dualgrid/outputs/csv_writers.hpp"
 #include "dualgrid/outputs/figures.hpp"
+#include "dualgrid/outputs/output_worker.hpp"
 #include "dualgrid/outputs/recording.hpp"
 #include "dualgrid/outputs/run.hpp"
 #include "dualgrid/outputs/weight_traces.hpp"
@@ -47,13 +50,19 @@ class RunFilesObserver : public cosim::StepObserver {
 };
 
 /// The replay recording (RUN_DIR/replay/, docs/replay.md): a frame every `interval` steps and at
-/// the last one. A failed write stops the recording with a warning, never the run.
+/// the last one, taken here and compressed and appended by `worker` (replay::Writer). A failed
+/// write stops the recording with a warning, never the run.
 class RecordingObserver : public cosim::StepObserver {
  public:
   /// `truth_label`: what the reference boxes are called (replay::Header::truth_label).
   RecordingObserver(const std::filesystem::path& out, const scenario::ScenarioConfig& config,
                     double interval_s, int max_particles, std::string truth_label,
-                    std::vector<std::string>* warnings);
+                    std::vector<std::string>* warnings, OutputWorker& worker);
+  /// Without Finish (a run ended by an error): waits for the frames in flight and warns if one
+  /// failed.
+  ~RecordingObserver() override;
+  RecordingObserver(const RecordingObserver&) = delete;
+  RecordingObserver& operator=(const RecordingObserver&) = delete;
   bool WantsVelocities(int step, double time) override;
   void OnStep(const cosim::StepView& v) override;
   /// Writes the index (the recording is usable only then); a failure costs only the replay.
@@ -70,6 +79,7 @@ class RecordingObserver : public cosim::StepObserver {
   int max_particles_ = 0;
   std::string truth_label_;
   std::vector<std::string>* warnings_;
+  OutputWorker& worker_;
   std::unique_ptr<replay::Writer> writer_;
   bool failed_ = false;
   replay::Header header_;
@@ -92,16 +102,30 @@ class InvariantObserver : public cosim::StepObserver {
   nlohmann::json rss_mb_ = nlohmann::json::array();
 };
 
+struct PictureJob;  // run_observers.cpp
+
 /// The grid and scene pictures (and with --write-particles the particle files) at the picture
-/// times. Figures never cost the run: a failure is a warning.
+/// times. What a picture shows is taken in OnStep; `worker` draws and encodes it. Figures never
+/// cost the run: a failure is a warning, printed and appended to `warnings` on the calling thread
+/// at the next picture step or at Finish (or by the destructor), in the order of the pictures.
 class PictureObserver : public cosim::StepObserver {
  public:
   PictureObserver(const std::filesystem::path& out, std::vector<double> times,
-                  const RunFolderOptions& options, std::vector<std::string>* warnings);
+                  const RunFolderOptions& options, std::vector<std::string>* warnings,
+                  OutputWorker& worker);
+  /// Publishes what Finish would have (a run ended by an error).
+  ~PictureObserver() override;
+  PictureObserver(const PictureObserver&) = delete;
+  PictureObserver& operator=(const PictureObserver&) = delete;
   bool WantsVelocities(int step, double time) override;
   void OnStep(const cosim::StepView& v) override;
+  /// Waits for the pictures handed to the worker and publishes their warnings.
+  void Finish();
 
  private:
+  /// Waits for the pictures handed to the worker and publishes their warnings, in order.
+  void Publish();
+
   std::filesystem::path out_;
   std::vector<double> times_;
   std::size_t next_ = 0;
@@ -111,6 +135,9 @@ class PictureObserver : public cosim::StepObserver {
   bool captions_;
   ReferenceWords words_;
   std::vector<std::string>* warnings_;
+  OutputWorker& worker_;
+  /// Pictures handed to the worker, oldest first, with their job (its failures once done).
+  std::deque<std::pair<std::future<void>, std::shared_ptr<PictureJob>>> pending_;
 };
 
 /// Resident memory of this process [MB] (/proc/self/statm), 0 if unreadable.
