@@ -124,15 +124,35 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
   // Counted into a table of this frame first, so that a refused frame leaves nothing counted.
+  // Four tables, cell i into table i % 4: a run of cells of one class (most of a grid) would
+  // otherwise wait on each increment of one counter before the next. Integer sums: the same
+  // counts in any order. Classes are checked after the loop (an out-of-range class of a counted
+  // cell marks `bad`; the loop then names the first such cell).
+  std::array<std::array<std::int64_t, 16>, 4> tables{};
+  const std::size_t n = truth.size();
+  const bool all = observed.empty();
+  bool bad = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const unsigned t = truth[i], p = predicted[i];
+    const bool counted = all || observed[i] != 0;
+    bad |= counted && (t >= kNumTruthClasses || p >= kNumPredictedClasses);
+    tables[i & 3][((t & 3) << 2) | (p & 3)] += counted;
+  }
+  if (bad) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!all && observed[i] == 0) continue;
+      if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
+        throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
+                                    std::to_string(i) + " has class out of range");
+    }
+  }
   std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses> frame{};
   std::int64_t cells = 0;
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    if (!observed.empty() && observed[i] == 0) continue;
-    if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
-      throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
-                                  std::to_string(i) + " has class out of range");
-    ++frame[truth[i]][predicted[i]];
-    ++cells;
+  for (int t = 0; t < kNumTruthClasses; ++t) {
+    for (int p = 0; p < kNumPredictedClasses; ++p) {
+      for (const auto& table : tables) frame[t][p] += table[(t << 2) | p];
+      cells += frame[t][p];
+    }
   }
   for (int t = 0; t < kNumTruthClasses; ++t)
     for (int p = 0; p < kNumPredictedClasses; ++p) m_.confusion[t][p] += frame[t][p];

@@ -18,6 +18,16 @@ std::uint64_t PackKey(std::int64_t ix, std::int64_t iy) {
          static_cast<std::uint32_t>(iy);
 }
 
+// static_cast<std::int64_t>(std::floor(v)), the same value, without the libm call that baseline
+// x86-64 (no rounding instruction) makes of std::floor (4 per point showed in the profiles):
+// truncation towards zero, minus one where that rounded a negative non-integer up. Exact for
+// |v| < 2^62 (the truncation and its conversion back are exact there); beyond, std::floor.
+std::int64_t FloorToInt(double v) {
+  if (!(std::abs(v) < 0x1p62)) return static_cast<std::int64_t>(std::floor(v));
+  const auto t = static_cast<std::int64_t>(v);
+  return t - static_cast<std::int64_t>(static_cast<double>(t) > v);
+}
+
 // Strict order used to break distance ties between core points: lexicographic (x, y).
 bool LexLess(const Position& a, const Position& b) {
   return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
@@ -135,8 +145,8 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   fy_.resize(m);
   fine_cell_.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
-    fx_[k] = static_cast<std::int64_t>(std::floor(points[core_ids_[k]].x() * inv_h));
-    fy_[k] = static_cast<std::int64_t>(std::floor(points[core_ids_[k]].y() * inv_h));
+    fx_[k] = FloorToInt(points[core_ids_[k]].x() * inv_h);
+    fy_[k] = FloorToInt(points[core_ids_[k]].y() * inv_h);
   }
   const int cells = fine_.Build(fx_, fy_, 2, fine_cell_);
   fine_start_.assign(cells + 1, 0);
@@ -203,8 +213,8 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
   iy_.resize(n);
   bucket_.resize(n);
   for (int i = 0; i < n; ++i) {
-    ix_[i] = static_cast<std::int64_t>(std::floor(points[i].x() * inv_eps_));
-    iy_[i] = static_cast<std::int64_t>(std::floor(points[i].y() * inv_eps_));
+    ix_[i] = FloorToInt(points[i].x() * inv_eps_);
+    iy_[i] = FloorToInt(points[i].y() * inv_eps_);
   }
   const int num_buckets = buckets_.Build(ix_, iy_, 1, bucket_);
   start_.assign(num_buckets + 1, 0);
