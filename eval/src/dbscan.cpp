@@ -131,53 +131,65 @@ int Dbscan::FindRoot(int c) {
   return c;
 }
 
-int Dbscan::CoreComponents(std::span<const Position> points) {
+double Dbscan::InvFineSide() const {
   // Side h < eps / sqrt(2) with a relative margin far above rounding: two points of one cell are
   // closer than eps * (1 - 1e-9), so squaredNorm() <= eps^2 holds for them whatever the rounding.
-  // Cells up to two apart (5 x 5 block) can hold neighbours: 2 h < eps < 3 h.
-  const double inv_h = std::sqrt(2.0) / (params_.eps * (1.0 - 1e-9));
-  const double eps2 = params_.eps * params_.eps;
-  core_ids_.clear();
-  for (int i = 0; i < static_cast<int>(points.size()); ++i)
-    if (core_[i]) core_ids_.push_back(i);
-  const std::size_t m = core_ids_.size();
-  fx_.resize(m);
-  fy_.resize(m);
-  fine_cell_.resize(m);
-  for (std::size_t k = 0; k < m; ++k) {
-    fx_[k] = FloorToInt(points[core_ids_[k]].x() * inv_h);
-    fy_[k] = FloorToInt(points[core_ids_[k]].y() * inv_h);
+  return std::sqrt(2.0) / (params_.eps * (1.0 - 1e-9));
+}
+
+void Dbscan::FineCells(std::span<const Position> points) {
+  const double inv_h = InvFineSide();
+  const std::size_t n = points.size();
+  fx_.resize(n);
+  fy_.resize(n);
+  fine_cell_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    fx_[i] = FloorToInt(points[i].x() * inv_h);
+    fy_[i] = FloorToInt(points[i].y() * inv_h);
   }
   const int cells = fine_.Build(fx_, fy_, 2, fine_cell_);
   fine_start_.assign(cells + 1, 0);
-  for (std::size_t k = 0; k < m; ++k) ++fine_start_[fine_cell_[k] + 1];
+  for (std::size_t i = 0; i < n; ++i) ++fine_start_[fine_cell_[i] + 1];
   for (int c = 0; c < cells; ++c) fine_start_[c + 1] += fine_start_[c];
-  fine_sorted_.resize(m);
+  fine_sorted_.resize(n);
   parent_.assign(fine_start_.begin(), fine_start_.end() - 1);  // borrowed as the cursor
-  for (std::size_t k = 0; k < m; ++k) fine_sorted_[parent_[fine_cell_[k]]++] = core_ids_[k];
-  // Cell coordinates per cell id (the first member's).
-  std::vector<int>& first = root_component_;
-  first.assign(cells, -1);
-  for (std::size_t k = 0; k < m; ++k)
-    if (first[fine_cell_[k]] < 0) first[fine_cell_[k]] = static_cast<int>(k);
+  for (std::size_t i = 0; i < n; ++i) fine_sorted_[parent_[fine_cell_[i]]++] = static_cast<int>(i);
+}
+
+int Dbscan::CoreComponents(std::span<const Position> points) {
+  // Cells up to two apart (5 x 5 block) can hold neighbours: 2 h < eps < 3 h.
+  const double eps2 = params_.eps * params_.eps;
+  const int cells = static_cast<int>(fine_start_.size()) - 1;
+  // Each cell's core points, in input order (a stable filter of fine_sorted_).
+  core_start_.resize(cells + 1);
+  core_sorted_.clear();
+  for (int c = 0; c < cells; ++c) {
+    core_start_[c] = static_cast<int>(core_sorted_.size());
+    for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k)
+      if (core_[fine_sorted_[k]]) core_sorted_.push_back(fine_sorted_[k]);
+  }
+  core_start_[cells] = static_cast<int>(core_sorted_.size());
   parent_.resize(cells);
   for (int c = 0; c < cells; ++c) parent_[c] = c;
   auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
-    for (int s = fine_start_[a]; s < fine_start_[a + 1]; ++s)
-      for (int t = fine_start_[b]; t < fine_start_[b + 1]; ++t)
-        if ((points[fine_sorted_[s]] - points[fine_sorted_[t]]).squaredNorm() <= eps2) return true;
+    for (int s = core_start_[a]; s < core_start_[a + 1]; ++s)
+      for (int t = core_start_[b]; t < core_start_[b + 1]; ++t)
+        if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
     return false;
   };
   // Adjacent cells first (they almost always link), then the ring two cells away, which is then
-  // mostly joined already and skipped without a pair search.
+  // mostly joined already and skipped without a pair search. Cells without core points take no
+  // part (they stay their own roots and get no component).
   for (const int ring : {1, 2}) {
     for (int a = 0; a < cells; ++a) {
-      const std::int64_t x = fx_[first[a]], y = fy_[first[a]];
+      if (core_start_[a] == core_start_[a + 1]) continue;
+      const int member = fine_sorted_[fine_start_[a]];  // all members share the coordinates
+      const std::int64_t x = fx_[member], y = fy_[member];
       for (std::int64_t dx = -ring; dx <= ring; ++dx) {
         for (std::int64_t dy = -ring; dy <= ring; ++dy) {
           if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
           const int b = fine_.Find(x + dx, y + dy);
-          if (b <= a) continue;  // each pair once
+          if (b <= a || core_start_[b] == core_start_[b + 1]) continue;  // each pair once
           const int ra = FindRoot(a), rb = FindRoot(b);
           if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
         }
@@ -186,14 +198,14 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   }
   // Compact component ids in cell order.
   int num_components = 0;
-  std::vector<int>& id_of_root = first;  // reused: first[] is no longer needed
+  std::vector<int>& id_of_root = root_component_;
   id_of_root.assign(cells, -1);
   for (int c = 0; c < cells; ++c) {
+    if (core_start_[c] == core_start_[c + 1]) continue;
     const int r = FindRoot(c);
     if (id_of_root[r] < 0) id_of_root[r] = num_components++;
   }
-  for (std::size_t k = 0; k < m; ++k)
-    component_[core_ids_[k]] = id_of_root[FindRoot(fine_cell_[k])];
+  for (const int i : core_sorted_) component_[i] = id_of_root[FindRoot(fine_cell_[i])];
   return num_components;
 }
 
@@ -237,14 +249,25 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
   }
   NearBuckets(num_buckets);
 
-  // Core points, bucket by bucket (a bucket's members share their neighbour buckets).
-  // Independent per point, so parallel; stops counting once both criteria hold.
+  // The fine grid of every point (for the components below). Without the weighted criterion, a
+  // fine cell holding min_points points makes them all core: they are within eps of each other
+  // (Gunawan's rule), so the count below would reach min_points for each of them too.
+  FineCells(points);
   core_.assign(n, 0);
+  if (!use_weights) {
+    for (std::size_t c = 0; c + 1 < fine_start_.size(); ++c)
+      if (fine_start_[c + 1] - fine_start_[c] >= params_.min_points)
+        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) core_[fine_sorted_[k]] = 1;
+  }
+
+  // The other core points, bucket by bucket (a bucket's members share their neighbour buckets).
+  // Independent per point, so parallel; stops counting once both criteria hold.
   ParallelFor(
       num_buckets, Schedule::kDynamic,
       [&](std::int64_t b64) {
         const int b = static_cast<int>(b64);
         for (int s = start_[b]; s < start_[b + 1]; ++s) {
+          if (core_[sorted_[s]]) continue;
           int count = 0;
           double weight = 0.0;
           ForEachNeighbour(b, s, [&](int t) {

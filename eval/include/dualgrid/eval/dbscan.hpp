@@ -92,7 +92,13 @@ class Dbscan {
     int Find(std::int64_t x, std::int64_t y) const;
   };
 
-  // Core-point components on the fine grid; fills component_ for core points, returns the count.
+  // 1 / h, the fine grid's inverse cell side [1/m] (h < eps / sqrt(2)).
+  double InvFineSide() const;
+  // The fine grid of all points: fx_, fy_, fine_cell_ per point; cell c holds the points
+  // fine_sorted_[fine_start_[c] .. fine_start_[c + 1]) in input order.
+  void FineCells(std::span<const Position> points);
+  // Core-point components on the fine grid (after FineCells and the core flags); fills
+  // component_ for core points, returns the count.
   int CoreComponents(std::span<const Position> points);
   int FindRoot(int c);
 
@@ -105,11 +111,12 @@ class Dbscan {
   std::vector<double> sorted_weight_;  // weights[sorted_[s]] when weighted
   std::vector<int> near_;
   std::vector<std::uint8_t> core_;
-  // Fine grid of the core points: cell c holds fine_sorted_[fine_start_[c] .. fine_start_[c + 1]).
+  // Fine grid of all points (FineCells); its core points per cell: core_sorted_[core_start_[c] ..
+  // core_start_[c + 1]).
   CellTable fine_;
-  std::vector<int> core_ids_;
   std::vector<std::int64_t> fx_, fy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
+  std::vector<int> core_start_, core_sorted_;
   std::vector<int> component_;
   std::vector<int> labels_;
   std::vector<int> relabel_;
