@@ -209,18 +209,54 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   return num_components;
 }
 
-std::span<const int> Dbscan::Run(std::span<const Position> points,
-                                 std::span<const double> weights) {
-  const int n = static_cast<int>(points.size());
-  if (!weights.empty() && weights.size() != points.size())
-    throw std::invalid_argument("Dbscan::Run: " + std::to_string(weights.size()) + " weights for " +
-                                std::to_string(points.size()) + " points");
-  for (int i = 0; i < n; ++i) {
-    if (!points[i].allFinite())
-      throw std::invalid_argument("Dbscan::Run: point " + std::to_string(i) + " is not finite");
+template <typename F>
+void Dbscan::ForEachFineNeighbour(std::span<const Position> points, int c, int i, F&& f) const {
+  const double eps2 = params_.eps * params_.eps;
+  const Position p = points[i];
+  const std::int64_t x = fx_[i], y = fy_[i];
+  for (std::int64_t dx = -2; dx <= 2; ++dx) {
+    for (std::int64_t dy = -2; dy <= 2; ++dy) {
+      const int b = dx == 0 && dy == 0 ? c : fine_.Find(x + dx, y + dy);
+      if (b < 0) continue;
+      for (int k = fine_start_[b]; k < fine_start_[b + 1]; ++k) {
+        const int j = fine_sorted_[k];
+        if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return;
+      }
+    }
   }
+}
 
-  // Spatial index with cell size eps: every neighbour lies in the 3x3 block around a point's cell.
+void Dbscan::CountCore(std::span<const Position> points) {
+  // A fine cell holding min_points points makes them all core: they are within eps of each other
+  // (Gunawan's rule). The points of the other cells count their neighbours until min_points.
+  const int cells = static_cast<int>(fine_start_.size()) - 1;
+  ParallelFor(
+      cells, Schedule::kDynamic,
+      [&](std::int64_t c64) {
+        const int c = static_cast<int>(c64);
+        const bool dense = fine_start_[c + 1] - fine_start_[c] >= params_.min_points;
+        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
+          const int i = fine_sorted_[k];
+          if (dense) {
+            core_[i] = 1;
+            continue;
+          }
+          int count = 0;
+          ForEachFineNeighbour(points, c, i, [&](int) {
+            if (++count < params_.min_points) return true;
+            core_[i] = 1;
+            return false;
+          });
+        }
+      },
+      /*worth=*/true, /*chunk=*/8);
+}
+
+void Dbscan::WeightedCore(std::span<const Position> points, std::span<const double> weights) {
+  const int n = static_cast<int>(points.size());
+  // Index cells of side eps: every neighbour lies in the 3 x 3 block around a point's cell. The
+  // neighbours are visited in a fixed order (own cell first, then NearBuckets' order, input order
+  // within a cell) and the weights summed in it, so that the sum is the same on every run.
   ix_.resize(n);
   iy_.resize(n);
   bucket_.resize(n);
@@ -233,79 +269,84 @@ std::span<const int> Dbscan::Run(std::span<const Position> points,
   for (int i = 0; i < n; ++i) ++start_[bucket_[i] + 1];
   for (int b = 0; b < num_buckets; ++b) start_[b + 1] += start_[b];
   sorted_.resize(n);
-  {
-    // Counting sort keeps input order inside each bucket; component_ is borrowed as the cursor.
-    component_.assign(start_.begin(), start_.end() - 1);
-    for (int i = 0; i < n; ++i) sorted_[component_[bucket_[i]]++] = i;
-  }
-
-  // Positions (and weights) in bucket order: the neighbour scans below read them contiguously.
-  const bool use_weights = !weights.empty() && params_.min_weight > 0.0;
+  // Counting sort keeps input order inside each bucket; component_ is borrowed as the cursor.
+  component_.assign(start_.begin(), start_.end() - 1);
+  for (int i = 0; i < n; ++i) sorted_[component_[bucket_[i]]++] = i;
+  // Positions and weights in bucket order: the neighbour scans below read them contiguously.
   sorted_pos_.resize(n);
-  sorted_weight_.resize(use_weights ? n : 0);
+  sorted_weight_.resize(n);
   for (int s = 0; s < n; ++s) {
     sorted_pos_[s] = points[sorted_[s]];
-    if (use_weights) sorted_weight_[s] = weights[sorted_[s]];
+    sorted_weight_[s] = weights[sorted_[s]];
   }
   NearBuckets(num_buckets);
-
-  // The fine grid of every point (for the components below). Without the weighted criterion, a
-  // fine cell holding min_points points makes them all core: they are within eps of each other
-  // (Gunawan's rule), so the count below would reach min_points for each of them too.
-  FineCells(points);
-  core_.assign(n, 0);
-  if (!use_weights) {
-    for (std::size_t c = 0; c + 1 < fine_start_.size(); ++c)
-      if (fine_start_[c + 1] - fine_start_[c] >= params_.min_points)
-        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) core_[fine_sorted_[k]] = 1;
-  }
-
-  // The other core points, bucket by bucket (a bucket's members share their neighbour buckets).
-  // Independent per point, so parallel; stops counting once both criteria hold.
+  // Bucket by bucket (a bucket's members share their neighbour buckets). Independent per point,
+  // so parallel; stops counting once both criteria hold.
   ParallelFor(
       num_buckets, Schedule::kDynamic,
       [&](std::int64_t b64) {
         const int b = static_cast<int>(b64);
         for (int s = start_[b]; s < start_[b + 1]; ++s) {
-          if (core_[sorted_[s]]) continue;
           int count = 0;
           double weight = 0.0;
           ForEachNeighbour(b, s, [&](int t) {
             ++count;
-            if (use_weights) weight += sorted_weight_[t];
-            const bool done =
-                count >= params_.min_points && (!use_weights || weight >= params_.min_weight);
+            weight += sorted_weight_[t];
+            const bool done = count >= params_.min_points && weight >= params_.min_weight;
             if (done) core_[sorted_[s]] = 1;
             return !done;
           });
         }
       },
       /*worth=*/true, /*chunk=*/8);
+}
+
+std::span<const int> Dbscan::Run(std::span<const Position> points,
+                                 std::span<const double> weights) {
+  const int n = static_cast<int>(points.size());
+  if (!weights.empty() && weights.size() != points.size())
+    throw std::invalid_argument("Dbscan::Run: " + std::to_string(weights.size()) + " weights for " +
+                                std::to_string(points.size()) + " points");
+  for (int i = 0; i < n; ++i) {
+    if (!points[i].allFinite())
+      throw std::invalid_argument("Dbscan::Run: point " + std::to_string(i) + " is not finite");
+  }
+
+  // The fine grid of every point: the core test of sparse cells, the components and the borders.
+  FineCells(points);
+  core_.assign(n, 0);
+  const bool use_weights = !weights.empty() && params_.min_weight > 0.0;
+  if (use_weights)
+    WeightedCore(points, weights);
+  else
+    CountCore(points);
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);
   const int num_components = CoreComponents(points);
 
   // Border points join their nearest core neighbour's cluster (see class comment for ties).
+  const int cells = static_cast<int>(fine_start_.size()) - 1;
   ParallelFor(
-      num_buckets, Schedule::kDynamic,
-      [&](std::int64_t b64) {
-        const int b = static_cast<int>(b64);
-        for (int s = start_[b]; s < start_[b + 1]; ++s) {
-          const int i = sorted_[s];
+      cells, Schedule::kDynamic,
+      [&](std::int64_t c64) {
+        const int c = static_cast<int>(c64);
+        if (core_start_[c + 1] - core_start_[c] == fine_start_[c + 1] - fine_start_[c]) return;
+        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
+          const int i = fine_sorted_[k];
           if (core_[i]) continue;
           double best_d2 = std::numeric_limits<double>::infinity();
-          int best = -1;  // a position in sorted order
-          ForEachNeighbour(b, s, [&](int t) {
-            if (!core_[sorted_[t]]) return true;
-            const double d2 = (sorted_pos_[t] - sorted_pos_[s]).squaredNorm();
-            if (d2 < best_d2 || (d2 == best_d2 && LexLess(sorted_pos_[t], sorted_pos_[best]))) {
+          int best = -1;  // an input index
+          ForEachFineNeighbour(points, c, i, [&](int j) {
+            if (!core_[j]) return true;
+            const double d2 = (points[j] - points[i]).squaredNorm();
+            if (d2 < best_d2 || (d2 == best_d2 && LexLess(points[j], points[best]))) {
               best_d2 = d2;
-              best = t;
+              best = j;
             }
             return true;
           });
-          component_[i] = best < 0 ? kNoise : component_[sorted_[best]];
+          component_[i] = best < 0 ? kNoise : component_[best];
         }
       },
       /*worth=*/true, /*chunk=*/8);
