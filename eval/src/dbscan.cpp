@@ -89,7 +89,9 @@ int Dbscan::CellTable::Build(std::span<const std::int64_t> ix, std::span<const s
   return count;
 }
 
-int Dbscan::CellTable::Find(std::int64_t x, std::int64_t y) const {
+// Inline (here, their only user): the component search calls Find and FindRoot for every pair
+// of nearby fine cells.
+[[gnu::always_inline]] inline int Dbscan::CellTable::Find(std::int64_t x, std::int64_t y) const {
   if (dense) return cells[static_cast<std::size_t>((y - y0) * w + (x - x0))];
   const auto it = map.find(PackKey(x, y));
   return it == map.end() ? -1 : it->second;
@@ -123,7 +125,7 @@ void Dbscan::ForEachNeighbour(int b, int s, F&& f) const {
       if ((sorted_pos_[t] - p).squaredNorm() <= eps2 && !f(t)) return;
 }
 
-int Dbscan::FindRoot(int c) {
+[[gnu::always_inline]] inline int Dbscan::FindRoot(int c) {
   while (parent_[c] != c) {
     parent_[c] = parent_[parent_[c]];  // path halving
     c = parent_[c];
