@@ -65,22 +65,20 @@ bool NearGrid(const OrientedBox& b, const Position& lo, const Position& hi) {
 CellWindow CellWindow::Around(const OrientedBox& box, const filter::DynamicGrid& grid) {
   // The box's bounding rectangle in cells, widened by one cell on each side: a particle lies in
   // its cell up to float rounding (micrometres), far less than the cell of margin.
-  double lo_x = box.center.x(), hi_x = lo_x, lo_y = box.center.y(), hi_y = lo_y;
+  Position lo = box.center, hi = box.center;
   for (const Position& c : box.Corners()) {
-    lo_x = std::min(lo_x, c.x());
-    hi_x = std::max(hi_x, c.x());
-    lo_y = std::min(lo_y, c.y());
-    hi_y = std::max(hi_y, c.y());
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
   }
   const double r = grid.resolution();
   const Position c0 = grid.CellCenter({0, 0});  // cell (x, y) spans c0 + (x, y) r +- r / 2
   const auto index = [&](double v, double c) { return std::floor((v - c) / r + 0.5); };
   CellWindow w;
-  if (!std::isfinite(lo_x + hi_x + lo_y + hi_y)) return w;  // an empty window
-  w.x0 = index(lo_x, c0.x()) - 1.0;
-  w.x1 = index(hi_x, c0.x()) + 1.0;
-  w.y0 = index(lo_y, c0.y()) - 1.0;
-  w.y1 = index(hi_y, c0.y()) + 1.0;
+  if (!lo.allFinite() || !hi.allFinite()) return w;  // an empty window
+  w.x0 = index(lo.x(), c0.x()) - 1.0;
+  w.x1 = index(hi.x(), c0.x()) + 1.0;
+  w.y0 = index(lo.y(), c0.y()) - 1.0;
+  w.y1 = index(hi.y(), c0.y()) + 1.0;
   return w;
 }
 

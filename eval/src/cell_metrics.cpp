@@ -124,19 +124,35 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
   // Counted into a table of this frame first, so that a refused frame leaves nothing counted.
-  // Four tables, cell i into table i % 4: a run of cells of one class (most of a grid) would
-  // otherwise wait on each increment of one counter before the next. Integer sums: the same
-  // counts in any order. Classes are checked after the loop (an out-of-range class of a counted
-  // cell marks `bad`; the loop then names the first such cell).
-  std::array<std::array<std::int64_t, 16>, 4> tables{};
+  // Chunk by chunk: each counted cell's pair as one byte truth * 4 + predicted (kNotCounted for
+  // the others), then each pair's count as a sum of comparisons: byte loops the compiler
+  // vectorises (every cell of every mode is counted in each step). Integer counts: the same in
+  // any order. A class out of range in a counted cell marks `bad`; a second loop then names the
+  // first such cell.
+  constexpr std::uint8_t kNotCounted = 0xff;
+  constexpr std::size_t kChunk = 4096;
+  std::array<std::uint8_t, kChunk> pairs;
+  std::array<std::int64_t, kNumTruthClasses * 4> counts{};
   const std::size_t n = truth.size();
   const bool all = observed.empty();
-  bool bad = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    const unsigned t = truth[i], p = predicted[i];
-    const bool counted = all || observed[i] != 0;
-    bad |= counted && (t >= kNumTruthClasses || p >= kNumPredictedClasses);
-    tables[i & 3][((t & 3) << 2) | (p & 3)] += counted;
+  unsigned bad = 0;
+  for (std::size_t begin = 0; begin < n; begin += kChunk) {
+    const std::size_t m = std::min(kChunk, n - begin);
+    const std::uint8_t* t = truth.data() + begin;
+    const std::uint8_t* p = predicted.data() + begin;
+    for (std::size_t j = 0; j < m; ++j) {
+      const unsigned counted = all ? 1u : static_cast<unsigned>(observed[begin + j] != 0);
+      bad |=
+          counted & static_cast<unsigned>(t[j] >= kNumTruthClasses || p[j] >= kNumPredictedClasses);
+      pairs[j] = counted ? static_cast<std::uint8_t>(((t[j] & 3) << 2) | (p[j] & 3)) : kNotCounted;
+    }
+    for (int k = 0; k < kNumTruthClasses * 4; ++k) {
+      for (std::size_t j0 = 0; j0 < m; j0 += 255) {
+        std::uint8_t c = 0;  // at most 255 matches: byte sums, 16 cells per instruction
+        for (std::size_t j = j0; j < std::min(m, j0 + 255); ++j) c += pairs[j] == k;
+        counts[k] += c;
+      }
+    }
   }
   if (bad) {
     for (std::size_t i = 0; i < n; ++i) {
@@ -150,7 +166,7 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
   std::int64_t cells = 0;
   for (int t = 0; t < kNumTruthClasses; ++t) {
     for (int p = 0; p < kNumPredictedClasses; ++p) {
-      for (const auto& table : tables) frame[t][p] += table[(t << 2) | p];
+      frame[t][p] = counts[(t << 2) | p];
       cells += frame[t][p];
     }
   }
