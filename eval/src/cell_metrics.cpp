@@ -124,51 +124,15 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
   // Counted into a table of this frame first, so that a refused frame leaves nothing counted.
-  // Chunk by chunk: each counted cell's pair as one byte truth * 4 + predicted (kNotCounted for
-  // the others), then each pair's count as a sum of comparisons: byte loops the compiler
-  // vectorises (every cell of every mode is counted in each step). Integer counts: the same in
-  // any order. A class out of range in a counted cell marks `bad`; a second loop then names the
-  // first such cell.
-  constexpr std::uint8_t kNotCounted = 0xff;
-  constexpr std::size_t kChunk = 4096;
-  std::array<std::uint8_t, kChunk> pairs;
-  std::array<std::int64_t, kNumTruthClasses * 4> counts{};
-  const std::size_t n = truth.size();
-  const bool all = observed.empty();
-  unsigned bad = 0;
-  for (std::size_t begin = 0; begin < n; begin += kChunk) {
-    const std::size_t m = std::min(kChunk, n - begin);
-    const std::uint8_t* t = truth.data() + begin;
-    const std::uint8_t* p = predicted.data() + begin;
-    for (std::size_t j = 0; j < m; ++j) {
-      const unsigned counted = all ? 1u : static_cast<unsigned>(observed[begin + j] != 0);
-      bad |=
-          counted & static_cast<unsigned>(t[j] >= kNumTruthClasses || p[j] >= kNumPredictedClasses);
-      pairs[j] = counted ? static_cast<std::uint8_t>(((t[j] & 3) << 2) | (p[j] & 3)) : kNotCounted;
-    }
-    for (int k = 0; k < kNumTruthClasses * 4; ++k) {
-      for (std::size_t j0 = 0; j0 < m; j0 += 255) {
-        std::uint8_t c = 0;  // at most 255 matches: byte sums, 16 cells per instruction
-        for (std::size_t j = j0; j < std::min(m, j0 + 255); ++j) c += pairs[j] == k;
-        counts[k] += c;
-      }
-    }
-  }
-  if (bad) {
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!all && observed[i] == 0) continue;
-      if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
-        throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
-                                    std::to_string(i) + " has class out of range");
-    }
-  }
   std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses> frame{};
   std::int64_t cells = 0;
-  for (int t = 0; t < kNumTruthClasses; ++t) {
-    for (int p = 0; p < kNumPredictedClasses; ++p) {
-      frame[t][p] = counts[(t << 2) | p];
-      cells += frame[t][p];
-    }
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (!observed.empty() && observed[i] == 0) continue;
+    if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
+      throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
+                                  std::to_string(i) + " has class out of range");
+    ++frame[truth[i]][predicted[i]];
+    ++cells;
   }
   for (int t = 0; t < kNumTruthClasses; ++t)
     for (int p = 0; p < kNumPredictedClasses; ++p) m_.confusion[t][p] += frame[t][p];

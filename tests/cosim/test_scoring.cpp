@@ -26,16 +26,38 @@ void CheckSameClusters(const std::vector<eval::Cluster>& a, const std::vector<ev
   }
 }
 
+// A car crossing in front of a moving ego (radial and tangential motion), seen by two radars,
+// so that dynamic cells, clusters and every cell class occur: the grid's cycle of `step`.
+struct Crossing {
+  static constexpr double kDt = 0.05;
+  Pose2 ego;
+  Velocity v{2.0, 9.0};
+  OrientedBox car;
+  static filter::FilterParams Params() {
+    filter::FilterParams fp;
+    fp.num_particles = 4000;
+    fp.num_birth = 400;
+    return fp;
+  }
+  void Step(filter::DynamicGrid& grid, int step) {
+    const double t = kDt * step;
+    ego.position = {8.0 * t, 0.0};
+    car = {Position(25.0, -12.0) + t * v, std::atan2(v.y(), v.x()), 4.5, 1.9};
+    const std::vector<filter::SensorCoverage> cov = {ForwardRadar(ego), LeftRadar(ego)};
+    std::vector<filter::Measurement> z;
+    for (const auto& c : cov)
+      for (const Position& p : NearFacePoints(car, c.origin, 1.5, 0.5))
+        z.push_back(Detect(p, v, c.origin));
+    grid.Update({ego, {8.0, 0.0}}, z, cov, kDt);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them or stale ones",
           "[cosim][scoring]") {
-  // A car crossing in front of a moving ego (radial and tangential motion), seen by two radars,
-  // so that dynamic cells, clusters and every cell class occur.
-  filter::FilterParams fp;
-  fp.num_particles = 4000;
-  fp.num_birth = 400;
-  filter::DynamicGrid grid(fp, 11);
+  // The crossing car (Crossing).
+  filter::DynamicGrid grid(Crossing::Params(), 11);
   const scenario::EvaluationConfig config;
   const double stale_threshold = config.dynamic_threshold + 0.2;
   cosim::ModeScorer with(config), without(config), stale(config);
@@ -43,19 +65,14 @@ TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them 
   // the float layer itself, clustered as the scorer does.
   eval::ParticleClusterer reference(config.dbscan, config.min_cluster_mass);
   cosim::GridSnapshot s;
-  Pose2 ego;
+  Crossing crossing;
   int dynamic_frames = 0, stale_differs = 0;
   for (int step = 0; step < 40; ++step) {
-    const double t = 0.05 * step;
-    ego.position = {8.0 * t, 0.0};
-    const Velocity v(2.0, 9.0);
-    const OrientedBox car{Position(25.0, -12.0) + t * v, std::atan2(v.y(), v.x()), 4.5, 1.9};
-    const std::vector<filter::SensorCoverage> cov = {ForwardRadar(ego), LeftRadar(ego)};
-    std::vector<filter::Measurement> z;
-    for (const auto& c : cov)
-      for (const Position& p : NearFacePoints(car, c.origin, 1.5, 0.5))
-        z.push_back(Detect(p, v, c.origin));
-    grid.Update({ego, {8.0, 0.0}}, z, cov, 0.05);
+    const double t = Crossing::kDt * step;
+    crossing.Step(grid, step);
+    const Pose2& ego = crossing.ego;
+    const OrientedBox& car = crossing.car;
+    const Velocity& v = crossing.v;
 
     const std::vector<eval::TruthObject> objects = {{1, car, v, true, true, true}};
     const std::vector<std::uint8_t> truth(static_cast<std::size_t>(grid.cells_x()) * grid.cells_y(),
@@ -112,25 +129,11 @@ TEST_CASE("DynamicParticles excludes exactly the particles inside the box, where
   // The crossing car above; boxes of several sizes and headings laid over its particles (and
   // one far away), so that the cells near the box (those that take the box test) hold particles
   // inside, on the edge and outside it. Reference: every particle of a dynamic cell tested.
-  filter::FilterParams fp;
-  fp.num_particles = 4000;
-  fp.num_birth = 400;
-  filter::DynamicGrid grid(fp, 11);
+  filter::DynamicGrid grid(Crossing::Params(), 11);
   const scenario::EvaluationConfig config;
-  Pose2 ego;
-  OrientedBox car;
-  for (int step = 0; step < 30; ++step) {
-    const double t = 0.05 * step;
-    ego.position = {8.0 * t, 0.0};
-    const Velocity v(2.0, 9.0);
-    car = {Position(25.0, -12.0) + t * v, std::atan2(v.y(), v.x()), 4.5, 1.9};
-    const std::vector<filter::SensorCoverage> cov = {ForwardRadar(ego), LeftRadar(ego)};
-    std::vector<filter::Measurement> z;
-    for (const auto& c : cov)
-      for (const Position& p : NearFacePoints(car, c.origin, 1.5, 0.5))
-        z.push_back(Detect(p, v, c.origin));
-    grid.Update({ego, {8.0, 0.0}}, z, cov, 0.05);
-  }
+  Crossing crossing;
+  for (int step = 0; step < 30; ++step) crossing.Step(grid, step);
+  const OrientedBox& car = crossing.car;
   cosim::GridSnapshot s;
   cosim::TakeSnapshot(grid, false, s);
   cosim::ClassifySnapshot(config.dynamic_threshold, s);
