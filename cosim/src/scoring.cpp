@@ -1,5 +1,6 @@
 #include "dualgrid/cosim/scoring.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -61,6 +62,26 @@ bool NearGrid(const OrientedBox& b, const Position& lo, const Position& hi) {
 
 }  // namespace
 
+CellWindow CellWindow::Around(const OrientedBox& box, const filter::DynamicGrid& grid) {
+  // The box's bounding rectangle in cells, widened by one cell on each side: a particle lies in
+  // its cell up to float rounding (micrometres), far less than the cell of margin.
+  Position lo = box.center, hi = box.center;
+  for (const Position& c : box.Corners()) {
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  const double r = grid.resolution();
+  const Position c0 = grid.CellCenter({0, 0});  // cell (x, y) spans c0 + (x, y) r +- r / 2
+  const auto index = [&](double v, double c) { return std::floor((v - c) / r + 0.5); };
+  CellWindow w;
+  if (!lo.allFinite() || !hi.allFinite()) return w;  // an empty window
+  w.x0 = index(lo.x(), c0.x()) - 1.0;
+  w.x1 = index(hi.x(), c0.x()) + 1.0;
+  w.y0 = index(lo.y(), c0.y()) - 1.0;
+  w.y1 = index(hi.y(), c0.y()) + 1.0;
+  return w;
+}
+
 std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame& g,
                                        const sim::Frame& frame, const sim::ScenarioSpec& spec) {
   const Position lo = grid.origin;
@@ -111,16 +132,22 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
                                 std::to_string(grid.cells_x() * grid.cells_y()) + " cells");
   out->clear();
   const std::optional<BoxTest> ego = exclude ? std::optional<BoxTest>(*exclude) : std::nullopt;
+  const std::optional<CellWindow> near_ego =
+      exclude ? std::optional<CellWindow>(CellWindow::Around(*exclude, grid)) : std::nullopt;
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
   // visited, in the particles' order. kDynamic is ClassifyCell's first test, dynamic > threshold.
+  // Only the particles of cells near the ego box take its test (the others are outside it).
   constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
+  const int cells_x = grid.cells_x();
   grid.ForEachWeightedCellWhere(
       classes, [](std::uint8_t c) { return c == kDynamic; },
-      [&](std::size_t, std::int64_t first, std::int64_t last) {
+      [&](std::size_t k, std::int64_t first, std::int64_t last) {
+        const bool test_ego = near_ego && near_ego->Holds(static_cast<int>(k % cells_x),
+                                                          static_cast<int>(k / cells_x));
         for (std::int64_t i = first; i < last; ++i) {
           const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
           if (!(p.weight > 0.0f)) continue;
-          if (ego && ego->Contains(p.position)) continue;
+          if (test_ego && ego->Contains(p.position)) continue;
           out->push_back({p.position, p.velocity, p.weight});
         }
       });

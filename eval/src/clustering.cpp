@@ -1,6 +1,7 @@
 #include "dualgrid/eval/clustering.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -10,6 +11,19 @@ ParticleClusterer::ParticleClusterer(const DbscanParams& params, double min_clus
     : dbscan_(params), min_cluster_weight_(min_cluster_weight) {
   if (!(min_cluster_weight >= 0.0 && std::isfinite(min_cluster_weight)))
     throw std::invalid_argument("ParticleClusterer: min_cluster_weight must be finite and >= 0");
+}
+
+void ParticleClusterer::PlainMeans(std::span<const WeightedParticle> particles, int label,
+                                   Cluster& c) const {
+  Position position = Position::Zero();
+  Velocity velocity = Velocity::Zero();
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    if (labels_[i] != label) continue;
+    position += particles[i].position;
+    velocity += particles[i].velocity;
+  }
+  c.position = position / c.size;
+  c.velocity = velocity / c.size;
 }
 
 std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> particles) {
@@ -32,25 +46,38 @@ std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> pa
 
   const int k = dbscan_.num_clusters();
   std::vector<Cluster> clusters(k);
-  // Unweighted sums kept alongside for the zero-weight fallback.
-  std::vector<Position> plain_position(k, Position::Zero());
-  std::vector<Velocity> plain_velocity(k, Velocity::Zero());
   for (Cluster& c : clusters) {
     c.min = Position::Constant(std::numeric_limits<double>::infinity());
     c.max = -c.min;
   }
-  for (int i = 0; i < n; ++i) {
-    if (labels_[i] == kNoise) continue;
-    const WeightedParticle& p = particles[i];
-    Cluster& c = clusters[labels_[i]];
-    c.position += p.weight * p.position;
-    c.velocity += p.weight * p.velocity;
-    c.weight += p.weight;
-    ++c.size;
-    c.min = c.min.cwiseMin(p.position);
-    c.max = c.max.cwiseMax(p.position);
-    plain_position[labels_[i]] += p.position;
-    plain_velocity[labels_[i]] += p.velocity;
+  // Runs of one label (the filter hands its particles over cell by cell, so a cluster's come in
+  // long runs) are summed in locals: the same additions in the same order as into the cluster.
+  for (int i = 0; i < n;) {
+    const int label = labels_[i];
+    if (label == kNoise) {
+      ++i;
+      continue;
+    }
+    Cluster& c = clusters[label];
+    Position position = c.position, lo = c.min, hi = c.max;
+    Velocity velocity = c.velocity;
+    double weight = c.weight;
+    int size = c.size;
+    for (; i < n && labels_[i] == label; ++i) {
+      const WeightedParticle& p = particles[i];
+      position += p.weight * p.position;
+      velocity += p.weight * p.velocity;
+      weight += p.weight;
+      ++size;
+      lo = lo.cwiseMin(p.position);
+      hi = hi.cwiseMax(p.position);
+    }
+    c.position = position;
+    c.velocity = velocity;
+    c.weight = weight;
+    c.size = size;
+    c.min = lo;
+    c.max = hi;
   }
   for (int c = 0; c < k; ++c) {
     Cluster& cl = clusters[c];
@@ -58,8 +85,7 @@ std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> pa
       cl.position /= cl.weight;
       cl.velocity /= cl.weight;
     } else {
-      cl.position = plain_position[c] / cl.size;
-      cl.velocity = plain_velocity[c] / cl.size;
+      PlainMeans(particles, c, cl);
     }
   }
   if (min_cluster_weight_ > 0.0) {

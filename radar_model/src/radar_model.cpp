@@ -211,12 +211,16 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   };
 
   std::vector<Scatterer> out;
+  // Most walked rail samples lie outside the field of view (a rail piece is walked whole once
+  // some of it is in view): those that OutsideFov rejects skip the atan2 (the same outcome).
+  const double fov_cos_bound = FovCosBound(half_fov);
   const auto consider = [&](const Position& q, const Velocity& v, double rcs_m2, int source_id,
                             int owner) {
     const Position local = local_of(q);
     Scatterer sc;
     sc.truth.range = local.norm();
     if (sc.truth.range < p.min_range || sc.truth.range > p.max_range) return;
+    if (OutsideFov(local, sc.truth.range, fov_cos_bound)) return;
     sc.truth.azimuth = std::atan2(local.y(), local.x());
     if (std::abs(sc.truth.azimuth) > half_fov) return;
     sc.truth.range_rate = (v - vs).dot(q - s) / sc.truth.range;

@@ -32,6 +32,23 @@ constexpr double kEgoBodySkin = 1e-3;
 // its far corner, hidden behind the near one (docs/radar.md step 2).
 constexpr double kMinGrazingSin = 0.0087;  // sin(0.5 deg)
 
+/// Margin on the cosine of a half field of view [-]: far above the rounding of a cosine, a norm
+/// and atan2 (~1e-15), far below any geometry that matters (1e-9 in cosine is >= 1e-9 rad).
+constexpr double kFovCosMargin = 1e-9;
+
+/// The bound FovCosBound(h) = cos(h) - kFovCosMargin used by OutsideFov, for a half field of
+/// view h in [0, pi] [rad].
+inline double FovCosBound(double half_fov) { return std::cos(half_fov) - kFovCosMargin; }
+
+/// A cheap, conservative field-of-view test for a point `local` of the sensor frame at range
+/// `range` = local.norm() > 0 [m]: true only when std::abs(std::atan2(local.y(), local.x())) >
+/// half_fov holds for certain (x / range = cos(azimuth) lies below cos(half_fov) by more than
+/// rounding can explain), so callers skip the atan2 of points it rejects and decide the rest with
+/// atan2 as before. `cos_bound` = FovCosBound(half_fov).
+inline bool OutsideFov(const Position& local, double range, double cos_bound) {
+  return local.x() < cos_bound * range;
+}
+
 /// Angular interval seen from the sensor, stored as centre direction and cos(half width) so
 /// membership is one dot product.
 struct Interval {

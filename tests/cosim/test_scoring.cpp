@@ -1,8 +1,12 @@
 // ModeScorer with and without the classes of ClassifySnapshot: the same scores, bit for bit, and
-// the same dynamic cells as the mass threshold itself picks.
+// the same dynamic cells as the mass threshold itself picks; DynamicParticles' ego box test (only
+// cells near the box take it) against testing every particle.
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
 #include "../filter/synthetic.hpp"
+#include "dualgrid/core/random.hpp"
 #include "dualgrid/cosim/scoring.hpp"
 
 using namespace dualgrid;
@@ -22,16 +26,38 @@ void CheckSameClusters(const std::vector<eval::Cluster>& a, const std::vector<ev
   }
 }
 
+// A car crossing in front of a moving ego (radial and tangential motion), seen by two radars,
+// so that dynamic cells, clusters and every cell class occur: the grid's cycle of `step`.
+struct Crossing {
+  static constexpr double kDt = 0.05;
+  Pose2 ego;
+  Velocity v{2.0, 9.0};
+  OrientedBox car;
+  static filter::FilterParams Params() {
+    filter::FilterParams fp;
+    fp.num_particles = 4000;
+    fp.num_birth = 400;
+    return fp;
+  }
+  void Step(filter::DynamicGrid& grid, int step) {
+    const double t = kDt * step;
+    ego.position = {8.0 * t, 0.0};
+    car = {Position(25.0, -12.0) + t * v, std::atan2(v.y(), v.x()), 4.5, 1.9};
+    const std::vector<filter::SensorCoverage> cov = {ForwardRadar(ego), LeftRadar(ego)};
+    std::vector<filter::Measurement> z;
+    for (const auto& c : cov)
+      for (const Position& p : NearFacePoints(car, c.origin, 1.5, 0.5))
+        z.push_back(Detect(p, v, c.origin));
+    grid.Update({ego, {8.0, 0.0}}, z, cov, kDt);
+  }
+};
+
 }  // namespace
 
 TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them or stale ones",
           "[cosim][scoring]") {
-  // A car crossing in front of a moving ego (radial and tangential motion), seen by two radars,
-  // so that dynamic cells, clusters and every cell class occur.
-  filter::FilterParams fp;
-  fp.num_particles = 4000;
-  fp.num_birth = 400;
-  filter::DynamicGrid grid(fp, 11);
+  // The crossing car (Crossing).
+  filter::DynamicGrid grid(Crossing::Params(), 11);
   const scenario::EvaluationConfig config;
   const double stale_threshold = config.dynamic_threshold + 0.2;
   cosim::ModeScorer with(config), without(config), stale(config);
@@ -39,19 +65,14 @@ TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them 
   // the float layer itself, clustered as the scorer does.
   eval::ParticleClusterer reference(config.dbscan, config.min_cluster_mass);
   cosim::GridSnapshot s;
-  Pose2 ego;
+  Crossing crossing;
   int dynamic_frames = 0, stale_differs = 0;
   for (int step = 0; step < 40; ++step) {
-    const double t = 0.05 * step;
-    ego.position = {8.0 * t, 0.0};
-    const Velocity v(2.0, 9.0);
-    const OrientedBox car{Position(25.0, -12.0) + t * v, std::atan2(v.y(), v.x()), 4.5, 1.9};
-    const std::vector<filter::SensorCoverage> cov = {ForwardRadar(ego), LeftRadar(ego)};
-    std::vector<filter::Measurement> z;
-    for (const auto& c : cov)
-      for (const Position& p : NearFacePoints(car, c.origin, 1.5, 0.5))
-        z.push_back(Detect(p, v, c.origin));
-    grid.Update({ego, {8.0, 0.0}}, z, cov, 0.05);
+    const double t = Crossing::kDt * step;
+    crossing.Step(grid, step);
+    const Pose2& ego = crossing.ego;
+    const OrientedBox& car = crossing.car;
+    const Velocity& v = crossing.v;
 
     const std::vector<eval::TruthObject> objects = {{1, car, v, true, true, true}};
     const std::vector<std::uint8_t> truth(static_cast<std::size_t>(grid.cells_x()) * grid.cells_y(),
@@ -101,4 +122,73 @@ TEST_CASE("ModeScorer scores the same with the snapshot's classes, without them 
     CHECK(m->tracked_fraction == b.tracked_fraction);
     CHECK(m->clusters_per_scan == b.clusters_per_scan);
   }
+}
+
+TEST_CASE("DynamicParticles excludes exactly the particles inside the box, wherever it lies",
+          "[cosim][scoring]") {
+  // The crossing car above; boxes of several sizes and headings laid over its particles (and
+  // one far away), so that the cells near the box (those that take the box test) hold particles
+  // inside, on the edge and outside it. Reference: every particle of a dynamic cell tested.
+  filter::DynamicGrid grid(Crossing::Params(), 11);
+  const scenario::EvaluationConfig config;
+  Crossing crossing;
+  for (int step = 0; step < 30; ++step) crossing.Step(grid, step);
+  const OrientedBox& car = crossing.car;
+  cosim::GridSnapshot s;
+  cosim::TakeSnapshot(grid, false, s);
+  cosim::ClassifySnapshot(config.dynamic_threshold, s);
+  std::vector<eval::WeightedParticle> all;
+  cosim::DynamicParticles(grid, s.classes, std::nullopt, &all);
+  REQUIRE(all.size() > 100);
+  int boxes_cutting = 0;
+  for (const double yaw : {0.0, 0.3, 1.2, -2.0}) {
+    for (const double size : {0.4, 1.5, 4.0}) {
+      for (const Position& shift : {Position(0.0, 0.0), Position(0.7, -0.4), Position(60.0, 9.0)}) {
+        const OrientedBox box{car.center + shift, yaw, size, 0.6 * size};
+        std::vector<eval::WeightedParticle> kept;
+        cosim::DynamicParticles(grid, s.classes, box, &kept);
+        std::vector<eval::WeightedParticle> expected;
+        for (const eval::WeightedParticle& p : all)
+          if (!box.Contains(p.position)) expected.push_back(p);
+        REQUIRE(kept.size() == expected.size());
+        for (std::size_t i = 0; i < kept.size(); ++i) {
+          CHECK(kept[i].position == expected[i].position);
+          CHECK(kept[i].velocity == expected[i].velocity);
+          CHECK(kept[i].weight == expected[i].weight);
+        }
+        boxes_cutting += kept.size() < all.size() && !kept.empty();
+      }
+    }
+  }
+  CHECK(boxes_cutting >= 12);  // most boxes over the car cut its particles in two
+}
+
+TEST_CASE("CellWindow holds every cell a box touches", "[cosim][scoring]") {
+  filter::FilterParams fp;
+  fp.num_particles = 200;
+  fp.num_birth = 20;
+  filter::DynamicGrid grid(fp, 3);
+  grid.Update({Pose2{Position(3.3, -1.7), 0.0}, {0.0, 0.0}}, {}, {}, 0.05);
+  CounterRng rng(5, RngPurpose::kTest, 0, 0);
+  for (int k = 0; k < 200; ++k) {
+    const OrientedBox box{Position(rng.Uniform(-40.0, 40.0), rng.Uniform(-10.0, 10.0)),
+                          rng.Uniform(-kPi, kPi), rng.Uniform(0.1, 6.0), rng.Uniform(0.1, 3.0)};
+    const cosim::CellWindow w = cosim::CellWindow::Around(box, grid);
+    // Points of the box (corners, centre, edge midpoints): each one's cell lies in the window.
+    std::vector<Position> pts = {box.center};
+    const auto c = box.Corners();
+    for (int i = 0; i < 4; ++i) {
+      pts.push_back(c[i]);
+      pts.push_back(0.5 * (c[i] + c[(i + 1) % 4]));
+    }
+    for (const Position& p : pts) {
+      const auto cell = grid.CellOf(p);
+      if (cell) CHECK(w.Holds(cell->x, cell->y));
+    }
+    // And it is small: the box's bounding rectangle plus a cell each side (3 cells of slack).
+    const double r = grid.resolution();
+    CHECK(w.x1 - w.x0 <= (std::abs(c[0].x() - c[2].x()) + std::abs(c[1].x() - c[3].x())) / r + 4);
+  }
+  const OrientedBox nan_box{Position(std::nan(""), 0.0), 0.0, 1.0, 1.0};
+  CHECK_FALSE(cosim::CellWindow::Around(nan_box, grid).Holds(0, 0));
 }

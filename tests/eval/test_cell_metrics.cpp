@@ -98,7 +98,8 @@ TEST_CASE("The confusion matrix equals a plain count over random frames", "[cell
   std::array<std::array<std::int64_t, 4>, 3> expected{};
   std::int64_t cells = 0;
   for (int frame = 0; frame < 4; ++frame) {
-    const std::size_t n = 1 + static_cast<std::size_t>(rng.Uniform() * 997);
+    // The last frame spans several of AddFrame's chunks (4,096 cells) and byte counters (255).
+    const std::size_t n = 1 + static_cast<std::size_t>(rng.Uniform() * (frame == 3 ? 12997 : 997));
     std::vector<std::uint8_t> truth(n), pred(n), observed(n);
     for (std::size_t i = 0; i < n; ++i) {
       truth[i] = static_cast<std::uint8_t>(rng.Uniform() * 3);
@@ -111,6 +112,11 @@ TEST_CASE("The confusion matrix equals a plain count over random frames", "[cell
     }
     acc.AddFrame(pred, truth, observed);
   }
+  // One class in every cell of a long frame: every byte counter full (255 of 255).
+  const std::vector<std::uint8_t> same(5000, 1);
+  acc.AddFrame(same, same, {});
+  expected[1][1] += 5000;
+  cells += 5000;
   const CellMetrics m = acc.Result();
   CHECK(m.confusion == expected);
   CHECK(m.cells == cells);

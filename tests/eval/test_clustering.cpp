@@ -1,3 +1,4 @@
+#include <limits>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -102,4 +103,54 @@ TEST_CASE("ParticleClusterer drops clusters below the minimum mass", "[eval][clu
   CHECK(heavy.labels()[0] == kNoise);
   CHECK(heavy.labels()[9] == 0);
   CHECK_THROWS_AS(ParticleClusterer(DbscanParams{}, -1.0), std::invalid_argument);
+}
+
+TEST_CASE("Cluster sums equal a particle-by-particle reference bit for bit", "[clustering]") {
+  // Three blobs whose particles come interleaved (runs of one) or blob by blob (long runs), and
+  // one blob of zero weights (plain means): every field as the reference sums it, in input order.
+  const bool interleaved = GENERATE(false, true);
+  std::vector<WeightedParticle> particles;
+  for (int i = 0; i < 90; ++i) {
+    const int blob = interleaved ? i % 3 : i / 30;
+    const double u = 0.013 * i, w = blob == 2 ? 0.0 : 0.1 + 0.37 * ((i * 7) % 11);
+    particles.push_back({Position(10.0 * blob + std::sin(u), std::cos(3.0 * u)),
+                         Velocity(1.0 + u, -2.0 * blob + 0.1 * u), w});
+  }
+  ParticleClusterer clusterer;
+  const std::vector<Cluster> clusters = clusterer.Run(particles);
+  REQUIRE(clusters.size() == 3);
+  const std::span<const int> labels = clusterer.labels();
+  for (int c = 0; c < 3; ++c) {
+    Cluster ref;
+    ref.min = Position::Constant(std::numeric_limits<double>::infinity());
+    ref.max = -ref.min;
+    Position plain_p = Position::Zero();
+    Velocity plain_v = Velocity::Zero();
+    for (std::size_t i = 0; i < particles.size(); ++i) {
+      if (labels[i] != c) continue;
+      const WeightedParticle& p = particles[i];
+      ref.position += p.weight * p.position;
+      ref.velocity += p.weight * p.velocity;
+      ref.weight += p.weight;
+      ++ref.size;
+      ref.min = ref.min.cwiseMin(p.position);
+      ref.max = ref.max.cwiseMax(p.position);
+      plain_p += p.position;
+      plain_v += p.velocity;
+    }
+    if (ref.weight > 0.0) {
+      ref.position /= ref.weight;
+      ref.velocity /= ref.weight;
+    } else {
+      ref.position = plain_p / ref.size;
+      ref.velocity = plain_v / ref.size;
+    }
+    CHECK(ref.size == 30);
+    CHECK(clusters[c].position == ref.position);
+    CHECK(clusters[c].velocity == ref.velocity);
+    CHECK(clusters[c].weight == ref.weight);
+    CHECK(clusters[c].size == ref.size);
+    CHECK(clusters[c].min == ref.min);
+    CHECK(clusters[c].max == ref.max);
+  }
 }

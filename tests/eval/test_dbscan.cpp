@@ -164,15 +164,24 @@ TEST_CASE("DBSCAN matches a brute-force reference and is permutation invariant",
   const std::uint64_t seed = GENERATE(range(1, 21));
   const bool snap = GENERATE(false, true);
   std::vector<Position> pts = RandomPoints(seed, 300, 20.0, snap);
+  // Shifted across zero: index cells of negative coordinates, and (snapped) points exactly on
+  // their edges, where flooring a negative coordinate differs from truncating it.
+  const double offset = GENERATE(0.0, -10.0);
+  for (Position& q : pts) q += Position(offset, offset);
   // One far outlier makes the points' rectangle too sparse for the dense index: the hash path.
   const bool sparse = GENERATE(false, true);
   if (sparse) pts.emplace_back(3.0e7, -2.0e7);
   const int n = static_cast<int>(pts.size());
-  const DbscanParams params{.eps = 1.0, .min_points = 4};
+  // Weighted: weights in eighths (every partial sum exact, so any summation order agrees with
+  // the reference), and a min_weight that some points with min_points neighbours miss.
+  const bool weighted = GENERATE(false, true);
+  const DbscanParams params{.eps = 1.0, .min_points = 4, .min_weight = weighted ? 2.5 : 0.0};
+  std::vector<double> weights(n);
+  for (int i = 0; i < n; ++i) weights[i] = (1 + i % 5) / 8.0;
   Dbscan dbscan(params);
   std::vector<int> identity(n);
   std::iota(identity.begin(), identity.end(), 0);
-  const auto labels_span = dbscan.Run(pts);
+  const auto labels_span = dbscan.Run(pts, weights);
   const std::vector<int> labels(labels_span.begin(), labels_span.end());
 
   // Brute-force reference, O(n^2): core flags, core components, border -> nearest core.
@@ -181,7 +190,14 @@ TEST_CASE("DBSCAN matches a brute-force reference and is permutation invariant",
     for (int j = 0; j < n; ++j)
       if ((pts[i] - pts[j]).norm() <= params.eps) nb[i].push_back(j);
   std::vector<bool> core(n);
-  for (int i = 0; i < n; ++i) core[i] = static_cast<int>(nb[i].size()) >= params.min_points;
+  int weight_misses = 0;
+  for (int i = 0; i < n; ++i) {
+    double w = 0.0;
+    for (const int j : nb[i]) w += weights[j];
+    core[i] = static_cast<int>(nb[i].size()) >= params.min_points && w >= params.min_weight;
+    weight_misses += static_cast<int>(nb[i].size()) >= params.min_points && !core[i];
+  }
+  if (weighted) CHECK(weight_misses > 0);  // the weighted criterion decided some points
   std::vector<int> comp(n, -1);
   int nc = 0;
   for (int i = 0; i < n; ++i) {
@@ -224,8 +240,9 @@ TEST_CASE("DBSCAN matches a brute-force reference and is permutation invariant",
   for (int i = n - 1; i > 0; --i)
     std::swap(perm[i], perm[static_cast<int>(rng.Uniform() * (i + 1))]);
   std::vector<Position> shuffled(n);
-  for (int i = 0; i < n; ++i) shuffled[i] = pts[perm[i]];
-  const auto shuffled_labels = dbscan.Run(shuffled);
+  std::vector<double> shuffled_weights(n);
+  for (int i = 0; i < n; ++i) shuffled[i] = pts[perm[i]], shuffled_weights[i] = weights[perm[i]];
+  const auto shuffled_labels = dbscan.Run(shuffled, shuffled_weights);
   CHECK(Partition(shuffled_labels, perm) == Partition(labels, identity));
 }
 

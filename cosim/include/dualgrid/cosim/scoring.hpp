@@ -52,6 +52,14 @@ void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s);
 std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame& grid_frame,
                                        const sim::Frame& frame, const sim::ScenarioSpec& spec);
 
+/// The logical cells of a grid near a box: every cell holding a point of `box` (its bounding
+/// rectangle widened by one cell) lies in [x0, x1] x [y0, y1]. Empty for a non-finite box.
+struct CellWindow {
+  double x0 = 0.0, x1 = -1.0, y0 = 0.0, y1 = -1.0;  ///< cell indices (as doubles: no overflow)
+  static CellWindow Around(const OrientedBox& box, const filter::DynamicGrid& grid);
+  bool Holds(int x, int y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+};
+
 /// The particles the paper clusters (Sec. V): `grid`'s weighted particles (after the weight
 /// update, before resampling; weights normalised per cell to its dynamic mass) in the cells whose
 /// `classes` entry (eval::CellClass per cell, index y * cells_x + x) is dynamic, with a positive

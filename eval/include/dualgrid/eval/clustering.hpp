@@ -45,6 +45,10 @@ class ParticleClusterer {
   std::span<const int> labels() const { return labels_; }
 
  private:
+  // The plain (unweighted) means of cluster `label`'s particles (labels_ of this Run) into `c`,
+  // whose size is set: the fallback of a cluster whose weights sum to zero.
+  void PlainMeans(std::span<const WeightedParticle> particles, int label, Cluster& c) const;
+
   Dbscan dbscan_;
   double min_cluster_weight_ = 0.0;
   std::vector<Position> positions_;

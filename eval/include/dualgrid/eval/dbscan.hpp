@@ -1,12 +1,14 @@
 // DBSCAN (Ester et al., KDD 1996) over 2-D points with a uniform-grid spatial index.
 //
-// Used to cluster the particles of dynamic cells (paper Sec. V). Neighbour queries look at the
-// 3x3 block of index cells of size eps around a point; core tests stop at min_points neighbours.
-// The clusters (components of the core graph) are found on a finer grid of side < eps / sqrt(2)
-// (Gunawan's grid DBSCAN): all core points of one fine cell are neighbours, and two fine cells are
-// joined after the first pair of their core points within eps, so dense clusters cost O(cells),
-// not O(points x density). bench_models' clusterer (10,500 particles on 8 vehicles): 1.16 -> 0.39
-// ms with this and the own-cell-first search below (docs/performance.md).
+// Used to cluster the particles of dynamic cells (paper Sec. V). The points are sorted into a
+// fine grid of side h < eps / sqrt(2) (Gunawan's grid DBSCAN): two points of one fine cell are
+// neighbours, so a cell holding min_points points makes them all core without a distance, and
+// the neighbours of a point lie in the 5 x 5 block of cells around its own. The clusters
+// (components of the core graph) are found on the same grid: two fine cells are joined after
+// the first pair of their core points within eps, so dense clusters cost O(cells), not
+// O(points x density). With the weighted criterion (min_weight > 0), the core test sums the
+// weights over index cells of side eps in a fixed order instead (the 3 x 3 block, own cell
+// first). Speed: docs/performance.md (bench_models' clusterer, bench_scoring).
 #pragma once
 
 #include <cstdint>
@@ -92,7 +94,21 @@ class Dbscan {
     int Find(std::int64_t x, std::int64_t y) const;
   };
 
-  // Core-point components on the fine grid; fills component_ for core points, returns the count.
+  // 1 / h, the fine grid's inverse cell side [1/m] (h < eps / sqrt(2)).
+  double InvFineSide() const;
+  // The fine grid of all points: fx_, fy_, fine_cell_ per point; cell c holds the points
+  // fine_sorted_[fine_start_[c] .. fine_start_[c + 1]) in input order.
+  void FineCells(std::span<const Position> points);
+  // Calls f(j) for every point j within eps of point i (itself included) of fine cell c, in the
+  // cells of the 5 x 5 block around c, until f returns false.
+  template <typename F>
+  void ForEachFineNeighbour(std::span<const Position> points, int c, int i, F&& f) const;
+  // Core flags without the weighted criterion: count neighbours on the fine grid.
+  void CountCore(std::span<const Position> points);
+  // Core flags with it: the weights summed over the eps cells in their fixed order.
+  void WeightedCore(std::span<const Position> points, std::span<const double> weights);
+  // Core-point components on the fine grid (after FineCells and the core flags); fills
+  // component_ for core points, returns the count.
   int CoreComponents(std::span<const Position> points);
   int FindRoot(int c);
 
@@ -105,11 +121,12 @@ class Dbscan {
   std::vector<double> sorted_weight_;  // weights[sorted_[s]] when weighted
   std::vector<int> near_;
   std::vector<std::uint8_t> core_;
-  // Fine grid of the core points: cell c holds fine_sorted_[fine_start_[c] .. fine_start_[c + 1]).
+  // Fine grid of all points (FineCells); its core points per cell: core_sorted_[core_start_[c] ..
+  // core_start_[c + 1]).
   CellTable fine_;
-  std::vector<int> core_ids_;
   std::vector<std::int64_t> fx_, fy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
+  std::vector<int> core_start_, core_sorted_;
   std::vector<int> component_;
   std::vector<int> labels_;
   std::vector<int> relabel_;
