@@ -125,7 +125,7 @@ double ParticleUnit(double extent_x, double extent_y);
 class Writer {
  public:
   /// Frames handed to the worker and not yet waited for: enough to ride out a picture the worker
-  /// draws in between (~0.1-0.2 s, while frames come every ~20 ms of a default run's wall time).
+  /// draws in between, which takes several frames' worth of the run's time (docs/performance.md).
   static constexpr std::size_t kFramesInFlight = 8;
 
   Writer(const std::filesystem::path& dir, Header header, OutputWorker& worker);
