@@ -4,7 +4,7 @@
 # REQUIRED: a missing package stops with CMake's own message naming it.
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
-find_package(hwy REQUIRED)  # Highway (libhwy-dev): the filter's SIMD
+find_package(hwy REQUIRED)  # Highway (libhwy-dev): the filter's and the radar scan's SIMD
 find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 # libsumo: SUMO's CMake config ships in Debian's sumo-tools; without it, find the headers and the

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "edge_walk.hpp"
 #include "ghosts.hpp"
 #include "scan_geometry.hpp"
 
@@ -36,7 +37,9 @@ struct ScanScratch {
   std::vector<Occluder> occluders;
   std::vector<int> candidate_targets;
   std::vector<RailPiece> rail_pieces;
-  std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
+  std::vector<Edge> rail_edges;                     // the pieces' ends, for WalkEdges
+  std::vector<std::vector<EdgeSample>> rail_walks;  // per rail piece
+  std::vector<std::vector<int>> bins;               // kAzimuthBins lists when occlusion is on
   std::vector<FaceSample> samples;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
 };
@@ -245,13 +248,18 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   }
 
   // 3. Guard rails: static line scatterers, RCS per metre of length.
-  for (const RailPiece& piece : rail_pieces) {
+  // The pieces are walked together first (WalkEdge's samples, several pieces on SIMD lanes).
+  std::vector<Edge>& rail_edges = scratch.rail_edges;
+  rail_edges.clear();
+  for (const RailPiece& piece : rail_pieces) rail_edges.push_back({piece.a, piece.b});
+  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), s, p.range_resolution,
+            p.azimuth_resolution, &scratch.rail_walks);
+  for (std::size_t k = 0; k < rail_pieces.size(); ++k) {
+    const RailPiece& piece = rail_pieces[k];
     const Polyline& line = scene.polylines[piece.polyline];
     const double rcs_per_m = std::pow(10.0, 0.1 * line.rcs_dbsm_per_metre);
-    WalkEdge(piece.a, piece.b, s, p.range_resolution, p.azimuth_resolution,
-             [&](const Position& q, double ds, double) {
-               consider(q, Velocity::Zero(), rcs_per_m * ds, line.id, -1 - piece.segment);
-             });
+    for (const EdgeSample& e : scratch.rail_walks[k])
+      consider(e.q, Velocity::Zero(), rcs_per_m * e.ds, line.id, -1 - piece.segment);
   }
 
   // 4. Multipath: the boxes' ghosts in the mirrors (docs/radar.md, "Multipath").
