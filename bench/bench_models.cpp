@@ -1,5 +1,7 @@
 // Speed of the radar model's Scan and of eval's ParticleClusterer (docs/performance.md).
-//   bench_models --benchmark_filter=RadarScan   (highway: 40 vehicles, 2 guard rails, DefaultRig)
+//   bench_models --benchmark_filter=RadarScan   (highway: 40 vehicles, 2 guard rails, DefaultRig;
+//                                                RadarScanLongRails: each rail one straight
+//                                                segment)
 //   bench_models --benchmark_filter=Multipath   (the same scan, multipath off and on side by side)
 //   bench_models --benchmark_filter=Clusterer   (10,000 particles on 8 vehicles)
 // Argument: OpenMP threads.
@@ -21,8 +23,9 @@ using namespace dualgrid;
 namespace {
 
 // Four-lane highway (3.5 m lanes, y in [-7, 7]) with a guard rail on each side (y = +-8.5 m, 600 m
-// long) and 40 vehicles within 150 m of the ego (centre of lane 2, 30 m/s).
-radar::Scene HighwayScene() {
+// long) and 40 vehicles within 150 m of the ego (centre of lane 2, 30 m/s). The rails are
+// polylines of 10 m segments, or with `long_rails` one segment each (as the scenarios' rails).
+radar::Scene HighwayScene(bool long_rails = false) {
   radar::Scene scene;
   for (int i = 0; i < 40; ++i) {
     CounterRng rng(7, RngPurpose::kTest, 0, static_cast<std::uint32_t>(i));
@@ -41,17 +44,18 @@ radar::Scene HighwayScene() {
   for (const double y : {-8.5, 8.5}) {
     radar::Polyline rail;
     rail.id = 1000 + static_cast<int>(y > 0);
-    for (double x = -300.0; x <= 300.0; x += 10.0) rail.points.push_back({x, y});
+    for (double x = -300.0; x <= 300.0; x += long_rails ? 600.0 : 10.0)
+      rail.points.push_back({x, y});
     scene.polylines.push_back(rail);
   }
   return scene;
 }
 
 // One Scan of all sensors due at time 0 (every sensor fires): detections of the whole rig.
-void BM_RadarScan(benchmark::State& state) {
+void RadarScan(benchmark::State& state, bool long_rails) {
   omp_set_num_threads(static_cast<int>(state.range(0)));
   const radar::RadarModel model(radar::DefaultRig(4.5, 1.8), radar::ModelOptions{}, 1);
-  const radar::Scene scene = HighwayScene();
+  const radar::Scene scene = HighwayScene(long_rails);
   radar::EgoMotion ego;
   ego.pose = Pose2{Position(0.0, -1.75), 0.0};
   ego.velocity = Velocity(30.0, 0.0);
@@ -67,7 +71,10 @@ void BM_RadarScan(benchmark::State& state) {
   state.counters["targets"] = static_cast<double>(scene.targets.size());
   state.counters["detections"] = static_cast<double>(detections);
 }
+void BM_RadarScan(benchmark::State& state) { RadarScan(state, false); }
+void BM_RadarScanLongRails(benchmark::State& state) { RadarScan(state, true); }
 BENCHMARK(BM_RadarScan)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_RadarScanLongRails)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 // The cost of multipath (issue 27: at most +20 % on a sim step): every iteration scans the same
 // scene with multipath off and then on, each timed, so that both see the same machine load; the

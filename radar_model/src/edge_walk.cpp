@@ -45,15 +45,35 @@ VD Spacing(DD d, VD ax, VD ay, VD dx, VD dy, VD len, VD pos, VD sx, VD sy, VD ra
   return hn::IfThenElse(hn::Lt(rest, ds), rest, ds);
 }
 
-void WalkGroup(const Lanes& lanes, int used, const Position& sensor, double range_res,
+// The cone's tests of the samples at (qx, qy), lane by lane as the scan's scalar code: the
+// local coordinates and range written to lx, ly, range; the kept lanes returned.
+hn::Mask<DD> Keep(DD d, const SensorCone& cone, VD qx, VD qy, double* lx, double* ly,
+                  double* range) {
+  const VD ex = hn::Sub(qx, hn::Set(d, cone.position.x()));
+  const VD ey = hn::Sub(qy, hn::Set(d, cone.position.y()));
+  const Matrix2& m = cone.to_local;
+  const VD x = hn::Add(hn::Mul(hn::Set(d, m(0, 0)), ex), hn::Mul(hn::Set(d, m(0, 1)), ey));
+  const VD y = hn::Add(hn::Mul(hn::Set(d, m(1, 0)), ex), hn::Mul(hn::Set(d, m(1, 1)), ey));
+  const VD r = hn::Sqrt(hn::Add(hn::Mul(x, x), hn::Mul(y, y)));
+  hn::Store(x, d, lx);
+  hn::Store(y, d, ly);
+  hn::Store(r, d, range);
+  const auto out =
+      hn::Or(hn::Or(hn::Lt(r, hn::Set(d, cone.min_range)), hn::Gt(r, hn::Set(d, cone.max_range))),
+             hn::Lt(x, hn::Mul(hn::Set(d, cone.fov_cos_bound), r)));
+  return hn::Not(out);
+}
+
+void WalkGroup(const Lanes& lanes, int used, const SensorCone& cone, double range_res,
                double azimuth_res, std::vector<EdgeSample>* const* out) {
   const DD d;
   assert(hn::Lanes(d) == kLanes);
-  const VD sx = hn::Set(d, sensor.x()), sy = hn::Set(d, sensor.y());
+  const VD sx = hn::Set(d, cone.position.x()), sy = hn::Set(d, cone.position.y());
   const VD rr = hn::Set(d, range_res), ar = hn::Set(d, azimuth_res), half = hn::Set(d, 0.5);
   VD pos[kVectors];
   for (VD& p : pos) p = hn::Zero(d);
-  alignas(16) double was[kGroup], qx[kGroup], qy[kGroup], step[kGroup];
+  alignas(16) double keep[kGroup], qx[kGroup], qy[kGroup], step[kGroup];
+  alignas(16) double lx[kGroup], ly[kGroup], range[kGroup];
   for (;;) {
     bool any = false;
     for (int k = 0; k < kVectors; ++k) {
@@ -62,25 +82,31 @@ void WalkGroup(const Lanes& lanes, int used, const Position& sensor, double rang
       const VD dx = hn::Load(d, lanes.dx + o), dy = hn::Load(d, lanes.dy + o);
       const VD len = hn::Load(d, lanes.len + o);
       const auto active = hn::Lt(pos[k], len);
-      hn::Store(pos[k], d, was + o);
-      if (hn::AllFalse(d, active)) continue;
+      if (hn::AllFalse(d, active)) {
+        hn::Store(hn::Zero(d), d, keep + o);
+        continue;
+      }
       any = true;
       const VD ds = Spacing(d, ax, ay, dx, dy, len, pos[k], sx, sy, rr, ar);
       const VD t = hn::Add(pos[k], hn::Mul(half, ds));
-      hn::Store(hn::Add(ax, hn::Mul(t, dx)), d, qx + o);
-      hn::Store(hn::Add(ay, hn::Mul(t, dy)), d, qy + o);
+      const VD x = hn::Add(ax, hn::Mul(t, dx)), y = hn::Add(ay, hn::Mul(t, dy));
+      const auto kept = hn::And(active, Keep(d, cone, x, y, lx + o, ly + o, range + o));
+      hn::Store(hn::IfThenElseZero(kept, hn::Set(d, 1.0)), d, keep + o);
+      hn::Store(x, d, qx + o);
+      hn::Store(y, d, qy + o);
       hn::Store(ds, d, step + o);
       pos[k] = hn::IfThenElse(active, hn::Add(pos[k], ds), pos[k]);
     }
     if (!any) return;
     for (int l = 0; l < used; ++l)
-      if (was[l] < lanes.len[l]) out[l]->push_back({Position(qx[l], qy[l]), step[l]});
+      if (keep[l] != 0.0)
+        out[l]->push_back({Position(qx[l], qy[l]), step[l], Position(lx[l], ly[l]), range[l]});
   }
 }
 
 }  // namespace
 
-void WalkEdges(const Edge* edges, int n, const Position& sensor, double range_res,
+void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
                double azimuth_res, std::vector<std::vector<EdgeSample>>* samples) {
   if (samples->size() < static_cast<std::size_t>(n)) samples->resize(n);
   for (int first = 0; first < n; first += kGroup) {
@@ -101,7 +127,7 @@ void WalkEdges(const Edge* edges, int n, const Position& sensor, double range_re
       lanes.dy[l] = dir.y();
       lanes.len[l] = len;
     }
-    WalkGroup(lanes, used, sensor, range_res, azimuth_res, out);
+    WalkGroup(lanes, used, cone, range_res, azimuth_res, out);
   }
 }
 

@@ -217,13 +217,12 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   // Most walked rail samples lie outside the field of view (a rail piece is walked whole once
   // some of it is in view): those that OutsideFov rejects skip the atan2 (the same outcome).
   const double fov_cos_bound = FovCosBound(half_fov);
-  const auto consider = [&](const Position& q, const Velocity& v, double rcs_m2, int source_id,
-                            int owner) {
-    const Position local = local_of(q);
+  // A point q kept by the first tests (range and field of view), with its local coordinates and
+  // range: the azimuth, the window and occlusion decide.
+  const auto consider_kept = [&](const Position& q, const Position& local, double range,
+                                 const Velocity& v, double rcs_m2, int source_id, int owner) {
     Scatterer sc;
-    sc.truth.range = local.norm();
-    if (sc.truth.range < p.min_range || sc.truth.range > p.max_range) return;
-    if (OutsideFov(local, sc.truth.range, fov_cos_bound)) return;
+    sc.truth.range = range;
     sc.truth.azimuth = std::atan2(local.y(), local.x());
     if (std::abs(sc.truth.azimuth) > half_fov) return;
     sc.truth.range_rate = (v - vs).dot(q - s) / sc.truth.range;
@@ -234,6 +233,14 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
     sc.source_id = source_id;
     sc.origin = q;
     out.push_back(sc);
+  };
+  const auto consider = [&](const Position& q, const Velocity& v, double rcs_m2, int source_id,
+                            int owner) {
+    const Position local = local_of(q);
+    const double range = local.norm();
+    if (range < p.min_range || range > p.max_range) return;
+    if (OutsideFov(local, range, fov_cos_bound)) return;
+    consider_kept(q, local, range, v, rcs_m2, source_id, owner);
   };
 
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
@@ -248,18 +255,26 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   }
 
   // 3. Guard rails: static line scatterers, RCS per metre of length.
-  // The pieces are walked together first (WalkEdge's samples, several pieces on SIMD lanes).
+  // The pieces are walked together first (WalkEdge's samples, several pieces on SIMD lanes),
+  // keeping the samples that pass `consider`'s first tests.
   std::vector<Edge>& rail_edges = scratch.rail_edges;
   rail_edges.clear();
   for (const RailPiece& piece : rail_pieces) rail_edges.push_back({piece.a, piece.b});
-  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), s, p.range_resolution,
+  SensorCone cone;
+  cone.position = s;
+  cone.to_local = to_local;
+  cone.min_range = p.min_range;
+  cone.max_range = p.max_range;
+  cone.fov_cos_bound = fov_cos_bound;
+  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), cone, p.range_resolution,
             p.azimuth_resolution, &scratch.rail_walks);
   for (std::size_t k = 0; k < rail_pieces.size(); ++k) {
     const RailPiece& piece = rail_pieces[k];
     const Polyline& line = scene.polylines[piece.polyline];
     const double rcs_per_m = std::pow(10.0, 0.1 * line.rcs_dbsm_per_metre);
     for (const EdgeSample& e : scratch.rail_walks[k])
-      consider(e.q, Velocity::Zero(), rcs_per_m * e.ds, line.id, -1 - piece.segment);
+      consider_kept(e.q, e.local, e.range, Velocity::Zero(), rcs_per_m * e.ds, line.id,
+                    -1 - piece.segment);
   }
 
   // 4. Multipath: the boxes' ghosts in the mirrors (docs/radar.md, "Multipath").

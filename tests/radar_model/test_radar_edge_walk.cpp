@@ -1,6 +1,8 @@
 // WalkEdges (radar_model/src/edge_walk.hpp), the guard rails' walk on SIMD lanes: every edge's
-// samples must be WalkEdge's (scan_geometry.hpp, the scalar walk the boxes still use) bit for
-// bit, in the same order, whatever the number of edges, their lengths and the sensor's place.
+// samples must be WalkEdge's (scan_geometry.hpp, the scalar walk the boxes still use) that the
+// scan's first tests keep (range and OutsideFov, as RadarModel::VisibleScatterers computes them),
+// bit for bit, in the same order, whatever the number of edges, their lengths, the sensor's place
+// and heading.
 #include <catch2/catch.hpp>
 
 #include <cstring>
@@ -17,13 +19,35 @@ namespace {
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-std::vector<EdgeSample> ScalarWalk(const Edge& e, const Position& s, double range_res,
-                                   double azimuth_res) {
+// The scalar path: WalkEdge, then the scan's first tests of each sample.
+std::vector<EdgeSample> ScalarWalk(const Edge& e, const SensorCone& c, double range_res,
+                                   double azimuth_res, std::size_t* walked = nullptr) {
   std::vector<EdgeSample> out;
-  WalkEdge(e.a, e.b, s, range_res, azimuth_res, [&](const Position& q, double ds, double) {
-    out.push_back({q, ds});
+  WalkEdge(e.a, e.b, c.position, range_res, azimuth_res, [&](const Position& q, double ds, double) {
+    if (walked) ++*walked;
+    const Position local = c.to_local * (q - c.position);
+    const double range = local.norm();
+    if (range < c.min_range || range > c.max_range) return;
+    if (OutsideFov(local, range, c.fov_cos_bound)) return;
+    out.push_back({q, ds, local, range});
   });
   return out;
+}
+
+bool SameSample(const EdgeSample& a, const EdgeSample& b) {
+  return SameBits(a.q.x(), b.q.x()) && SameBits(a.q.y(), b.q.y()) && SameBits(a.ds, b.ds) &&
+         SameBits(a.local.x(), b.local.x()) && SameBits(a.local.y(), b.local.y()) &&
+         SameBits(a.range, b.range);
+}
+
+SensorCone RandomCone(CounterRng& rng) {
+  SensorCone c;
+  c.position = Position(rng.Uniform(-500.0, 500.0), rng.Uniform(-20.0, 20.0));
+  c.to_local = Rotation(rng.Uniform(-kPi, kPi)).transpose();
+  c.min_range = rng.Uniform(0.0, 1.0);
+  c.max_range = rng.Uniform(40.0, 250.0);
+  c.fov_cos_bound = FovCosBound(rng.Uniform(0.1, kPi));
+  return c;
 }
 
 // Random edges as the scan makes them: rail pieces up to a few hundred metres, short box faces,
@@ -40,50 +64,49 @@ Edge RandomEdge(CounterRng& rng, const Position& s) {
 
 }  // namespace
 
-TEST_CASE("WalkEdges gives WalkEdge's samples bit for bit", "[radar][edge_walk]") {
+TEST_CASE("WalkEdges gives the kept samples of WalkEdge bit for bit", "[radar][edge_walk]") {
   std::vector<std::vector<EdgeSample>> walks;  // reused across scenes, as the scan's scratch
-  std::size_t compared = 0;
+  std::size_t walked = 0, kept = 0;
   for (std::uint32_t scene = 0; scene < 60; ++scene) {
     CounterRng rng(23, RngPurpose::kTest, scene, 0);
-    const Position s(rng.Uniform(-500.0, 500.0), rng.Uniform(-20.0, 20.0));
+    const SensorCone cone = RandomCone(rng);
     const double range_res = rng.Uniform(0.1, 1.0), azimuth_res = rng.Uniform(0.005, 0.1);
     const int n = static_cast<int>(scene % 11);  // 0 to 10: groups of lanes and leftovers
     std::vector<Edge> edges;
-    for (int i = 0; i < n; ++i) edges.push_back(RandomEdge(rng, s));
-    WalkEdges(edges.data(), n, s, range_res, azimuth_res, &walks);
+    for (int i = 0; i < n; ++i) edges.push_back(RandomEdge(rng, cone.position));
+    WalkEdges(edges.data(), n, cone, range_res, azimuth_res, &walks);
     REQUIRE(walks.size() >= static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
-      const std::vector<EdgeSample> expected = ScalarWalk(edges[i], s, range_res, azimuth_res);
+      const std::vector<EdgeSample> expected =
+          ScalarWalk(edges[i], cone, range_res, azimuth_res, &walked);
       INFO("scene " << scene << ", edge " << i);
       REQUIRE(walks[i].size() == expected.size());
-      for (std::size_t k = 0; k < expected.size(); ++k) {
-        const bool same = SameBits(walks[i][k].q.x(), expected[k].q.x()) &&
-                          SameBits(walks[i][k].q.y(), expected[k].q.y()) &&
-                          SameBits(walks[i][k].ds, expected[k].ds);
-        if (!same) FAIL_CHECK("sample " << k << " differs");
-        ++compared;
-      }
+      for (std::size_t k = 0; k < expected.size(); ++k)
+        if (!SameSample(walks[i][k], expected[k])) FAIL_CHECK("sample " << k << " differs");
+      kept += expected.size();
     }
   }
-  CHECK(compared > 10000);  // the scenes reached long walks, not only empty ones
+  // The scenes reached long walks, and the cone both kept and dropped many samples.
+  CHECK(kept > 5000);
+  CHECK(walked - kept > 5000);
 }
 
 TEST_CASE("WalkEdges on a sensor sitting on the edge and on an empty edge", "[radar][edge_walk]") {
-  const Position s(2.0, 1.0);
+  SensorCone cone;
+  cone.position = Position(2.0, 1.0);
+  cone.max_range = 100.0;  // min range 0, all around: every sample kept
   const Edge edges[3] = {{Position(2.0, 1.0), Position(4.0, 1.0)},    // starts at the sensor
                          {Position(0.0, 1.0), Position(0.0, 1.0)},    // empty
                          {Position(-1.0, 1.0), Position(5.0, 1.0)}};  // runs through it
   std::vector<std::vector<EdgeSample>> walks(5);
-  walks[1].push_back({Position(9.0, 9.0), 1.0});  // stale entries are cleared
-  WalkEdges(edges, 3, s, 0.2, 0.02, &walks);
+  walks[1].push_back({Position(9.0, 9.0), 1.0, Position(7.0, 8.0), 10.6});  // cleared
+  WalkEdges(edges, 3, cone, 0.2, 0.02, &walks);
   CHECK(walks[1].empty());
   for (int i : {0, 2}) {
-    const std::vector<EdgeSample> expected = ScalarWalk(edges[i], s, 0.2, 0.02);
+    const std::vector<EdgeSample> expected = ScalarWalk(edges[i], cone, 0.2, 0.02);
     REQUIRE(walks[i].size() == expected.size());
+    REQUIRE(!expected.empty());
     if (i == 0) CHECK(walks[i].front().ds == kMinSpacing);  // the first step, at the sensor
-    for (std::size_t k = 0; k < expected.size(); ++k) {
-      CHECK(SameBits(walks[i][k].q.x(), expected[k].q.x()));
-      CHECK(SameBits(walks[i][k].ds, expected[k].ds));
-    }
+    for (std::size_t k = 0; k < expected.size(); ++k) CHECK(SameSample(walks[i][k], expected[k]));
   }
 }
