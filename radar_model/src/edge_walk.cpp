@@ -64,8 +64,8 @@ hn::Mask<DD> Keep(DD d, const SensorCone& cone, VD qx, VD qy, double* lx, double
   return hn::Not(out);
 }
 
-void WalkGroup(const Lanes& lanes, int used, const SensorCone& cone, double range_res,
-               double azimuth_res, std::vector<EdgeSample>* const* out) {
+void WalkGroup(const Lanes& lanes, int first, int used, const SensorCone& cone, double range_res,
+               double azimuth_res, SampleSink sink, void* context) {
   const DD d;
   assert(hn::Lanes(d) == kLanes);
   const VD sx = hn::Set(d, cone.position.x()), sy = hn::Set(d, cone.position.y());
@@ -100,23 +100,20 @@ void WalkGroup(const Lanes& lanes, int used, const SensorCone& cone, double rang
     if (!any) return;
     for (int l = 0; l < used; ++l)
       if (keep[l] != 0.0)
-        out[l]->push_back({Position(qx[l], qy[l]), step[l], Position(lx[l], ly[l]), range[l]});
+        sink(context, first + l,
+             EdgeSample{Position(qx[l], qy[l]), step[l], Position(lx[l], ly[l]), range[l]});
   }
 }
 
 }  // namespace
 
 void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
-               double azimuth_res, std::vector<std::vector<EdgeSample>>* samples) {
-  if (samples->size() < static_cast<std::size_t>(n)) samples->resize(n);
+               double azimuth_res, SampleSink sink, void* context) {
   for (int first = 0; first < n; first += kGroup) {
     const int used = std::min(kGroup, n - first);
     Lanes lanes;
-    std::vector<EdgeSample>* out[kGroup] = {};
     for (int l = 0; l < used; ++l) {
       const Edge& e = edges[first + l];
-      out[l] = &(*samples)[first + l];
-      out[l]->clear();
       // As WalkEdge: nothing for an empty edge (its lane keeps length 0).
       const double len = (e.b - e.a).norm();
       if (!(len > 0.0)) continue;
@@ -127,7 +124,7 @@ void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_re
       lanes.dy[l] = dir.y();
       lanes.len[l] = len;
     }
-    WalkGroup(lanes, used, cone, range_res, azimuth_res, out);
+    WalkGroup(lanes, first, used, cone, range_res, azimuth_res, sink, context);
   }
 }
 

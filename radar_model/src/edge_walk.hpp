@@ -2,8 +2,6 @@
 // (scan_geometry.hpp) emits, bit for bit, with the edges on SIMD lanes.
 #pragma once
 
-#include <vector>
-
 #include "dualgrid/core/types.hpp"
 
 namespace dualgrid::radar::detail {
@@ -33,14 +31,29 @@ struct EdgeSample {
   double range;
 };
 
+/// Receives the kept samples: sink(context, edge, sample) for edge `edge` (an index into the
+/// walked edges), in WalkEdge's order within each edge; the edges' samples come interleaved.
+using SampleSink = void (*)(void* context, int edge, const EdgeSample& sample);
+
 /// Walks every edge of edges[0, n) as WalkEdge(a, b, cone.position, range_res, azimuth_res,
-/// emit) does and stores, in WalkEdge's order, those of edge i's samples that the cone keeps in
-/// (*samples)[i] (grown to n entries if shorter; entries i < n cleared first, their capacity
-/// kept, later ones left alone). The values are bit for bit those of the scalar code: each lane
-/// performs the same IEEE operations in the same order (SSE4, no FMA). WalkEdge's third value
-/// (the sine at the sample) is not computed. Walking several edges at once hides the latency of
-/// each edge's chain of square roots and divisions (every sample's spacing depends on the last).
+/// emit) does and hands the samples that the cone keeps to `sink`. The values are bit for bit
+/// those of the scalar code: each lane performs the same IEEE operations in the same order
+/// (SSE4, no FMA). WalkEdge's third value (the sine at the sample) is not computed. Walking
+/// several edges at once hides the latency of each edge's chain of square roots and divisions
+/// (every sample's spacing depends on the last), and so does the sink's work done in between.
 void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
-               double azimuth_res, std::vector<std::vector<EdgeSample>>* samples);
+               double azimuth_res, SampleSink sink, void* context);
+
+/// WalkEdges with a callable sink(int edge, const EdgeSample& sample).
+template <class Sink>
+void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
+               double azimuth_res, Sink& sink) {
+  WalkEdges(
+      edges, n, cone, range_res, azimuth_res,
+      [](void* context, int edge, const EdgeSample& sample) {
+        (*static_cast<Sink*>(context))(edge, sample);
+      },
+      &sink);
+}
 
 }  // namespace dualgrid::radar::detail

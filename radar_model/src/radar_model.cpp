@@ -28,6 +28,7 @@ struct RailPiece {
   int polyline;
   Position a, b;
   int segment;
+  double rcs_per_m;  // [m^2 / m]
 };
 
 // One thread's working memory for the scans of one sensor at a time, kept between calls so that
@@ -37,9 +38,11 @@ struct ScanScratch {
   std::vector<Occluder> occluders;
   std::vector<int> candidate_targets;
   std::vector<RailPiece> rail_pieces;
-  std::vector<Edge> rail_edges;                     // the pieces' ends, for WalkEdges
-  std::vector<std::vector<EdgeSample>> rail_walks;  // per rail piece
-  std::vector<std::vector<int>> bins;               // kAzimuthBins lists when occlusion is on
+  std::vector<Edge> rail_edges;        // the pieces' ends, for WalkEdges
+  std::vector<int> piece_of;           // the rail piece of each kept rail scatterer
+  std::vector<int> piece_starts;       // GroupByPiece's counts
+  std::vector<Scatterer> rail_buffer;  // GroupByPiece's copy
+  std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
   std::vector<FaceSample> samples;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
 };
@@ -47,6 +50,23 @@ struct ScanScratch {
 ScanScratch& Scratch() {
   thread_local ScanScratch scratch;
   return scratch;
+}
+
+// Puts (*out)[begin, end) in the order of piece_of (one entry each, values in [0, pieces)),
+// stably: the scatterers of piece 0 first, each piece's in the order they came.
+void GroupByPiece(std::vector<Scatterer>* out, std::size_t begin, const std::vector<int>& piece_of,
+                  int pieces, ScanScratch& scratch) {
+  assert(out->size() - begin == piece_of.size());
+  if (std::is_sorted(piece_of.begin(), piece_of.end())) return;
+  std::vector<int>& starts = scratch.piece_starts;
+  starts.assign(pieces + 1, 0);
+  for (const int k : piece_of) ++starts[k + 1];
+  for (int k = 0; k < pieces; ++k) starts[k + 1] += starts[k];
+  std::vector<Scatterer>& buffer = scratch.rail_buffer;
+  buffer.resize(piece_of.size());
+  for (std::size_t i = 0; i < piece_of.size(); ++i)
+    buffer[starts[piece_of[i]]++] = (*out)[begin + i];
+  std::copy(buffer.begin(), buffer.end(), out->begin() + static_cast<std::ptrdiff_t>(begin));
 }
 
 }  // namespace
@@ -155,7 +175,8 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
       if (local[0].norm() < 1e-9 || local[1].norm() < 1e-9) continue;
       const Interval iv = IntervalOf(local, 2);
       if (!in_fov(iv)) continue;
-      rail_pieces.push_back({static_cast<int>(li), a, b, segment_index});
+      rail_pieces.push_back({static_cast<int>(li), a, b, segment_index,
+                             std::pow(10.0, 0.1 * scene.polylines[li].rcs_dbsm_per_metre)});
       Occluder o;
       o.owner = -1 - segment_index;
       o.is_box = false;
@@ -218,21 +239,22 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   // some of it is in view): those that OutsideFov rejects skip the atan2 (the same outcome).
   const double fov_cos_bound = FovCosBound(half_fov);
   // A point q kept by the first tests (range and field of view), with its local coordinates and
-  // range: the azimuth, the window and occlusion decide.
+  // range: the azimuth, the window and occlusion decide. True when it became a scatterer.
   const auto consider_kept = [&](const Position& q, const Position& local, double range,
                                  const Velocity& v, double rcs_m2, int source_id, int owner) {
     Scatterer sc;
     sc.truth.range = range;
     sc.truth.azimuth = std::atan2(local.y(), local.x());
-    if (std::abs(sc.truth.azimuth) > half_fov) return;
+    if (std::abs(sc.truth.azimuth) > half_fov) return false;
     sc.truth.range_rate = (v - vs).dot(q - s) / sc.truth.range;
-    if (!model.InWindow(sc.truth) || occluded(q, owner, sc.truth)) return;
+    if (!model.InWindow(sc.truth) || occluded(q, owner, sc.truth)) return false;
     sc.position = q;
     sc.velocity = v;
     sc.rcs_m2 = rcs_m2;
     sc.source_id = source_id;
     sc.origin = q;
     out.push_back(sc);
+    return true;
   };
   const auto consider = [&](const Position& q, const Velocity& v, double rcs_m2, int source_id,
                             int owner) {
@@ -254,9 +276,10 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
                   });
   }
 
-  // 3. Guard rails: static line scatterers, RCS per metre of length.
-  // The pieces are walked together first (WalkEdge's samples, several pieces on SIMD lanes),
-  // keeping the samples that pass `consider`'s first tests.
+  // 3. Guard rails: static line scatterers, RCS per metre of length. The pieces are walked
+  // together (WalkEdge's samples, several pieces on SIMD lanes, those outside the range or the
+  // field of view dropped there), their samples considered as they come, then the scatterers
+  // put back piece after piece, the order of walking the pieces one by one.
   std::vector<Edge>& rail_edges = scratch.rail_edges;
   rail_edges.clear();
   for (const RailPiece& piece : rail_pieces) rail_edges.push_back({piece.a, piece.b});
@@ -266,16 +289,18 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   cone.min_range = p.min_range;
   cone.max_range = p.max_range;
   cone.fov_cos_bound = fov_cos_bound;
-  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), cone, p.range_resolution,
-            p.azimuth_resolution, &scratch.rail_walks);
-  for (std::size_t k = 0; k < rail_pieces.size(); ++k) {
+  const std::size_t rails_begin = out.size();
+  std::vector<int>& piece_of = scratch.piece_of;
+  piece_of.clear();
+  auto sink = [&](int k, const EdgeSample& e) {
     const RailPiece& piece = rail_pieces[k];
-    const Polyline& line = scene.polylines[piece.polyline];
-    const double rcs_per_m = std::pow(10.0, 0.1 * line.rcs_dbsm_per_metre);
-    for (const EdgeSample& e : scratch.rail_walks[k])
-      consider_kept(e.q, e.local, e.range, Velocity::Zero(), rcs_per_m * e.ds, line.id,
-                    -1 - piece.segment);
-  }
+    if (consider_kept(e.q, e.local, e.range, Velocity::Zero(), piece.rcs_per_m * e.ds,
+                      scene.polylines[piece.polyline].id, -1 - piece.segment))
+      piece_of.push_back(k);
+  };
+  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), cone, p.range_resolution,
+            p.azimuth_resolution, sink);
+  GroupByPiece(&out, rails_begin, piece_of, static_cast<int>(rail_pieces.size()), scratch);
 
   // 4. Multipath: the boxes' ghosts in the mirrors (docs/radar.md, "Multipath").
   if (options_.multipath.enabled) {

@@ -34,6 +34,19 @@ std::vector<EdgeSample> ScalarWalk(const Edge& e, const SensorCone& c, double ra
   return out;
 }
 
+// WalkEdges' samples gathered per edge (each edge's in the order they came).
+std::vector<std::vector<EdgeSample>> Walk(const Edge* edges, int n, const SensorCone& cone,
+                                          double range_res, double azimuth_res) {
+  std::vector<std::vector<EdgeSample>> walks(n);
+  auto sink = [&](int edge, const EdgeSample& sample) {
+    REQUIRE(edge >= 0);
+    REQUIRE(edge < n);
+    walks[edge].push_back(sample);
+  };
+  WalkEdges(edges, n, cone, range_res, azimuth_res, sink);
+  return walks;
+}
+
 bool SameSample(const EdgeSample& a, const EdgeSample& b) {
   return SameBits(a.q.x(), b.q.x()) && SameBits(a.q.y(), b.q.y()) && SameBits(a.ds, b.ds) &&
          SameBits(a.local.x(), b.local.x()) && SameBits(a.local.y(), b.local.y()) &&
@@ -65,7 +78,6 @@ Edge RandomEdge(CounterRng& rng, const Position& s) {
 }  // namespace
 
 TEST_CASE("WalkEdges gives the kept samples of WalkEdge bit for bit", "[radar][edge_walk]") {
-  std::vector<std::vector<EdgeSample>> walks;  // reused across scenes, as the scan's scratch
   std::size_t walked = 0, kept = 0;
   for (std::uint32_t scene = 0; scene < 60; ++scene) {
     CounterRng rng(23, RngPurpose::kTest, scene, 0);
@@ -74,8 +86,7 @@ TEST_CASE("WalkEdges gives the kept samples of WalkEdge bit for bit", "[radar][e
     const int n = static_cast<int>(scene % 11);  // 0 to 10: groups of lanes and leftovers
     std::vector<Edge> edges;
     for (int i = 0; i < n; ++i) edges.push_back(RandomEdge(rng, cone.position));
-    WalkEdges(edges.data(), n, cone, range_res, azimuth_res, &walks);
-    REQUIRE(walks.size() >= static_cast<std::size_t>(n));
+    const auto walks = Walk(edges.data(), n, cone, range_res, azimuth_res);
     for (int i = 0; i < n; ++i) {
       const std::vector<EdgeSample> expected =
           ScalarWalk(edges[i], cone, range_res, azimuth_res, &walked);
@@ -98,9 +109,7 @@ TEST_CASE("WalkEdges on a sensor sitting on the edge and on an empty edge", "[ra
   const Edge edges[3] = {{Position(2.0, 1.0), Position(4.0, 1.0)},    // starts at the sensor
                          {Position(0.0, 1.0), Position(0.0, 1.0)},    // empty
                          {Position(-1.0, 1.0), Position(5.0, 1.0)}};  // runs through it
-  std::vector<std::vector<EdgeSample>> walks(5);
-  walks[1].push_back({Position(9.0, 9.0), 1.0, Position(7.0, 8.0), 10.6});  // cleared
-  WalkEdges(edges, 3, cone, 0.2, 0.02, &walks);
+  const auto walks = Walk(edges, 3, cone, 0.2, 0.02);
   CHECK(walks[1].empty());
   for (int i : {0, 2}) {
     const std::vector<EdgeSample> expected = ScalarWalk(edges[i], cone, 0.2, 0.02);
