@@ -11,6 +11,7 @@
 #include "../../radar_model/src/edge_walk.hpp"
 #include "../../radar_model/src/scan_geometry.hpp"
 #include "dualgrid/core/random.hpp"
+#include "dualgrid/radar_model/radar_model.hpp"
 
 using namespace dualgrid;
 using namespace dualgrid::radar::detail;
@@ -118,4 +119,57 @@ TEST_CASE("WalkEdges on a sensor sitting on the edge and on an empty edge", "[ra
     if (i == 0) CHECK(walks[i].front().ds == kMinSpacing);  // the first step, at the sensor
     for (std::size_t k = 0; k < expected.size(); ++k) CHECK(SameSample(walks[i][k], expected[k]));
   }
+}
+
+// The scan considers the rail samples as the lanes emit them (several pieces interleaved) and
+// then puts the scatterers back piece after piece (GroupByPiece in radar_model.cpp): the order of
+// walking the pieces one by one, which the resolution cells' sums depend on. Rails that run
+// towards +x with many segments (pieces walked together) must give their scatterers polyline
+// after polyline, each along +x.
+TEST_CASE("the scan keeps the rails' scatterers in walking order", "[radar][edge_walk]") {
+  const radar::RadarModel model(radar::DefaultRig(4.5, 1.8), radar::ModelOptions{}, 1);
+  std::size_t rail_scatterers = 0, polylines_seen = 0;
+  for (std::uint32_t scene_index = 0; scene_index < 20; ++scene_index) {
+    CounterRng rng(29, RngPurpose::kTest, scene_index, 0);
+    radar::Scene scene;
+    for (int i = 0; i < 4; ++i) {  // occluders
+      radar::Target t;
+      t.id = i;
+      t.box = OrientedBox{Position(rng.Uniform(-60.0, 60.0), rng.Uniform(-8.0, 8.0)),
+                          rng.Uniform(-0.3, 0.3), 4.5, 1.8};
+      scene.targets.push_back(t);
+    }
+    for (int i = 0; i < 4; ++i) {
+      radar::Polyline line;
+      line.id = 1000 + i;
+      const double y = (i % 2 == 0 ? -1.0 : 1.0) * rng.Uniform(4.0, 20.0);
+      for (double x = -200.0; x < 200.0; x += rng.Uniform(3.0, 60.0))
+        line.points.push_back(Position(x, y + rng.Uniform(-0.5, 0.5)));
+      scene.polylines.push_back(line);
+    }
+    radar::EgoMotion ego;
+    ego.pose = Pose2{Position(0.0, 0.0), rng.Uniform(-0.2, 0.2)};
+    ego.velocity = Velocity(25.0, 0.0);
+    ego.length = 4.5;
+    ego.width = 1.8;
+    for (int sensor = 0; sensor < static_cast<int>(model.sensors().size()); ++sensor) {
+      int last_id = -1;
+      double last_x = 0.0;
+      for (const radar::Scatterer& sc : model.VisibleScatterers(sensor, ego, scene)) {
+        if (sc.source_id < 1000) continue;
+        ++rail_scatterers;
+        INFO("scene " << scene_index << ", sensor " << sensor << ", rail " << sc.source_id);
+        REQUIRE(sc.source_id >= last_id);
+        if (sc.source_id == last_id) {
+          REQUIRE(sc.position.x() > last_x);
+        } else {
+          ++polylines_seen;
+        }
+        last_id = sc.source_id;
+        last_x = sc.position.x();
+      }
+    }
+  }
+  CHECK(rail_scatterers > 10000);
+  CHECK(polylines_seen > 100);  // several rails per scan, so pieces of several were interleaved
 }
