@@ -37,6 +37,7 @@ struct RailPiece {
 struct ScanScratch {
   std::vector<Occluder> occluders;
   std::vector<int> candidate_targets;
+  std::vector<std::array<Position, 4>> candidate_corners;  // the candidates' box corners
   std::vector<RailPiece> rail_pieces;
   std::vector<Edge> rail_edges;        // the pieces' ends, for WalkEdges
   std::vector<int> piece_of;           // the rail piece of each kept rail scatterer
@@ -138,6 +139,7 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   std::vector<int>& candidate_targets = scratch.candidate_targets;
   occluders.clear();
   candidate_targets.clear();
+  scratch.candidate_corners.clear();
   for (std::size_t ti = 0; ti < scene.targets.size(); ++ti) {
     const OrientedBox& box = scene.targets[ti].box;
     const double half_diag = 0.5 * std::hypot(box.length, box.width);
@@ -149,6 +151,7 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
     const Interval iv = IntervalOf(local, 4);
     if (!in_fov(iv)) continue;
     candidate_targets.push_back(static_cast<int>(ti));
+    scratch.candidate_corners.push_back(corners);
     Occluder o;
     o.owner = static_cast<int>(ti);
     o.is_box = true;
@@ -267,10 +270,12 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
 
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
   std::vector<FaceSample>& samples = scratch.samples;
-  for (const int ti : candidate_targets) {
+  for (std::size_t c = 0; c < candidate_targets.size(); ++c) {
+    const int ti = candidate_targets[c];
     const Target& t = scene.targets[ti];
-    BoxScatterers(t.box.Corners(), std::pow(10.0, 0.1 * t.rcs_dbsm), s, p.range_resolution,
-                  p.azimuth_resolution, samples, [&](const Position& q, double rcs_share) {
+    BoxScatterers(scratch.candidate_corners[c], std::pow(10.0, 0.1 * t.rcs_dbsm), s,
+                  p.range_resolution, p.azimuth_resolution, samples,
+                  [&](const Position& q, double rcs_share) {
                     consider(q, RigidPointVelocity(t.velocity, t.yaw_rate, t.box.center, q),
                              rcs_share, t.id, ti);
                   });
