@@ -70,6 +70,32 @@ void GroupByPiece(std::vector<Scatterer>* out, std::size_t begin, const std::vec
   std::copy(buffer.begin(), buffer.end(), out->begin() + static_cast<std::ptrdiff_t>(begin));
 }
 
+// Step 3 of VisibleScatterers for the pieces in scratch.rail_pieces: walked together
+// (WalkEdge's samples, several pieces on SIMD lanes, those outside the cone's range or field of
+// view dropped there), each kept sample handed to consider_kept(q, local, range, velocity, rcs,
+// source id, owner) -> bool (a scatterer appended to *out) as it comes, then the new scatterers
+// put back piece after piece: the order of walking the pieces one by one.
+template <class ConsiderKept>
+void ScanRails(const Scene& scene, const SensorCone& cone, const SensorParams& p,
+               ConsiderKept& consider_kept, std::vector<Scatterer>* out, ScanScratch& scratch) {
+  const std::vector<RailPiece>& pieces = scratch.rail_pieces;
+  std::vector<Edge>& edges = scratch.rail_edges;
+  edges.clear();
+  for (const RailPiece& piece : pieces) edges.push_back({piece.a, piece.b});
+  const std::size_t begin = out->size();
+  std::vector<int>& piece_of = scratch.piece_of;
+  piece_of.clear();
+  auto sink = [&](int k, const EdgeSample& e) {
+    const RailPiece& piece = pieces[k];
+    if (consider_kept(e.q, e.local, e.range, Velocity::Zero(), piece.rcs_per_m * e.ds,
+                      scene.polylines[piece.polyline].id, -1 - piece.segment))
+      piece_of.push_back(k);
+  };
+  WalkEdges(edges.data(), static_cast<int>(edges.size()), cone, p.range_resolution,
+            p.azimuth_resolution, sink);
+  GroupByPiece(out, begin, piece_of, static_cast<int>(pieces.size()), scratch);
+}
+
 }  // namespace
 
 RadarModel::RadarModel(std::vector<SensorParams> sensors, ModelOptions options, std::uint64_t seed)
@@ -281,31 +307,14 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
                   });
   }
 
-  // 3. Guard rails: static line scatterers, RCS per metre of length. The pieces are walked
-  // together (WalkEdge's samples, several pieces on SIMD lanes, those outside the range or the
-  // field of view dropped there), their samples considered as they come, then the scatterers
-  // put back piece after piece, the order of walking the pieces one by one.
-  std::vector<Edge>& rail_edges = scratch.rail_edges;
-  rail_edges.clear();
-  for (const RailPiece& piece : rail_pieces) rail_edges.push_back({piece.a, piece.b});
+  // 3. Guard rails: static line scatterers, RCS per metre of length.
   SensorCone cone;
   cone.position = s;
   cone.to_local = to_local;
   cone.min_range = p.min_range;
   cone.max_range = p.max_range;
   cone.fov_cos_bound = fov_cos_bound;
-  const std::size_t rails_begin = out.size();
-  std::vector<int>& piece_of = scratch.piece_of;
-  piece_of.clear();
-  auto sink = [&](int k, const EdgeSample& e) {
-    const RailPiece& piece = rail_pieces[k];
-    if (consider_kept(e.q, e.local, e.range, Velocity::Zero(), piece.rcs_per_m * e.ds,
-                      scene.polylines[piece.polyline].id, -1 - piece.segment))
-      piece_of.push_back(k);
-  };
-  WalkEdges(rail_edges.data(), static_cast<int>(rail_edges.size()), cone, p.range_resolution,
-            p.azimuth_resolution, sink);
-  GroupByPiece(&out, rails_begin, piece_of, static_cast<int>(rail_pieces.size()), scratch);
+  ScanRails(scene, cone, p, consider_kept, &out, scratch);
 
   // 4. Multipath: the boxes' ghosts in the mirrors (docs/radar.md, "Multipath").
   if (options_.multipath.enabled) {
