@@ -1,7 +1,6 @@
 #include "edge_walk.hpp"
 
 #include <algorithm>
-#include <cassert>
 
 #include <hwy/highway.h>
 
@@ -11,11 +10,15 @@ namespace dualgrid::radar::detail {
 namespace {
 
 namespace hn = hwy::HWY_NAMESPACE;
-using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
+constexpr int kLanes = 2;  // doubles per vector (128 bits)
+using DD = hn::FixedTag<double, kLanes>;
 using VD = hn::Vec<DD>;
+#if HWY_ARCH_X86
+// Built for x86-64-v2 (radar_model/CMakeLists.txt): SSE4 lanes, no FMA, the scalar code's bits
+// on every x86-64 CPU since 2009.
 static_assert(HWY_TARGET == HWY_SSE4, "the radar's SIMD target is pinned to SSE4");
+#endif
 
-constexpr int kLanes = 2;                  // doubles per SSE4 vector
 constexpr int kVectors = 2;                // vectors walked side by side
 constexpr int kGroup = kLanes * kVectors;  // edges per group
 
@@ -67,7 +70,6 @@ hn::Mask<DD> Keep(DD d, const SensorCone& cone, VD qx, VD qy, double* lx, double
 void WalkGroup(const Lanes& lanes, int first, int used, const SensorCone& cone, double range_res,
                double azimuth_res, SampleSink sink, void* context) {
   const DD d;
-  assert(hn::Lanes(d) == kLanes);
   const VD sx = hn::Set(d, cone.position.x()), sy = hn::Set(d, cone.position.y());
   const VD rr = hn::Set(d, range_res), ar = hn::Set(d, azimuth_res), half = hn::Set(d, 0.5);
   VD pos[kVectors];
