@@ -23,22 +23,6 @@ struct WeightTrace {
   std::vector<double> tangential_share;
 };
 
-/// Weight sums of the particles inside one box (WeightTraces' quantities, unnormalised).
-struct BoxWeights {
-  double position = 0, velocity = 0, weight = 0;  ///< sums of w_position, w_velocity, weight
-  /// Sums of w_position and w_velocity over the particles within WeightTrace::kGoodVelocity of
-  /// the box's velocity.
-  double position_good = 0, velocity_good = 0;
-};
-
-/// For each boxes[k]: the sums over the particles of `p` inside it (OrientedBox::Contains), each
-/// added in ascending particle order (the bits of one pass per box), with velocities[k] [m/s] the
-/// velocity for its good sums. Boxes and particles in one frame [m]; the two vectors are of one
-/// size. One pass over the particles, each tested against the boxes near it in x.
-std::vector<BoxWeights> SumWeightsInBoxes(const filter::ParticleSet& p,
-                                          const std::vector<OrientedBox>& boxes,
-                                          const std::vector<Velocity>& velocities);
-
 /// Weight traces of every vehicle in the grid (paper Fig. 4), from one filter's particles.
 /// Only traces that can still become the focus are kept: the requested vehicle's, those of the
 /// vehicles in the grid now, and the current leader's (most frames in the grid); a trace whose
