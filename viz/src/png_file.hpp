@@ -14,8 +14,9 @@ namespace dualgrid::viz::detail {
 /// what cairo_surface_write_to_png writes, so the file decodes
 /// (cairo_image_surface_create_from_png, any PNG reader) to the same pixels in the same format as
 /// cairo's file; only the compression differs (no row filters, zlib level 3: PNG_IMAGE_FLAG_FAST)
-/// and the file is tagged sRGB. Returns false when the file cannot be opened, encoded, written or
-/// closed (a partial file may remain, as with cairo's writer).
+/// and one ancillary chunk (sRGB where cairo writes bKGD, white). Returns false when the file
+/// cannot be opened, encoded, written or closed (a partial file may remain, as with cairo's
+/// writer).
 bool WritePng(cairo_surface_t* image, const std::string& path);
 
 }  // namespace dualgrid::viz::detail
