@@ -25,6 +25,7 @@ if(NOT TARGET SUMO::libsumocpp)
   message(STATUS "SUMO's CMake config not found (package sumo-tools); using ${LIBSUMO_LIBRARY}")
 endif()
 find_package(ZLIB REQUIRED)
+find_package(PNG REQUIRED)  # viz: the figures' PNG files (libpng-dev)
 find_package(Threads REQUIRED)  # outputs: the replay writer's worker thread
 find_package(EXPAT REQUIRED)  # users' SUMO files, parsed streaming (sim/xml_scan.hpp)
 find_package(PkgConfig REQUIRED)

@@ -86,6 +86,24 @@ json HeaderJson(const Header& h) {
 
 }  // namespace
 
+bool DeflateRle(const std::vector<std::uint8_t>& raw, std::vector<std::uint8_t>& packed) {
+  z_stream z{};
+  // Z_RLE matches runs of one byte only (distance 1), so the level chooses nothing but the
+  // header's FLEVEL bits; 1 says "fastest".
+  // One call takes at most 4 GiB (zlib's uInt); a frame is at most 1 GiB (the reader's bound).
+  if (raw.size() > UINT32_MAX || deflateInit2(&z, 1, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK)
+    return false;
+  packed.resize(deflateBound(&z, static_cast<uLong>(raw.size())));
+  z.next_in = const_cast<Bytef*>(raw.data());  // zlib's API is not const-correct; never written
+  z.avail_in = static_cast<uInt>(raw.size());
+  z.next_out = packed.data();
+  z.avail_out = static_cast<uInt>(packed.size());
+  const bool done = deflate(&z, Z_FINISH) == Z_STREAM_END;
+  packed.resize(z.total_out);
+  deflateEnd(&z);
+  return done;
+}
+
 double ParticleUnit(double extent_x, double extent_y) {
   const double extent = std::max(extent_x, extent_y);
   return std::max(0.01, extent / 65000.0);
@@ -141,13 +159,10 @@ void Writer::Write(const Frame& f) {
     Append(raw_, m.dynamic);
   }
   (void)n;
-  uLongf packed_size = compressBound(raw_.size());
-  packed_.resize(packed_size);
-  // Level 6 (zlib's default): ~10 % smaller than level 1 for ~1 ms more per frame, little at the
-  // default of two frames per simulated second.
-  if (compress2(packed_.data(), &packed_size, raw_.data(), raw_.size(), 6) != Z_OK)
+  if (!DeflateRle(raw_, packed_))
     throw std::runtime_error("replay: compressing frame t = " + FormatFixed(f.time, 2) +
                              " s failed");
+  const std::size_t packed_size = packed_.size();
   bin_.write(reinterpret_cast<const char*>(packed_.data()),
              static_cast<std::streamsize>(packed_size));
   if (!bin_)

@@ -11,6 +11,7 @@
 
 #include "dualgrid/core/types.hpp"
 #include "dualgrid/viz/figure.hpp"
+#include "png_file.hpp"
 
 namespace dualgrid::viz::detail {
 
@@ -118,8 +119,8 @@ void Canvas::Save(const std::string& path) const {
   }
   if (ext == ".png") {
     cairo_surface_flush(target.get());
-    const cairo_status_t status = cairo_surface_write_to_png(target.get(), path.c_str());
-    if (status != CAIRO_STATUS_SUCCESS) fail(status);
+    // The words cairo's own writer used for a file it could not open or write.
+    if (!WritePng(target.get(), path)) fail(CAIRO_STATUS_WRITE_ERROR);
   } else {
     // SVG and PDF surfaces write their file when finished; errors show in the surface status.
     cairo_surface_finish(target.get());

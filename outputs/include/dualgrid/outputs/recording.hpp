@@ -112,12 +112,18 @@ struct Header {
   std::string truth_label = "ground truth";
 };
 
+/// One frame's bytes as frames.bin holds them: `raw` deflated into one zlib stream (RFC 1950,
+/// which any inflater reads: zlib's uncompress, the browser's DecompressionStream("deflate"),
+/// Python's zlib.decompress) with zlib's run-length strategy (Z_RLE; docs/replay.md, "Cost", says
+/// why). Replaces `packed`; false if zlib fails (then `packed` holds nothing usable).
+bool DeflateRle(const std::vector<std::uint8_t>& raw, std::vector<std::uint8_t>& packed);
+
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).
 double ParticleUnit(double extent_x, double extent_y);
 
 /// Writes a recording frame by frame. Add takes the frame over and returns at once: `worker`
-/// packs, compresses (zlib, the run's largest output cost) and appends it while the run goes on,
-/// in the order added, so the files are the same bytes as written in line. At most
+/// packs, compresses (DeflateRle) and appends it while the run goes on, in the order added, so
+/// the files are the same bytes as written in line. At most
 /// kFramesInFlight frames wait or are being written (bounded memory): Add then waits for the
 /// oldest. A failed write throws std::runtime_error naming the file, from the Add that waits for
 /// that frame (the kFramesInFlight-th after it) or from Finish; the destructor waits for the
