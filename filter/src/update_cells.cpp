@@ -8,7 +8,7 @@
 
 #include "grid_internal.hpp"
 #include "team.hpp"
-#include "weigh_particles.hpp"
+#include "dualgrid/filter/weigh_particles.hpp"
 
 namespace dualgrid::filter {
 
