@@ -38,16 +38,6 @@ inline VF ModeFactor(WeightMode mode, VF lp, VF lv) {
   return mode == WeightMode::kPosition ? lp : mode == WeightMode::kVelocity ? lv : hn::Max(lp, lv);
 }
 
-// Candidate detections of a cell: up to three contiguous lists of grid-local positions [m] and
-// detection indices j (the 3 x 3 buckets' rows, or one pre-filtered list).
-struct Candidates {
-  const float* x[3];
-  const float* y[3];
-  const int* item[3];
-  std::int64_t n[3];
-  int lists;
-};
-
 // Folds candidate (e2, item) into the running lexicographic minimum (d2, jn) of the candidates
 // with e2 < cutoff2; jn = kNone (below every index) while there is none, so that a candidate at
 // e2 == d2 == cutoff2 never enters.
@@ -61,114 +51,36 @@ inline void Fold(VF e2, VI item, VF& d2, VI& jn) {
   jn = hn::IfThenElse(hn::RebindMask(di, better), item, jn);
 }
 
-// Squared distance [m^2] from the lanes' particles (x, y) to candidate k of list r.
-inline VF Distance2(const Candidates& cand, int r, std::int64_t k, VF x, VF y) {
+// Squared distance [m^2] from the lanes' particles (x, y) to the candidate at bucket order k.
+inline VF Distance2(const WeighInputs& in, std::int64_t k, VF x, VF y) {
   const DF df;
-  const VF ex = hn::Sub(hn::Set(df, cand.x[r][k]), x);
-  const VF ey = hn::Sub(hn::Set(df, cand.y[r][k]), y);
+  const VF ex = hn::Sub(hn::Set(df, in.det_x[k]), x);
+  const VF ey = hn::Sub(hn::Set(df, in.det_y[k]), y);
   return hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey));
 }
 
-// Nearest candidate detection of each lane's particle within the cutoff: squared distance
-// [m^2] into d2, index j (or -1) into jn. Ties go to the lower index. The result is the
-// lexicographic minimum of (e2, j) over the candidates with e2 < cutoff2: it does not depend on
-// the candidates' order (two running minima, even and odd candidates, then merged by the same
-// rule), nor on candidates with e2 >= cutoff2 in every lane.
-inline void Nearest(const WeighInputs& in, const Candidates& cand, VF x, VF y, VF& d2, VI& jn) {
+// Nearest candidate detection (CellParticles::cand) of each lane's particle within the cutoff:
+// squared distance [m^2] into d2, index j (or -1) into jn. Ties go to the lower index. The result
+// is the lexicographic minimum of (e2, j) over the candidates with e2 < cutoff2, which does not
+// depend on the candidates' order: two running minima, over the even and the odd candidates of
+// each range, merged by the same rule (half the dependency chain of one).
+inline void Nearest(const WeighInputs& in, const CellParticles& c, VF x, VF y, VF& d2, VI& jn) {
   const DF df;
   const DI di;
   d2 = hn::Set(df, in.cutoff2);
   jn = hn::Set(di, kNone);
   VF d2b = d2;
   VI jnb = jn;
-  for (int r = 0; r < cand.lists; ++r) {
-    const int* citem = cand.item[r];
-    std::int64_t k = 0;
-    for (; k + 2 <= cand.n[r]; k += 2) {
-      Fold(Distance2(cand, r, k, x, y), hn::Set(di, citem[k]), d2, jn);
-      Fold(Distance2(cand, r, k + 1, x, y), hn::Set(di, citem[k + 1]), d2b, jnb);
+  for (const auto& range : c.cand) {
+    std::int64_t k = range[0];
+    for (; k + 2 <= range[1]; k += 2) {
+      Fold(Distance2(in, k, x, y), hn::Set(di, in.det_item[k]), d2, jn);
+      Fold(Distance2(in, k + 1, x, y), hn::Set(di, in.det_item[k + 1]), d2b, jnb);
     }
-    if (k < cand.n[r]) Fold(Distance2(cand, r, k, x, y), hn::Set(di, citem[k]), d2, jn);
+    if (k < range[1]) Fold(Distance2(in, k, x, y), hn::Set(di, in.det_item[k]), d2, jn);
   }
   Fold(d2b, jnb, d2, jn);
   jn = hn::IfThenElse(hn::Eq(jn, hn::Set(di, kNone)), hn::Set(di, -1), jn);
-}
-
-// The cell's candidates as CellParticles::cand names them (bucket order).
-Candidates BucketCandidates(const WeighInputs& in, const CellParticles& c) {
-  Candidates cand{};
-  cand.lists = 3;
-  for (int r = 0; r < 3; ++r) {
-    cand.x[r] = in.det_x + c.cand[r][0];
-    cand.y[r] = in.det_y + c.cand[r][0];
-    cand.item[r] = in.det_item + c.cand[r][0];
-    cand.n[r] = c.cand[r][1] - c.cand[r][0];
-  }
-  return cand;
-}
-
-// Room of a pre-filtered candidate list (cells with more candidates scan the buckets' lists),
-// plus a vector's lanes for CompressStore's full-vector writes.
-constexpr std::int64_t kMaxFiltered = 512;
-struct FilteredList {
-  alignas(64) float x[kMaxFiltered + kMaxLanes];
-  alignas(64) float y[kMaxFiltered + kMaxLanes];
-  alignas(64) int item[kMaxFiltered + kMaxLanes];
-};
-
-// Keeps, in bucket order, the candidates whose squared distance g2 to the bounding box of the
-// cell's particles is below cutoff2, both in float. The same bits from Nearest (docs/algorithm.md,
-// step 5): for every particle, |fl(cx - px)| = fl(|cx - px|) >= fl(x0 - cx) or fl(cx - x1) (px
-// lies in [x0, x1], rounding is monotonic), likewise in y, and e2 = ex^2 + ey^2 takes the same
-// float operations as g2, so a dropped candidate has e2 >= g2 >= cutoff2 in every lane and never
-// enters Nearest's minimum. Returns `all` itself where the filter does not apply: more than
-// kMaxFiltered candidates, or a box that is not a box (NaN).
-Candidates FilterCandidates(const WeighInputs& in, const CellParticles& c, const Candidates& all,
-                            FilteredList& out) {
-  if (all.n[0] + all.n[1] + all.n[2] > kMaxFiltered) return all;
-  float x0 = c.x[c.lo], x1 = x0, y0 = c.y[c.lo], y1 = y0;
-  for (std::int64_t i = c.lo + 1; i < c.hi; ++i) {
-    x0 = std::min(x0, c.x[i]);
-    x1 = std::max(x1, c.x[i]);
-    y0 = std::min(y0, c.y[i]);
-    y1 = std::max(y1, c.y[i]);
-  }
-  if (!(x0 <= x1 && y0 <= y1)) return all;
-  const DF df;
-  const DI di;
-  const std::size_t lanes = hn::Lanes(df);
-  const VF vx0 = hn::Set(df, x0), vx1 = hn::Set(df, x1), vy0 = hn::Set(df, y0),
-           vy1 = hn::Set(df, y1), cutoff2 = hn::Set(df, in.cutoff2), zero = hn::Zero(df);
-  std::size_t n = 0;
-  // Appends the lanes of (x, y, item) among the first `valid` that lie within the cutoff.
-  const auto keep = [&](VF x, VF y, VI item, std::size_t valid) {
-    const VF gx = hn::Max(zero, hn::Max(hn::Sub(vx0, x), hn::Sub(x, vx1)));
-    const VF gy = hn::Max(zero, hn::Max(hn::Sub(vy0, y), hn::Sub(y, vy1)));
-    const auto near =
-        hn::And(hn::FirstN(df, valid), hn::Lt(hn::Add(hn::Mul(gx, gx), hn::Mul(gy, gy)), cutoff2));
-    hn::CompressStore(x, near, df, out.x + n);
-    hn::CompressStore(y, near, df, out.y + n);
-    n += hn::CompressStore(item, hn::RebindMask(di, near), di, out.item + n);
-  };
-  for (int r = 0; r < all.lists; ++r) {
-    const float *cx = all.x[r], *cy = all.y[r];
-    const int* citem = all.item[r];
-    const std::size_t len = static_cast<std::size_t>(all.n[r]);
-    std::size_t k = 0;
-    for (; k + lanes <= len; k += lanes)
-      keep(hn::LoadU(df, cx + k), hn::LoadU(df, cy + k), hn::LoadU(di, citem + k), lanes);
-    if (k < len) {  // the list's last < lanes candidates through lane buffers
-      alignas(64) float bx[kMaxLanes] = {}, by[kMaxLanes] = {};
-      alignas(64) int bi[kMaxLanes] = {};
-      for (std::size_t t = 0; t < len - k; ++t) {
-        bx[t] = cx[k + t];
-        by[t] = cy[k + t];
-        bi[t] = citem[k + t];
-      }
-      keep(hn::Load(df, bx), hn::Load(df, by), hn::Load(di, bi), len - k);
-    }
-  }
-  return Candidates{{out.x}, {out.y}, {out.item}, {static_cast<std::int64_t>(n)}, 1};
 }
 
 // Squared velocity error against detection jc's Doppler, in units of sigma_v^2 times 2 inv_2v2
@@ -194,9 +106,9 @@ inline VF VelocityError(const WeighInputs& in, VF vx, VF vy, VI jc) {
 }
 
 // One vector of particles at p[0..lanes), of which the first `valid` count.
-inline void WeighVector(const WeighInputs& in, const CellParticles& c, const Candidates& cand,
-                        const float* px, const float* py, const float* pvx, const float* pvy,
-                        float* pw, float* pwp, float* pwv, std::size_t valid, Acc& acc) {
+inline void WeighVector(const WeighInputs& in, const CellParticles& c, const float* px,
+                        const float* py, const float* pvx, const float* pvy, float* pw, float* pwp,
+                        float* pwv, std::size_t valid, Acc& acc) {
   const DF df;
   const DI di;
   const auto lanes = hn::FirstN(df, valid);
@@ -208,7 +120,7 @@ inline void WeighVector(const WeighInputs& in, const CellParticles& c, const Can
   const auto fast = hn::AndNot(slow, lanes);
   VF d2;
   VI jn;
-  Nearest(in, cand, x, y, d2, jn);
+  Nearest(in, c, x, y, d2, jn);
   const auto has = hn::RebindMask(df, hn::Gt(jn, hn::Set(di, -1)));
   // Without a detection in any lane both likelihoods are 0 in every lane: the exps and the
   // gathers are skipped (most vectors of a sparse scene; the same values as computing them).
@@ -264,13 +176,9 @@ CellSums WeighParticles(const WeighInputs& in, const CellParticles& c) {
   const std::int64_t n = static_cast<std::int64_t>(hn::Lanes(df));
   const VF z = hn::Zero(df);
   Acc acc{z, z, z, z, z, z};
-  FilteredList filtered;
-  const Candidates all = BucketCandidates(in, c);
-  const Candidates cand =
-      c.hi - c.lo > in.filter_above ? FilterCandidates(in, c, all, filtered) : all;
   std::int64_t i = c.lo;
   for (; i + n <= c.hi; i += n) {
-    WeighVector(in, c, cand, c.x + i, c.y + i, c.vx + i, c.vy + i, c.weight + i, c.w_position + i,
+    WeighVector(in, c, c.x + i, c.y + i, c.vx + i, c.vy + i, c.weight + i, c.w_position + i,
                 c.w_velocity + i, static_cast<std::size_t>(n), acc);
   }
   if (i < c.hi) {  // the tail through lane buffers (no read past the arrays)
@@ -278,7 +186,7 @@ CellSums WeighParticles(const WeighInputs& in, const CellParticles& c) {
     alignas(64) float buf[7][kMaxLanes] = {};
     const float* src[7] = {c.x, c.y, c.vx, c.vy, c.weight, c.w_position, c.w_velocity};
     for (int a = 0; a < 7; ++a) CopyTail(src[a] + i, buf[a], m);
-    WeighVector(in, c, cand, buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], m, acc);
+    WeighVector(in, c, buf[0], buf[1], buf[2], buf[3], buf[4], buf[5], buf[6], m, acc);
     CopyTail(buf[4], c.weight + i, m);
     CopyTail(buf[5], c.w_position + i, m);
     CopyTail(buf[6], c.w_velocity + i, m);

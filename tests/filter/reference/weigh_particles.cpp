@@ -1,5 +1,5 @@
 // Test reference (tests/filter/test_weigh_particles.cpp): WeighParticles of commit 27f8aeb (before
-// the candidate pre-filter and the two running minima of Nearest), namespace dualgrid::filter_ref.
+// the two running minima of Nearest), namespace dualgrid::filter_ref.
 // Not part of the library. Built for the library's SIMD target (tests/filter/CMakeLists.txt).
 #include "weigh_particles.hpp"
 

@@ -1,6 +1,6 @@
 // The per-particle part of step 5 (paper eqs. 7, 8, 14), vectorised: one cell's particles in
 // float, SIMD lanes through Highway. docs/algorithm.md, "Float state". Internal to the filter
-// (UpdateCells); public so that tests/filter can check its candidate pre-filter bit for bit.
+// (UpdateCells); public so that tests/filter can check it bit for bit against an earlier version.
 #pragma once
 
 #include <cstdint>
@@ -26,12 +26,6 @@ struct WeighInputs {
   /// compensated radial velocity vector (vr_x, vr_y) [m/s].
   const float *u0 = nullptr, *u1 = nullptr, *u2 = nullptr, *fit_k = nullptr, *fit_t = nullptr;
   const float *vr_x = nullptr, *vr_y = nullptr;
-  /// Cells with more particles than this get their candidate detections pre-filtered (those
-  /// within the cutoff of the cell's particles' bounding box, a conservative superset: the same
-  /// results); the others scan the 3 x 3 buckets' candidates as they are. A tuning knob, not a
-  /// switch of results (docs/algorithm.md, step 5).
-  std::int64_t filter_above = kDefaultFilterAbove;
-  static constexpr std::int64_t kDefaultFilterAbove = 8;
 };
 
 /// One cell's particles [lo, hi) of the sorted set (arrays as LocalParticles').
@@ -55,8 +49,7 @@ struct CellSums {
 /// slow mass); otherwise the nearest candidate detection within the cutoff (ties to the lower
 /// index j), the position and velocity likelihoods lp, lv (eqs. 7, 8: decayed prior `keep`
 /// where neither a detection nor the field of view scores it), weight <- m, w_position <- lp
-/// w_position wcap, w_velocity <- lv w_velocity wcap. Returns the sums. The results do not
-/// depend on in.filter_above (bit for bit). The lanes' sums are added
+/// w_position wcap, w_velocity <- lv w_velocity wcap. Returns the sums. The lanes' sums are added
 /// in a fixed order: the result depends on the particles alone (one SIMD target per build).
 CellSums WeighParticles(const WeighInputs& in, const CellParticles& c);
 
