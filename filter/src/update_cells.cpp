@@ -6,9 +6,9 @@
 #include <cmath>
 #include <limits>
 
+#include "dualgrid/filter/weigh_particles.hpp"
 #include "grid_internal.hpp"
 #include "team.hpp"
-#include "weigh_particles.hpp"
 
 namespace dualgrid::filter {
 

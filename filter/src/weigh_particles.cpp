@@ -1,10 +1,11 @@
 // WeighParticles (weigh_particles.hpp): the particle loop of step 5 on SIMD lanes (Highway, one
 // static target per build: docs/performance.md, "Issue 37", why not dynamic dispatch).
-#include "weigh_particles.hpp"
+#include "dualgrid/filter/weigh_particles.hpp"
 
 #include "dualgrid/filter/simd.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
@@ -37,27 +38,49 @@ inline VF ModeFactor(WeightMode mode, VF lp, VF lv) {
   return mode == WeightMode::kPosition ? lp : mode == WeightMode::kVelocity ? lv : hn::Max(lp, lv);
 }
 
-// Nearest candidate detection of each lane's particle within the cutoff: squared distance
-// [m^2] into d2, index j (or -1) into jn. Ties go to the lower index.
+// Folds candidate (e2, item) into the running lexicographic minimum (d2, jn) of the candidates
+// with e2 < cutoff2; jn = kNone (below every index) while there is none, so that a candidate at
+// e2 == d2 == cutoff2 never enters.
+constexpr int kNone = std::numeric_limits<int>::min();
+inline void Fold(VF e2, VI item, VF& d2, VI& jn) {
+  const DF df;
+  const DI di;
+  const auto better =
+      hn::Or(hn::Lt(e2, d2), hn::And(hn::Eq(e2, d2), hn::RebindMask(df, hn::Lt(item, jn))));
+  d2 = hn::IfThenElse(better, e2, d2);
+  jn = hn::IfThenElse(hn::RebindMask(di, better), item, jn);
+}
+
+// Squared distance [m^2] from the lanes' particles (x, y) to the candidate at bucket order k.
+inline VF Distance2(const WeighInputs& in, std::int64_t k, VF x, VF y) {
+  const DF df;
+  const VF ex = hn::Sub(hn::Set(df, in.det_x[k]), x);
+  const VF ey = hn::Sub(hn::Set(df, in.det_y[k]), y);
+  return hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey));
+}
+
+// Nearest candidate detection (CellParticles::cand) of each lane's particle within the cutoff:
+// squared distance [m^2] into d2, index j (or -1) into jn. Ties go to the lower index. The result
+// is the lexicographic minimum of (e2, j) over the candidates with e2 < cutoff2, which does not
+// depend on the candidates' order: two running minima, over the even and the odd candidates of
+// each range, merged by the same rule (half the dependency chain of one).
 inline void Nearest(const WeighInputs& in, const CellParticles& c, VF x, VF y, VF& d2, VI& jn) {
   const DF df;
   const DI di;
   d2 = hn::Set(df, in.cutoff2);
-  jn = hn::Set(di, -1);
-  const VI minus_one = hn::Set(di, -1);
+  jn = hn::Set(di, kNone);
+  VF d2b = d2;
+  VI jnb = jn;
   for (const auto& range : c.cand) {
-    for (std::int64_t k = range[0]; k < range[1]; ++k) {
-      const VF ex = hn::Sub(hn::Set(df, in.det_x[k]), x);
-      const VF ey = hn::Sub(hn::Set(df, in.det_y[k]), y);
-      const VF e2 = hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey));
-      const VI item = hn::Set(di, in.det_item[k]);
-      const auto tie = hn::And(
-          hn::Eq(e2, d2), hn::RebindMask(df, hn::And(hn::Gt(jn, minus_one), hn::Lt(item, jn))));
-      const auto better = hn::Or(hn::Lt(e2, d2), tie);
-      d2 = hn::IfThenElse(better, e2, d2);
-      jn = hn::IfThenElse(hn::RebindMask(di, better), item, jn);
+    std::int64_t k = range[0];
+    for (; k + 2 <= range[1]; k += 2) {
+      Fold(Distance2(in, k, x, y), hn::Set(di, in.det_item[k]), d2, jn);
+      Fold(Distance2(in, k + 1, x, y), hn::Set(di, in.det_item[k + 1]), d2b, jnb);
     }
+    if (k < range[1]) Fold(Distance2(in, k, x, y), hn::Set(di, in.det_item[k]), d2, jn);
   }
+  Fold(d2b, jnb, d2, jn);
+  jn = hn::IfThenElse(hn::Eq(jn, hn::Set(di, kNone)), hn::Set(di, -1), jn);
 }
 
 // Squared velocity error against detection jc's Doppler, in units of sigma_v^2 times 2 inv_2v2

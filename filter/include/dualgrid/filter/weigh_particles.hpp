@@ -1,5 +1,6 @@
-// The per-particle part of step 5 (paper eqs. 7, 8, 14), vectorised (internal): one cell's
-// particles in float, SIMD lanes through Highway. docs/algorithm.md, "Float state".
+// The per-particle part of step 5 (paper eqs. 7, 8, 14), vectorised: one cell's particles in
+// float, SIMD lanes through Highway. docs/algorithm.md, "Float state". Internal to the filter
+// (UpdateCells); public so that tests/filter can check it bit for bit against an earlier version.
 #pragma once
 
 #include <cstdint>
