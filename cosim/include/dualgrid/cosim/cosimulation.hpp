@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -118,7 +119,10 @@ class CoSimulation {
   std::vector<eval::ScenarioMetrics> Metrics() const;
 
  private:
-  void FilterAndScore(bool with_velocities);
+  friend class StepRegion;  // one step's parallel region (step_region.hpp)
+  // The step's filters, truth and scores, then `observe` on the calling thread unless one of
+  // them failed (their error, or else observe's, is thrown after the region).
+  void FilterAndScore(bool with_velocities, const std::function<void()>& observe);
   // The schedule of this step for `team` threads: round robin at first, then re-planned from the
   // filters' measured times (cosimulation.cpp, before ScheduleFor's definition).
   const ModeSchedule& ScheduleFor(int modes, int team);
