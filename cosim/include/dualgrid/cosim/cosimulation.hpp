@@ -33,14 +33,13 @@ struct CoSimOptions {
   /// depend on it.
   int threads = 0;
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
-  /// threads), it reads the next step while the others filter (SUMO's step and the radar scan;
-  /// for recorded data a twin of the source) and builds that step's measurement grid there
-  /// (Pipeline::ReadAhead, PrepareAhead; for SUMO the grid only while another thread still
-  /// filters, else Advance builds it with every thread). Results do not depend on it: the grid is
-  /// taken only for the same inputs, and an error or the end met reading ahead surfaces at the next
-  /// Step(), where it would have without it. SUMO then stands one step ahead between steps: a run
-  /// stopped early has simulated that step too (sumo(), SUMO's own outputs). Its gain is measured
-  /// in docs/performance.md.
+  /// threads), the step's region also reads the next step (SUMO's step and the radar scan; for
+  /// recorded data a twin of the source) and builds that step's measurement grid, on whichever
+  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion). Results do not depend on it:
+  /// the grid is taken only for the same inputs, and an error or the end met reading ahead
+  /// surfaces at the next Step(), where it would have without it. SUMO then stands one step ahead
+  /// between steps: a run stopped early has simulated that step too (sumo(), SUMO's own
+  /// outputs). Its gain is measured in docs/performance.md.
   bool read_ahead = true;
 };
 
@@ -64,7 +63,10 @@ struct StepView {
 };
 
 /// A hook run after every step, on the calling thread, in the order added. Exceptions thrown by
-/// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then).
+/// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then). With more
+/// than one thread, OnStep runs inside the step's parallel region (its own OpenMP loops then run
+/// on one thread) while another thread may be building the next step's measurement grid: read
+/// the step through the StepView only.
 class StepObserver {
  public:
   virtual ~StepObserver() = default;
@@ -90,13 +92,14 @@ class CoSimulation {
   /// `observer` is not owned and must outlive the run.
   void AddObserver(StepObserver* observer);
 
-  /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's region),
-  /// every mode's filter cycle, the shared ground truth and every mode's scoring (one parallel
-  /// region; with read_ahead, the next step's SUMO step and radar scan, and its measurement grid
-  /// while another thread still filters, on a thread with time to spare in it), then the
-  /// observers. False at the end of the run (nothing
-  /// done then). An exception of SUMO or the radar is thrown by the Step() of the step it belongs
-  /// to, after the observers of every earlier step ran.
+  /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's
+  /// region), then one parallel region: every mode's filter cycle (each on the thread
+  /// ModeSchedule names), the shared ground truth, every mode's scoring and, with read_ahead, the
+  /// next step's SUMO step, radar scan and measurement grid (each taken by whichever thread is
+  /// free: StepRegion), and the observers on the calling thread once the step is scored. False
+  /// at the end of the run (nothing done then). An exception of SUMO or the radar is thrown by
+  /// the Step() of the step it belongs to, after the observers of every earlier step ran; after
+  /// an error of the filters or the scoring no observer sees the step.
   bool Step();
   /// Ends the run: SUMO closes and writes its own outputs (Pipeline::Finish). Results, the last
   /// frame and the end state stay readable; Step() must not be called again.
