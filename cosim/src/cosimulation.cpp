@@ -10,7 +10,6 @@
 #include <atomic>
 #include <chrono>
 #include <exception>
-#include <functional>
 
 namespace dualgrid::cosim {
 
@@ -50,12 +49,11 @@ bool CoSimulation::Step() {
   // Every observer is asked (no short cut): each may keep its own schedule.
   for (StepObserver* o : observers_)
     with_velocities = o->WantsVelocities(steps_, f.time) || with_velocities;
+  FilterAndScore(with_velocities);
   const StepView view{steps_,   f,        pipeline_,      mode_names_,    snapshots_,
                       scorers_, objects_, truth_classes_, with_velocities};
-  FilterAndScore(with_velocities, [&] {
-    ++steps_;
-    for (StepObserver* o : observers_) o->OnStep(view);
-  });
+  ++steps_;
+  for (StepObserver* o : observers_) o->OnStep(view);
   return true;
 }
 
@@ -70,16 +68,12 @@ bool CoSimulation::Step() {
 // step's reading and measurement grid, the next cycle's noise) is taken by whichever thread is
 // free first (TaskBoard), so that a thread slowed down (by another process, or the output thread)
 // does not leave the other idle at the region's end. Results do not depend on either: every value
-// is computed by one thread from the same inputs. The observers run in the region too, on the
-// calling thread, once the step is scored: the next step's measurement grid is built meanwhile.
-void CoSimulation::FilterAndScore(bool with_velocities, const std::function<void()>& observe) {
+// is computed by one thread from the same inputs.
+void CoSimulation::FilterAndScore(bool with_velocities) {
   const int modes = static_cast<int>(mode_names_.size());
   objects_.clear();
   truth_classes_.clear();
-  if (modes == 0) {
-    observe();
-    return;
-  }
+  if (modes == 0) return;
   if (threads_ > 0) omp_set_num_threads(threads_);
   const int threads = omp_get_max_threads();
   const int team = std::min(modes, threads);
@@ -97,7 +91,6 @@ void CoSimulation::FilterAndScore(bool with_velocities, const std::function<void
   const auto run_thread = [&](int t) {
     for (int m : schedule.filters(t)) region.Filter(m);
     region.Work();
-    if (t == 0) region.Observe(observe);
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and

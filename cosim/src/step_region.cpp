@@ -83,7 +83,12 @@ void StepRegion::Run(int task) {
       if (read_ahead_) p.ReadAhead();  // noexcept: an error waits for the next Advance
       return;
     case kPrepareAhead:
-      if (read_ahead_) p.PrepareAhead();  // noexcept likewise
+      // For SUMO, only while a filter still runs: once every thread is free, the next Advance
+      // builds the grid faster with all of them than this thread alone (which of the two
+      // happens depends on timing, never a result). Recorded data: always (a twin's read).
+      if (read_ahead_ &&
+          (filters_done_.load(std::memory_order_acquire) < modes_ || !p.source().can_run_ahead()))
+        p.PrepareAhead();  // noexcept likewise
       return;
     default:
       if (task == NoiseTask()) {
@@ -126,31 +131,11 @@ void StepRegion::Score(int m) {
   });
 }
 
-void StepRegion::Observe(const std::function<void()>& observe) {
-  // Everything but the next step's measurement grid, which reads nothing the observers see and
-  // nothing they write (Pipeline::PrepareAhead).
-  board_.WaitUntil([this] {
-    for (int task = 0; task < board_.size(); ++task)
-      if (task != kPrepareAhead && !board_.done(task)) return false;
-    return true;
-  });
-  if (Failed()) return;  // the step is not complete: nobody observes it
-  Guarded(observe_error_, observe);
-}
-
-bool StepRegion::Failed() const {
-  if (truth_error_ || noise_error_) return true;
-  for (const auto& e : errors_)
-    if (e) return true;
-  return false;
-}
-
 void StepRegion::Rethrow() const {
   if (truth_error_) std::rethrow_exception(truth_error_);
   if (noise_error_) std::rethrow_exception(noise_error_);
   for (const auto& e : errors_)
     if (e) std::rethrow_exception(e);
-  if (observe_error_) std::rethrow_exception(observe_error_);
 }
 
 }  // namespace dualgrid::cosim

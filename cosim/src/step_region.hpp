@@ -3,15 +3,14 @@
 // cycle on the thread the ModeSchedule names (Filter), and the rest of the step as tasks that
 // whichever thread is free first takes (Work, a TaskBoard), in this order of priority: the ground
 // truth (from any filter finished: they share one geometry), the next step read ahead (SUMO's
-// step and the radar scan, or a recorded source's twin), the next step's measurement grid, each
-// mode's scoring, the next cycle's prediction noise. A task starts once its inputs are complete
-// (a score after its filter and the truth, the read-ahead after the truth, which reads the
-// source's ids, the grid after the read-ahead), so no value depends on the thread that computes
-// it. The calling thread then runs the step's observers (Observe) while the next grid may still be
-// built. Exceptions never leave a thread: kept per task and rethrown by Rethrow after the region.
+// step and the radar scan, or a recorded source's twin), the next step's measurement grid (for
+// SUMO only while a filter still runs), each mode's scoring, the next cycle's prediction noise. A
+// task starts once its inputs are complete (a score after its filter and the truth, the
+// read-ahead after the truth, which reads the source's ids, the grid after the read-ahead), so no
+// value depends on the thread that computes it. Exceptions never leave a thread: kept per task
+// and rethrown by Rethrow after the region.
 #include <atomic>
 #include <exception>
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -31,12 +30,7 @@ class StepRegion {
   /// Takes tasks until none is left to take (TaskBoard::Work); every thread of the region, after
   /// its filters.
   void Work();
-  /// The region's calling thread, after Work: once every task but the next step's measurement
-  /// grid is done, runs `observe` (the step's observers) unless a task failed; what it throws
-  /// is kept for Rethrow.
-  void Observe(const std::function<void()>& observe);
-  /// After the region: the first error of the truth, the noise, a mode (in mode order), or else
-  /// of the observers.
+  /// After the region: the first error of the truth, the noise or a mode (in mode order).
   void Rethrow() const;
 
  private:
@@ -47,7 +41,6 @@ class StepRegion {
   void Run(int task);
   void Truth();
   void Score(int m);
-  bool Failed() const;
 
   CoSimulation& cs_;
   const int modes_;
@@ -55,7 +48,7 @@ class StepRegion {
   OrientedBox ego_box_;
   bool score_points_;
   std::vector<std::exception_ptr> errors_;  // per mode: its filter's or its scoring's
-  std::exception_ptr truth_error_, noise_error_, observe_error_;
+  std::exception_ptr truth_error_, noise_error_;
   std::unique_ptr<std::atomic<int>[]> filtered_;  // per mode: 1 once its filter ran (or failed)
   std::atomic<int> filters_done_{0}, filters_ok_{0};
   bool truth_ok_ = false;  // written by the truth task, read by scores after it

@@ -11,7 +11,6 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,7 +34,8 @@ struct CoSimOptions {
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
   /// threads), the step's region also reads the next step (SUMO's step and the radar scan; for
   /// recorded data a twin of the source) and builds that step's measurement grid, on whichever
-  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion). Results do not depend on it:
+  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while a
+  /// filter still runs, else Advance builds it with every thread). Results do not depend on it:
   /// the grid is taken only for the same inputs, and an error or the end met reading ahead
   /// surfaces at the next Step(), where it would have without it. SUMO then stands one step ahead
   /// between steps: a run stopped early has simulated that step too (sumo(), SUMO's own
@@ -63,10 +63,7 @@ struct StepView {
 };
 
 /// A hook run after every step, on the calling thread, in the order added. Exceptions thrown by
-/// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then). With more
-/// than one thread, OnStep runs inside the step's parallel region (its own OpenMP loops then run
-/// on one thread) while another thread may be building the next step's measurement grid: read
-/// the step through the StepView only.
+/// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then).
 class StepObserver {
  public:
   virtual ~StepObserver() = default;
@@ -95,11 +92,10 @@ class CoSimulation {
   /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's
   /// region), then one parallel region: every mode's filter cycle (each on the thread
   /// ModeSchedule names), the shared ground truth, every mode's scoring and, with read_ahead, the
-  /// next step's SUMO step, radar scan and measurement grid (each taken by whichever thread is
-  /// free: StepRegion), and the observers on the calling thread once the step is scored. False
-  /// at the end of the run (nothing done then). An exception of SUMO or the radar is thrown by
-  /// the Step() of the step it belongs to, after the observers of every earlier step ran; after
-  /// an error of the filters or the scoring no observer sees the step.
+  /// next step's SUMO step and radar scan and (while a filter still runs) its measurement grid,
+  /// each taken by whichever thread is free (StepRegion); then the observers. False at the end
+  /// of the run (nothing done then). An exception of SUMO or the radar is thrown by the Step() of
+  /// the step it belongs to, after the observers of every earlier step ran.
   bool Step();
   /// Ends the run: SUMO closes and writes its own outputs (Pipeline::Finish). Results, the last
   /// frame and the end state stay readable; Step() must not be called again.
@@ -123,9 +119,7 @@ class CoSimulation {
 
  private:
   friend class StepRegion;  // one step's parallel region (step_region.hpp)
-  // The step's filters, truth and scores, then `observe` on the calling thread unless one of
-  // them failed (their error, or else observe's, is thrown after the region).
-  void FilterAndScore(bool with_velocities, const std::function<void()>& observe);
+  void FilterAndScore(bool with_velocities);
   // The schedule of this step for `team` threads: round robin at first, then re-planned from the
   // filters' measured times (cosimulation.cpp, before ScheduleFor's definition).
   const ModeSchedule& ScheduleFor(int modes, int team);
