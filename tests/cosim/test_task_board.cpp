@@ -74,6 +74,21 @@ TEST_CASE("TaskBoard: every task runs once, after the tasks it waits for", "[cos
   }
 }
 
+TEST_CASE("TaskBoard: under contention every task is claimed by one thread only", "[cosim]") {
+  // Many tiny tasks, all ready, four threads racing for each: a claim that is not atomic runs
+  // some twice.
+  const int n = 20000;
+  for (int round = 0; round < 5; ++round) {
+    TaskBoard board(n);
+    std::vector<std::atomic<int>> runs(n);
+    RunWorkers(
+        board, 4, [](int) { return true; }, [&](int, int i) { ++runs[i]; });
+    int wrong = 0;
+    for (int i = 0; i < n; ++i) wrong += runs[i].load() != 1 ? 1 : 0;
+    CHECK(wrong == 0);
+  }
+}
+
 TEST_CASE("TaskBoard: a sleeping thread wakes for work made ready outside the board", "[cosim]") {
   // Task 0 is ready only once `outside` is set by a thread that is not working on the board (as
   // a filter finishing): Wake() must reach the thread sleeping in Work.
