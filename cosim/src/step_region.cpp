@@ -47,8 +47,9 @@ void StepRegion::Filter(int m) {
   // Mode m's own slot, read after the region (its end orders the accesses): ScheduleFor.
   cs_.filter_seconds_[m] +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!errors_[m]) filters_ok_.fetch_add(1, std::memory_order_acq_rel);
+  // filtered_[m] first: a thread that sees the counts (Ready's truth) then sees it too (Truth).
   filtered_[m].store(1, std::memory_order_release);
+  if (!errors_[m]) filters_ok_.fetch_add(1, std::memory_order_acq_rel);
   filters_done_.fetch_add(1, std::memory_order_acq_rel);
   board_.Wake();
 }
