@@ -2,6 +2,8 @@
 
 #include "dualgrid/cosim/mode_schedule.hpp"
 
+#include "step_region.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -58,12 +60,15 @@ bool CoSimulation::Step() {
 // The modes run concurrently, one thread each, in one parallel region per step instead of ~40 (the
 // filters' regions and barriers, three times): robust when another process shares the cores
 // (docs/performance.md). With one mode (or one thread) the filter's own loops are parallel
-// instead. Which thread runs what is fixed (ModeSchedule), not left to a task queue: a filter's
-// state (~2-3 MB) then stays in the cache of the core that updated it last step, and its snapshot
-// is taken there at once. With tasks, a mode moved between cores from step to step and every pass
-// over its cells paid for the move (+28 % CPU time on the recorded loop, docs/performance.md).
-// Results do not depend on the schedule: every value is computed by one thread from the same
-// inputs.
+// instead. Which thread filters which mode is fixed (ModeSchedule), not left to a task queue: a
+// filter's state (~2-3 MB) then stays in the cache of the core that updated it last step, and its
+// snapshot is taken there at once. With tasks, a mode moved between cores from step to step and
+// every pass over its cells paid for the move (+28 % CPU time on the recorded loop,
+// docs/performance.md). The rest of the step (RegionTask: the truth, the scoring, the next
+// step's reading and measurement grid, the next cycle's noise) is taken by whichever thread is
+// free first (TaskBoard), so that a thread slowed down (by another process, or the output thread)
+// does not leave the other idle at the region's end. Results do not depend on either: every value
+// is computed by one thread from the same inputs.
 void CoSimulation::FilterAndScore(bool with_velocities) {
   const int modes = static_cast<int>(mode_names_.size());
   objects_.clear();
@@ -76,103 +81,16 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   // on 2 cores that is 1, and nested regions stay off.
   const int per_filter = std::max(1, threads / team);
   omp_set_max_active_levels(per_filter > 1 ? 2 : 1);
-  const sim::Frame& f = pipeline_.frame();
-  const OrientedBox ego_box = pipeline_.grid_frame().ToGrid(f.ego.box);
-  // Labelled recorded points, scored per mode at their cells.
-  const bool score_points = pipeline_.source().has_labels();
-  point_positions_.clear();
-  if (score_points)
-    for (const radar::Detection& d : pipeline_.detections())
-      point_positions_.push_back(pipeline_.grid_frame().ToGrid(d.position_world));
   const ModeSchedule& schedule = ScheduleFor(modes, team);
   // The prediction normals are the same for every mode: drawn once (here only at the first step;
-  // afterwards ahead, by the thread with the fewest filters, while the others still filter).
+  // afterwards ahead, in the region, for the next cycle).
   pipeline_.DrawNoise(false);
-  // Exceptions must not leave a parallel region: kept per mode, rethrown after it. Every flag is
-  // raised whatever happened, so that no thread waits for work that failed.
-  std::vector<std::exception_ptr> errors(modes);
-  std::exception_ptr truth_error, noise_error;
-  std::vector<std::atomic<int>> filtered(modes);
-  std::atomic<int> truth_done{0};
-  auto guarded = [](std::exception_ptr& slot, auto&& work) {
-    try {
-      work();
-    } catch (...) {
-      slot = std::current_exception();
-    }
-  };
-  auto raise = [](std::atomic<int>& flag) {
-    flag.store(1, std::memory_order_release);
-    flag.notify_all();
-  };
-  auto await = [](const std::atomic<int>& flag) {
-    while (flag.load(std::memory_order_acquire) == 0) flag.wait(0, std::memory_order_acquire);
-  };
-  // All filters share one grid geometry (centred on the same ego), so the ground truth per cell
-  // and per object is computed once, from the first filter its thread finished, for every mode.
-  // truth_ok: computed (not skipped after its filter failed); published by truth_done.
-  bool truth_ok = false;
-  auto truth = [&](int m) {
-    guarded(truth_error, [&] {
-      if (errors[m]) return;  // that error is the step's; the others are not scored
-      objects_ = pipeline_.TruthObjects(pipeline_.grid(m));
-      truth_classes_ =
-          TruthClasses(snapshots_[m], pipeline_.grid_frame(), f, pipeline_.config().sim);
-      truth_ok = true;
-    });
-    raise(truth_done);
-  };
-  auto score = [&](int m) {
-    await(filtered[m]);
-    await(truth_done);
-    guarded(errors[m], [&] {
-      if (errors[m]) return;
-      // The velocity moments (observers' pictures and files only) on the scoring thread: with
-      // the filters of two modes on one thread, this spreads them over both.
-      if (with_velocities) TakeVelocities(pipeline_.grid(m), snapshots_[m]);
-      if (!truth_ok) return;
-      scorers_[m].AddFrame(f.time, pipeline_.grid(m), snapshots_[m], objects_, truth_classes_,
-                           ego_box);
-      if (score_points)
-        scorers_[m].AddPoints(pipeline_.grid(m), snapshots_[m], point_positions_,
-                              pipeline_.labels(), ego_box);
-    });
-  };
+  // Reading ahead only when a thread filters fewer modes than another (3 modes on 2 threads):
+  // otherwise there is no time to spare in the region, and Advance does it all between regions.
+  StepRegion region(*this, with_velocities, read_ahead_ && team > 1 && modes % team != 0);
   const auto run_thread = [&](int t) {
-    for (int m : schedule.filters(t)) {
-      const auto start = std::chrono::steady_clock::now();
-      guarded(errors[m], [&] {
-        pipeline_.UpdateFilter(m);
-        TakeSnapshot(pipeline_.grid(m), false, snapshots_[m]);
-        // Here, not in the scorer: it may run on another core (ClassifySnapshot).
-        ClassifySnapshot(pipeline_.config().evaluation.dynamic_threshold, snapshots_[m]);
-      });
-      // Mode m's own slot, read after the region (its end orders the accesses): ScheduleFor.
-      filter_seconds_[m] +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      raise(filtered[m]);
-      if (t == schedule.truth_thread() && m == schedule.filters(t).front()) truth(m);
-    }
-    for (int m : schedule.scores(t)) score(m);
-    if (t == schedule.truth_thread()) {  // the other slot: no race
-      guarded(noise_error, [&] { pipeline_.DrawNoise(true); });
-      // In the time this thread would wait for the others, only when it runs fewer filters
-      // than they do (3 modes on 2 threads; otherwise there is no such time and Advance does
-      // it all between the regions): the next step from a source that can run ahead (SUMO's
-      // step and the radar scan), then its measurement grid while another thread still filters
-      // (once they are all done, Advance builds it faster with every thread than this one
-      // alone would); for recorded data the grid of the next step read from a twin of the
-      // source (reading it is cheap), in every step. After the truth (this
-      // thread's, above): nothing in this region reads the source or ids() afterwards, and
-      // every reader of the step reads the pipeline's copy of it.
-      if (read_ahead_ && team > 1 && schedule.filters(t).size() < schedule.filters(0).size()) {
-        pipeline_.ReadAhead();
-        const bool others_filtering = std::any_of(
-            filtered.begin(), filtered.end(),
-            [](const std::atomic<int>& done) { return done.load(std::memory_order_acquire) == 0; });
-        if (others_filtering || !pipeline_.source().can_run_ahead()) pipeline_.PrepareAhead();
-      }
-    }
+    for (int m : schedule.filters(t)) region.Filter(m);
+    region.Work();
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and
@@ -187,10 +105,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
     }
   }
   ++timed_steps_;
-  if (truth_error) std::rethrow_exception(truth_error);
-  if (noise_error) std::rethrow_exception(noise_error);
-  for (auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  region.Rethrow();
 }
 
 // The first kWarmUp steps are not timed (the first cycles fill the grid and are not typical);

@@ -68,23 +68,11 @@ ModeSchedule::ModeSchedule(int modes, int threads, std::span<const double> costs
       throw std::invalid_argument("ModeSchedule: a cost must be finite and >= 0, got " +
                                   std::to_string(c));
   filters_.resize(threads);
-  scores_.resize(threads);
   if (costs.empty()) {
     for (int m = 0; m < modes; ++m) filters_[m % threads].push_back(m);
   } else {
     const std::vector<int> place = BestPlacement(modes, threads, costs);
     for (int m = 0; m < modes; ++m) filters_[place[m]].push_back(m);  // increasing m
-  }
-  // Threads t < extra filter one mode more than the others; thread threads-1-t, if it is one with
-  // fewer, scores that thread's first mode (ready earliest) while t filters its next.
-  const int extra = modes % threads;
-  for (int t = 0; t < threads; ++t) {
-    const auto& own = filters_[t];
-    const int helper = threads - 1 - t;
-    for (std::size_t k = 0; k < own.size(); ++k) {
-      const bool handed_over = t < extra && helper >= extra && k == 0;
-      scores_[handed_over ? helper : t].push_back(own[k]);
-    }
   }
 }
 

@@ -32,14 +32,14 @@ struct CoSimOptions {
   /// depend on it.
   int threads = 0;
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
-  /// threads), it reads the next step while the others filter (SUMO's step and the radar scan;
-  /// for recorded data a twin of the source) and builds that step's measurement grid there
-  /// (Pipeline::ReadAhead, PrepareAhead; for SUMO the grid only while another thread still
-  /// filters, else Advance builds it with every thread). Results do not depend on it: the grid is
-  /// taken only for the same inputs, and an error or the end met reading ahead surfaces at the next
-  /// Step(), where it would have without it. SUMO then stands one step ahead between steps: a run
-  /// stopped early has simulated that step too (sumo(), SUMO's own outputs). Its gain is measured
-  /// in docs/performance.md.
+  /// threads), the step's region also reads the next step (SUMO's step and the radar scan; for
+  /// recorded data a twin of the source) and builds that step's measurement grid, on whichever
+  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while a
+  /// filter still runs, else Advance builds it with every thread). Results do not depend on it:
+  /// the grid is taken only for the same inputs, and an error or the end met reading ahead
+  /// surfaces at the next Step(), where it would have without it. SUMO then stands one step ahead
+  /// between steps: a run stopped early has simulated that step too (sumo(), SUMO's own
+  /// outputs). Its gain is measured in docs/performance.md.
   bool read_ahead = true;
 };
 
@@ -89,13 +89,13 @@ class CoSimulation {
   /// `observer` is not owned and must outlive the run.
   void AddObserver(StepObserver* observer);
 
-  /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's region),
-  /// every mode's filter cycle, the shared ground truth and every mode's scoring (one parallel
-  /// region; with read_ahead, the next step's SUMO step and radar scan, and its measurement grid
-  /// while another thread still filters, on a thread with time to spare in it), then the
-  /// observers. False at the end of the run (nothing
-  /// done then). An exception of SUMO or the radar is thrown by the Step() of the step it belongs
-  /// to, after the observers of every earlier step ran.
+  /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's
+  /// region), then one parallel region: every mode's filter cycle (each on the thread
+  /// ModeSchedule names), the shared ground truth, every mode's scoring and, with read_ahead, the
+  /// next step's SUMO step and radar scan and (while a filter still runs) its measurement grid,
+  /// each taken by whichever thread is free (StepRegion); then the observers. False at the end
+  /// of the run (nothing done then). An exception of SUMO or the radar is thrown by the Step() of
+  /// the step it belongs to, after the observers of every earlier step ran.
   bool Step();
   /// Ends the run: SUMO closes and writes its own outputs (Pipeline::Finish). Results, the last
   /// frame and the end state stay readable; Step() must not be called again.
@@ -118,6 +118,7 @@ class CoSimulation {
   std::vector<eval::ScenarioMetrics> Metrics() const;
 
  private:
+  friend class StepRegion;  // one step's parallel region (step_region.hpp)
   void FilterAndScore(bool with_velocities);
   // The schedule of this step for `team` threads: round robin at first, then re-planned from the
   // filters' measured times (cosimulation.cpp, before ScheduleFor's definition).

@@ -1,5 +1,5 @@
 #pragma once
-// Which thread filters and scores which weight mode in one co-simulation step.
+// Which thread filters which weight mode in one co-simulation step.
 //
 // Fixed for a given (modes, threads, costs), so that a filter runs on the same thread every step
 // and its state stays in that core's cache; the co-simulation re-plans it from measured filter
@@ -17,29 +17,21 @@ class ModeSchedule {
   /// `costs` (one per mode, finite and >= 0: e.g. measured seconds per cycle), the modes are
   /// placed so that the largest sum of costs on a thread is smallest (exhaustive search, up to 8
   /// modes; more keep m % threads; ties and anything not strictly better than m % threads keep
-  /// m % threads). Only the filters' costs count: the truth, the noise and the scoring handed to
-  /// a thread with fewer filters (below) are not in the sums. A thread filters its modes
-  /// in increasing m. Each mode is scored on the thread that filtered it, except that the first
-  /// filter of every thread with one more filter than others is scored by a thread with fewer (3
-  /// modes on 2 threads, no costs: thread 0 filters 0 and 2 and scores 2; thread 1 filters 1 and
-  /// scores 1 and 0). The ground truth of the step is computed by the last thread, right after
-  /// its first filter (it has the fewest filters).
+  /// m % threads). Only the filters are placed: the rest of a step (the truth, the scoring, the
+  /// reading ahead) goes to whichever thread is free (StepRegion, TaskBoard). A thread filters
+  /// its modes in increasing m.
   /// Throws std::invalid_argument outside these ranges, for a cost count other than `modes` or a
   /// negative or non-finite cost.
   ModeSchedule(int modes, int threads, std::span<const double> costs = {});
 
   /// Modes filtered by thread `t`, in order.
   const std::vector<int>& filters(int t) const { return filters_.at(t); }
-  /// Modes scored by thread `t`, in order (after its filters).
-  const std::vector<int>& scores(int t) const { return scores_.at(t); }
-  /// The thread that computes the step's ground truth after its first filter.
-  int truth_thread() const { return static_cast<int>(filters_.size()) - 1; }
   /// The largest sum of `costs` (one per mode) over the modes a thread filters.
   double MaxLoad(std::span<const double> costs) const;
   bool operator==(const ModeSchedule& o) const { return filters_ == o.filters_; }
 
  private:
-  std::vector<std::vector<int>> filters_, scores_;
+  std::vector<std::vector<int>> filters_;
 };
 
 }  // namespace dualgrid::cosim
