@@ -5,6 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
 
 #include "dualgrid/viz/replay_frame.hpp"
 
@@ -121,6 +127,31 @@ TEST_CASE("replay frame: cells take their masses' colours at their place; cluste
   CHECK(outline.r > 180);
   CHECK(outline.b > 150);
   CHECK(outline.g < 80);
+
+  // SavePng: a PNG of the frame's size, RGB (the frame is opaque); its pixels are those of
+  // viz's one PNG writer, which test_png_file checks against cairo's decoder.
+  const std::filesystem::path png =
+      std::filesystem::temp_directory_path() /
+      ("dualgrid_replay_frame_" + std::to_string(::getpid()) + ".png");
+  renderer.SavePng(png.string());
+  std::ifstream in(png, std::ios::binary);
+  std::vector<unsigned char> head(26);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  REQUIRE(in.gcount() == 26);
+  in.close();
+  std::filesystem::remove(png);
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  CHECK(std::equal(signature, signature + 8, head.begin()));
+  const auto be32 = [&](int at) {
+    return (head[at] << 24) | (head[at + 1] << 16) | (head[at + 2] << 8) | head[at + 3];
+  };
+  CHECK(std::string(head.begin() + 12, head.begin() + 16) == "IHDR");
+  CHECK(be32(16) == renderer.width());
+  CHECK(be32(20) == renderer.height());
+  CHECK(head[24] == 8);  // bit depth
+  CHECK(head[25] == 2);  // colour type: RGB
+  CHECK_THROWS_WITH(renderer.SavePng("/nonexistent_dir_dualgrid/frame.png"),
+                    Catch::Contains("cannot write"));
 }
 
 TEST_CASE("replay frame: bad layouts and pictures are refused naming the field", "[viz][replay]") {

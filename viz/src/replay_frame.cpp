@@ -9,6 +9,7 @@
 
 #include "cell_image.hpp"
 #include "draw.hpp"
+#include "png_file.hpp"
 
 namespace dualgrid::viz {
 
@@ -381,8 +382,7 @@ const std::uint8_t* ReplayRenderer::Render(const ReplayPicture& picture) {
 }
 
 void ReplayRenderer::SavePng(const std::string& path) const {
-  if (cairo_surface_write_to_png(impl_->frame.get(), path.c_str()) != CAIRO_STATUS_SUCCESS)
-    throw std::runtime_error("cannot write " + path);
+  if (!detail::WritePng(impl_->frame.get(), path)) throw std::runtime_error("cannot write " + path);
 }
 
 }  // namespace dualgrid::viz
