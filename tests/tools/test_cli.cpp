@@ -19,6 +19,12 @@ namespace {
 
 fs::path TempDir(const std::string& name) { return dualgrid::testing::TempDir("cli", name); }
 
+int CountOccurrences(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 // A path of cairo's SVG: its style attribute and its points (M/L coordinates only).
 struct SvgPath {
   std::string style;
@@ -49,6 +55,46 @@ TEST_CASE("--help lists the subcommands", "[cli]") {
   for (const char* name :
        {"\n  sim ", "\n  snapshot ", "\n  run ", "\n  experiment ", "\n  tangential "})
     CHECK(r.output.find(name) != std::string::npos);
+}
+
+// The launcher (tools/src/launcher.cpp): libgomp prints its settings at load with
+// OMP_DISPLAY_ENV; a program that re-executed itself would print them twice, first with libgomp's
+// default spin count.
+TEST_CASE("dualgrid sets OpenMP's wait policy before the program loads, in one load", "[cli]") {
+  const Result r = Shell("OMP_DISPLAY_ENV=VERBOSE " + std::string(DUALGRID_EXE) + " --version");
+  REQUIRE(r.code == 0);
+  CHECK(CountOccurrences(r.output, "OPENMP DISPLAY ENVIRONMENT BEGIN") == 1);
+  CHECK(r.output.find("OMP_WAIT_POLICY = 'PASSIVE'") != std::string::npos);
+  CHECK(r.output.find("GOMP_SPINCOUNT = '300'\n") != std::string::npos);
+  CHECK(r.output.find("dualgrid 0.") != std::string::npos);
+  // A policy the user chose is kept.
+  const Result user = Shell("OMP_DISPLAY_ENV=VERBOSE OMP_WAIT_POLICY=ACTIVE " +
+                            std::string(DUALGRID_EXE) + " --version");
+  REQUIRE(user.code == 0);
+  CHECK(CountOccurrences(user.output, "OPENMP DISPLAY ENVIRONMENT BEGIN") == 1);
+  CHECK(user.output.find("OMP_WAIT_POLICY = 'ACTIVE'") != std::string::npos);
+}
+
+TEST_CASE("Child runs and run lists name the command the user ran", "[cli]") {
+  const auto d = TempDir("launcher_list");
+  REQUIRE(Run("sweep tangential --set tangential.sensor=front --set tangential.count=1 --seeds 1 "
+              "--duration 2 --emit list -q --out " +
+              (d / "s").string())
+              .code == 0);
+  const std::string list = Slurp(d / "s" / "runs.txt");
+  REQUIRE(!list.empty());
+  const std::string first = list.substr(0, list.find(' '));
+  CHECK(fs::equivalent(fs::path(first.front() == '\'' ? first.substr(1, first.size() - 2) : first),
+                       fs::path(DUALGRID_EXE)));
+}
+
+TEST_CASE("A launcher without its program says so in one line", "[cli]") {
+  const auto d = TempDir("launcher_alone");
+  fs::copy_file(DUALGRID_EXE, d / "dualgrid");
+  const Result r = Shell((d / "dualgrid").string() + " --version");
+  CHECK(r.code == 1);
+  CHECK(CountLines(r.output) == 1);
+  CHECK(r.output.find("cannot find dualgrid-bin in " + d.string()) != std::string::npos);
 }
 
 TEST_CASE("Same scenario and seed give identical ground truth; another seed differs", "[cli]") {

@@ -49,7 +49,11 @@ std::string FilesystemMessage(const std::filesystem::filesystem_error& e) {
   return (where.empty() ? "" : where + ": ") + op + ": " + e.code().message();
 }
 
-std::string SelfPath(const char* argv0) {
+// The command the user ran: the launcher `dualgrid` names itself in DUALGRID_COMMAND before it
+// executes this program (tools/src/launcher.cpp); run directly, this program itself. Child runs
+// start it, and the installed data are found from it (PREFIX/bin/dualgrid -> PREFIX/share).
+std::string CommandPath(const char* argv0) {
+  if (const char* command = std::getenv("DUALGRID_COMMAND"); command && *command) return command;
   char buf[4096];
   const ssize_t n = readlink("/proc/self/exe", buf, sizeof buf - 1);
   return n > 0 ? std::string(buf, n) : std::string(argv0);
@@ -77,9 +81,10 @@ std::string HelpHint(const CLI::App& app) {
 // 2.5 ms with passive waiting (docs/performance.md). Purely passive waiting (a futex sleep at
 // every barrier) costs ~30 us per barrier on a quiet machine, though; a spin of ~3 us
 // (GOMP_SPINCOUNT=300) before sleeping keeps most of the quiet speed and the robustness under
-// load. libgomp reads these variables when it is loaded, before main, so the program re-executes
-// itself once with them set, unless the user chose a policy or spin count. Returns only if no
-// re-exec happened.
+// load. libgomp reads these variables when it is loaded, before main: the launcher `dualgrid`
+// sets them before it executes this program (tools/src/launcher.cpp). Run directly without them,
+// the program re-executes itself once with them set (loading every library twice), unless the
+// user chose a policy or spin count. Returns only if no re-exec happened.
 static void UseShortOpenMpSpinning(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
   if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) != 0 || setenv("GOMP_SPINCOUNT", "300", 1) != 0)
@@ -100,9 +105,10 @@ int main(int argc, char** argv) {
       "docs/scenarios.md)."};
   app.require_subcommand(1);
   app.footer(kExitCodes);
-  const dualgrid::sim::NetworkDirLocation data = dualgrid::sim::FindNetworkDir();
+  const std::string command = CommandPath(argv[0]);
+  const dualgrid::sim::NetworkDirLocation data = dualgrid::sim::FindNetworkDir(command);
   app.set_version_flag("--version", VersionText(data));
-  const CliContext ctx{data.dir, SelfPath(argv[0])};
+  const CliContext ctx{data.dir, command};
   const std::vector<Command> commands = {
       AddSimCommand(app, ctx),     AddSnapshotCommand(app, ctx),   AddRunCommand(app, ctx),
       AddReplayCommand(app, ctx),  AddExperimentCommand(app, ctx), AddTangentialCommand(app, ctx),
