@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <future>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -323,14 +325,20 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   const bool recording = observers.recording &&
                          observers.recording->Finish(metrics_json["modes"], cosim.pipeline().ids(),
                                                      r.complete, r.status);
+  // Every file written so far is final: the output worker digests them while this thread draws
+  // the figures (cairo stays on one thread, in the same order as ever).
+  const auto early = std::make_shared<FileDigests>();
+  std::future<void> early_done =
+      observers.worker.Post([early, &o] { *early = FolderDigests(o.out); });
   if (o.figures && !r.stop)
     WriteRunFigures(cosim, config, o, metrics, observers.files.traces(), observers.trace_mode,
                     &r.warnings);
   if (recording && !r.stop && (o.video || o.viewer)) WriteReplayFiles(o, callbacks, &r.warnings);
+  early_done.get();
 
   // Written last: a run folder without summary.json did not finish.
   AddSummary(cosim, config, r, observers, recorded, &summary);
-  summary["digests"] = OutputDigests(o.out);
+  summary["digests"] = OutputDigests(o.out, *early);
   SealOutputFolder(o.out);
   WriteTextFile(o.out / "summary.json", summary.dump(2) + "\n");
   return r;

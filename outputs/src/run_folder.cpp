@@ -14,34 +14,67 @@
 
 namespace dualgrid::outputs {
 
-nlohmann::json OutputDigests(const std::filesystem::path& dir) {
+namespace {
+
+// The files OutputDigests covers, sorted: every regular file under `dir` except SUMO's own
+// outputs (dated, and naming paths) and the additional files' copies (naming the run folder),
+// which are SUMO's business, not dualgrid's results; summary.json, which holds the digests; the
+// run marker; and the logs (*.log).
+std::vector<std::filesystem::path> DigestedFiles(const std::filesystem::path& dir) {
   std::vector<std::filesystem::path> files;
   for (auto it = std::filesystem::recursive_directory_iterator(dir);
        it != std::filesystem::recursive_directory_iterator(); ++it) {
-    // SUMO's own outputs (dated, and naming paths) and the additional files' copies (naming the
-    // run folder) are SUMO's business, not dualgrid's results.
     const std::string name = it->path().filename().string();
     if (it.depth() == 0 && it->is_directory() &&
         (name == "sumo_outputs" || name == "sumo_additional")) {
       it.disable_recursion_pending();
       continue;
     }
-    if (it->is_regular_file()) files.push_back(it->path());
+    if (!it->is_regular_file()) continue;
+    if (name == "summary.json" || name == kRunMarker || it->path().extension() == ".log") continue;
+    files.push_back(it->path());
   }
   std::sort(files.begin(), files.end());
+  return files;
+}
+
+// FNV-1a 64 of the file's bytes, with the size and modification time it had before it was read.
+FileDigest DigestFile(const std::filesystem::path& f, std::vector<char>& buf) {
+  std::error_code ec;  // a file that cannot be read is digested as empty, as before
+  FileDigest d{{}, std::filesystem::file_size(f, ec), std::filesystem::last_write_time(f, ec)};
+  std::uint64_t h = 14695981039346656037ull;
+  std::ifstream in(f, std::ios::binary);
+  while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
+    for (std::streamsize i = 0; i < in.gcount(); ++i)
+      h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ull;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  d.hex = hex;
+  return d;
+}
+
+}  // namespace
+
+FileDigests FolderDigests(const std::filesystem::path& dir) {
+  FileDigests digests;
+  std::vector<char> buf(1 << 16);
+  for (const auto& f : DigestedFiles(dir))
+    digests[std::filesystem::relative(f, dir).string()] = DigestFile(f, buf);
+  return digests;
+}
+
+nlohmann::json OutputDigests(const std::filesystem::path& dir, const FileDigests& earlier) {
   nlohmann::json digests = nlohmann::json::object();
   std::vector<char> buf(1 << 16);
-  for (const auto& f : files) {
-    const std::string name = f.filename().string();
-    if (name == "summary.json" || name == kRunMarker || f.extension() == ".log") continue;
-    std::uint64_t h = 14695981039346656037ull;
-    std::ifstream in(f, std::ios::binary);
-    while (in.read(buf.data(), static_cast<std::streamsize>(buf.size())) || in.gcount() > 0)
-      for (std::streamsize i = 0; i < in.gcount(); ++i)
-        h = (h ^ static_cast<unsigned char>(buf[i])) * 1099511628211ull;
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-    digests[std::filesystem::relative(f, dir).string()] = hex;
+  for (const auto& f : DigestedFiles(dir)) {
+    const std::string name = std::filesystem::relative(f, dir).string();
+    const auto known = earlier.find(name);
+    std::error_code ec;
+    if (known != earlier.end() && known->second.size == std::filesystem::file_size(f, ec) &&
+        known->second.modified == std::filesystem::last_write_time(f, ec) && !ec)
+      digests[name] = known->second.hex;
+    else
+      digests[name] = DigestFile(f, buf).hex;
   }
   return digests;
 }

@@ -2,7 +2,9 @@
 // files' digests and the record of how the run ended (both in summary.json, written last).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -11,6 +13,15 @@
 #include "dualgrid/outputs/output_guard.hpp"
 
 namespace dualgrid::outputs {
+
+/// One file's digest (OutputDigests) with the size and modification time it had when read.
+struct FileDigest {
+  std::string hex;  ///< 16 hex digits
+  std::uintmax_t size = 0;
+  std::filesystem::file_time_type modified;
+};
+/// By path relative to the folder digested.
+using FileDigests = std::map<std::string, FileDigest>;
 
 /// Test hook (docs/reliability.md): true when the environment variable DUALGRID_FAULT lists
 /// `what` (comma-separated), e.g. DUALGRID_FAULT=figure:tracked_share.png,run-seed:2. Lets the
@@ -22,7 +33,14 @@ bool FaultInjected(const std::string& what);
 /// own sumo.log and the seed runs' logs (*.log). Everything else a run writes is a function of the
 /// scenario and the seed alone (wall-clock times live only in summary.json), so equal digests
 /// mean equal outputs, whatever the thread count.
-nlohmann::json OutputDigests(const std::filesystem::path& dir);
+/// `earlier`: digests taken before (FolderDigests), reused for every file whose size and
+/// modification time are still those it had then (the run's files that were final early, digested
+/// while the figures are drawn); any other file is read again.
+nlohmann::json OutputDigests(const std::filesystem::path& dir, const FileDigests& earlier = {});
+
+/// The digests OutputDigests would give for the files under `dir` now, each with the size and
+/// modification time it had when read (relative path -> digest). Throws as OutputDigests.
+FileDigests FolderDigests(const std::filesystem::path& dir);
 
 /// After Start(), when `ego: {from_routes: auto}` chose the ego: prints to stderr the vehicle it
 /// chose and why (unless `quiet`), and a warning when no vehicle ever had another in its grid
