@@ -8,7 +8,12 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
+
+#include <zlib.h>
 
 #include "png_file.hpp"
 
@@ -105,4 +110,41 @@ TEST_CASE("a PNG that cannot be written is reported", "[viz][png]") {
   const Surface image(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 8, 8));
   CHECK_FALSE(WritePng(image.s, "/nonexistent_dir_dualgrid/x.png"));
   if (fs::exists("/dev/full")) CHECK_FALSE(WritePng(image.s, "/dev/full"));  // ENOSPC
+}
+
+TEST_CASE("the PNG holds IHDR, sRGB, IDAT and IEND, its rows unfiltered", "[viz][png]") {
+  const Surface image(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, 64, 40));
+  cairo_t* cr = cairo_create(image.s);
+  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
+  cairo_paint(cr);
+  cairo_set_source_rgb(cr, 0.2, 0.5, 0.7);
+  cairo_arc(cr, 30.0, 20.0, 15.0, 0.0, 2.0 * M_PI);
+  cairo_fill(cr);
+  cairo_destroy(cr);
+  cairo_surface_flush(image.s);
+  const fs::path path = TempDir() / "chunks.png";
+  REQUIRE(WritePng(image.s, path.string()));
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)),
+                                        std::istreambuf_iterator<char>());
+  std::vector<std::string> chunks;
+  std::vector<unsigned char> idat;
+  for (std::size_t at = 8; at + 12 <= file.size();) {
+    const std::size_t n = static_cast<std::size_t>(file[at]) << 24 | file[at + 1] << 16 |
+                          file[at + 2] << 8 | file[at + 3];
+    const std::string type(file.begin() + static_cast<long>(at) + 4,
+                           file.begin() + static_cast<long>(at) + 8);
+    if (type == "IDAT")
+      idat.insert(idat.end(), file.begin() + static_cast<long>(at) + 8,
+                  file.begin() + static_cast<long>(at + 8 + n));
+    if (chunks.empty() || chunks.back() != type) chunks.push_back(type);
+    at += 12 + n;
+  }
+  CHECK(chunks == std::vector<std::string>{"IHDR", "sRGB", "IDAT", "IEND"});
+  // Opaque: RGB rows of 1 + 64 * 3 bytes, each starting with its filter type (0: none).
+  std::vector<unsigned char> raw(40 * (1 + 64 * 3));
+  uLongf size = raw.size();
+  REQUIRE(uncompress(raw.data(), &size, idat.data(), idat.size()) == Z_OK);
+  REQUIRE(size == raw.size());
+  for (std::size_t row = 0; row < 40; ++row) CHECK(raw[row * (1 + 64 * 3)] == 0);
 }

@@ -1,6 +1,6 @@
-// Writing a cairo image surface as a PNG file, through libpng's simplified API with its fast
-// setting instead of cairo_surface_write_to_png's libpng defaults (docs/output.md, "PNG
-// encoding", says what it costs and saves).
+// Writing a cairo image surface as a PNG file through libpng, without row filters at zlib level
+// 1, instead of cairo_surface_write_to_png's libpng defaults (docs/output.md, "PNG encoding",
+// says what it costs and saves).
 #pragma once
 
 #include <cairo.h>
@@ -13,8 +13,8 @@ namespace dualgrid::viz::detail {
 /// 8-bit PNG, RGB when every pixel is opaque and RGBA otherwise, its colours un-premultiplied:
 /// what cairo_surface_write_to_png writes, so the file decodes
 /// (cairo_image_surface_create_from_png, any PNG reader) to the same pixels in the same format as
-/// cairo's file; only the compression differs (no row filters, zlib level 3: PNG_IMAGE_FLAG_FAST)
-/// and one ancillary chunk (sRGB where cairo writes bKGD, white). Returns false when the file
+/// cairo's file; only the compression differs (no row filters, zlib level 1) and one ancillary
+/// chunk (sRGB where cairo writes bKGD, white). Returns false when the file
 /// cannot be opened, encoded, written or closed (a partial file may remain, as with cairo's
 /// writer).
 bool WritePng(cairo_surface_t* image, const std::string& path);
