@@ -11,7 +11,7 @@ cp -a "$prefix" "$work/moved"
 moved=$work/moved
 fail() { echo "install_check: $*" >&2; exit 1; }
 
-for f in bin/dualgrid lib/cmake/dualgrid/dualgridConfig.cmake share/dualgrid/networks/highway.net.xml \
+for f in bin/dualgrid libexec/dualgrid-bin lib/cmake/dualgrid/dualgridConfig.cmake share/dualgrid/networks/highway.net.xml \
          share/dualgrid/scenarios/highway.yaml include/dualgrid/cosim/cosimulation.hpp \
          include/dualgrid/filter/dynamic_grid.hpp; do
   [ -e "$moved/$f" ] || fail "missing in the installed tree: $f"
