@@ -57,7 +57,7 @@ TEST_CASE("--help lists the subcommands", "[cli]") {
     CHECK(r.output.find(name) != std::string::npos);
 }
 
-// The launcher (tools/src/launcher.cpp): libgomp prints its settings at load with
+// The launcher (tools/launcher/launcher.cpp): libgomp prints its settings at load with
 // OMP_DISPLAY_ENV; a program that re-executed itself would print them twice, first with libgomp's
 // default spin count.
 TEST_CASE("dualgrid sets OpenMP's wait policy before the program loads, in one load", "[cli]") {
