@@ -130,27 +130,37 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
     throw std::invalid_argument("DynamicParticles: " + std::to_string(classes.size()) +
                                 " cell classes for a grid of " +
                                 std::to_string(grid.cells_x() * grid.cells_y()) + " cells");
-  out->clear();
   const std::optional<BoxTest> ego = exclude ? std::optional<BoxTest>(*exclude) : std::nullopt;
   const std::optional<CellWindow> near_ego =
       exclude ? std::optional<CellWindow>(CellWindow::Around(*exclude, grid)) : std::nullopt;
   // Cell by cell (the particles are sorted by cell): only the few dynamic cells' particles are
   // visited, in the particles' order. kDynamic is ClassifyCell's first test, dynamic > threshold.
   // Only the particles of cells near the ego box take its test (the others are outside it).
+  // Written through a pointer into `out`, grown ahead of each cell (its old entries are
+  // overwritten, never read; the vector is reused per step, so it grows past the last call's size
+  // only), not by push_back: its end pointer, stored per particle, would make the compiler reload
+  // the grid's arrays per particle.
   constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
   const int cells_x = grid.cells_x();
+  std::size_t m = 0;  // particles written
   grid.ForEachWeightedCellWhere(
       classes, [](std::uint8_t c) { return c == kDynamic; },
       [&](std::size_t k, std::int64_t first, std::int64_t last) {
+        const auto count = static_cast<std::size_t>(last - first);
+        if (m + count > out->size()) out->resize(m + count);  // past the last call's size only
+        eval::WeightedParticle* const dst = out->data();
         const bool test_ego = near_ego && near_ego->Holds(static_cast<int>(k % cells_x),
                                                           static_cast<int>(k / cells_x));
+        std::size_t j = m;
         for (std::int64_t i = first; i < last; ++i) {
           const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
           if (!(p.weight > 0.0f)) continue;
           if (test_ego && ego->Contains(p.position)) continue;
-          out->push_back({p.position, p.velocity, p.weight});
+          dst[j++] = {p.position, p.velocity, p.weight};
         }
+        m = j;
       });
+  out->resize(m);
 }
 
 ModeScorer::ModeScorer(const scenario::EvaluationConfig& config)

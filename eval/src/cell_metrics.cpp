@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -115,6 +116,48 @@ void ClassifyCells(std::span<const float> free, std::span<const float> static_oc
   }
 }
 
+namespace {
+
+using Bytes = std::uint8_t __attribute__((vector_size(16)));
+constexpr int kCodes = kNumTruthClasses * kNumPredictedClasses;  // code = 4 truth + predicted
+using Confusion = std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses>;
+
+// Counts the cells [0, end) (end a multiple of 16) into `frame`, 16 cells per step on byte lanes:
+// each cell's code (4 truth + predicted, or 15 when not observed) is compared with the 12 codes
+// and the matches counted in byte counters, which are added up every 255 steps (before they can
+// wrap). Returns false, with `frame` partly counted, when an observed cell has a class out of
+// range (the caller then counts cell by cell, which names the cell).
+bool CountLanes(const std::uint8_t* predicted, const std::uint8_t* truth,
+                const std::uint8_t* observed, std::size_t end, Confusion& frame) {
+  const Bytes all = ~Bytes{};
+  for (std::size_t i = 0; i < end;) {
+    const std::size_t chunk_end = std::min(end, i + 255 * 16);
+    Bytes count[kCodes] = {};
+    Bytes bad = {};
+    for (; i < chunk_end; i += 16) {
+      Bytes t, p, o = all;
+      std::memcpy(&t, truth + i, 16);
+      std::memcpy(&p, predicted + i, 16);
+      if (observed) {
+        std::memcpy(&o, observed + i, 16);
+        o = reinterpret_cast<Bytes>(o != 0);
+      }
+      bad |= o & reinterpret_cast<Bytes>((t >= kNumTruthClasses) | (p >= kNumPredictedClasses));
+      const Bytes code = ((t << 2) | p) | (~o & 15);
+      for (int k = 0; k < kCodes; ++k)
+        count[k] -= reinterpret_cast<Bytes>(code == static_cast<std::uint8_t>(k));
+    }
+    for (int lane = 0; lane < 16; ++lane)
+      if (bad[lane]) return false;
+    for (int k = 0; k < kCodes; ++k)
+      for (int lane = 0; lane < 16; ++lane)
+        frame[k / kNumPredictedClasses][k % kNumPredictedClasses] += count[k][lane];
+  }
+  return true;
+}
+
+}  // namespace
+
 void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predicted,
                                              std::span<const std::uint8_t> truth,
                                              std::span<const std::uint8_t> observed) {
@@ -123,19 +166,30 @@ void CellClassificationAccumulator::AddFrame(std::span<const std::uint8_t> predi
                                 std::to_string(predicted.size()) + " predicted, " +
                                 std::to_string(truth.size()) + " truth, " +
                                 std::to_string(observed.size()) + " observed)");
+  static_assert(kNumPredictedClasses == 4 && kCodes < 15, "CountLanes' codes");
   // Counted into a table of this frame first, so that a refused frame leaves nothing counted.
-  std::array<std::array<std::int64_t, kNumPredictedClasses>, kNumTruthClasses> frame{};
-  std::int64_t cells = 0;
-  for (std::size_t i = 0; i < truth.size(); ++i) {
+  // The cells on lanes first; the rest (or all, when the lanes met a bad class) one by one.
+  Confusion frame{};
+  std::size_t first = truth.size() - truth.size() % 16;
+  if (!CountLanes(predicted.data(), truth.data(), observed.empty() ? nullptr : observed.data(),
+                  first, frame)) {
+    frame = {};
+    first = 0;
+  }
+  for (std::size_t i = first; i < truth.size(); ++i) {
     if (!observed.empty() && observed[i] == 0) continue;
     if (truth[i] >= kNumTruthClasses || predicted[i] >= kNumPredictedClasses)
       throw std::invalid_argument("CellClassificationAccumulator::AddFrame: cell " +
                                   std::to_string(i) + " has class out of range");
     ++frame[truth[i]][predicted[i]];
-    ++cells;
   }
-  for (int t = 0; t < kNumTruthClasses; ++t)
-    for (int p = 0; p < kNumPredictedClasses; ++p) m_.confusion[t][p] += frame[t][p];
+  std::int64_t cells = 0;
+  for (int t = 0; t < kNumTruthClasses; ++t) {
+    for (int p = 0; p < kNumPredictedClasses; ++p) {
+      m_.confusion[t][p] += frame[t][p];
+      cells += frame[t][p];
+    }
+  }
   m_.cells += cells;
   ++m_.frames;
 }

@@ -28,6 +28,14 @@ std::int64_t FloorToInt(double v) {
   return t - static_cast<std::int64_t>(static_cast<double>(t) > v);
 }
 
+// The cell offsets of Chebyshev distance 1 and 2 in the upper half plane (dy > 0, or dy == 0 and
+// dx > 0): of two cells at one of these distances, exactly one sees the other at such an offset.
+struct Offset {
+  int dx, dy;
+};
+constexpr Offset kHalfRing1[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+constexpr Offset kHalfRing2[] = {{2, 0}, {-2, 1}, {2, 1}, {-2, 2}, {-1, 2}, {0, 2}, {1, 2}, {2, 2}};
+
 // Strict order used to break distance ties between core points: lexicographic (x, y).
 bool LexLess(const Position& a, const Position& b) {
   return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
@@ -159,18 +167,24 @@ void Dbscan::FineCells(std::span<const Position> points) {
 }
 
 int Dbscan::CoreComponents(std::span<const Position> points) {
-  // Cells up to two apart (5 x 5 block) can hold neighbours: 2 h < eps < 3 h.
+  // Cells up to two apart (5 x 5 block) can hold neighbours: h < eps < 2 h, and points of cells
+  // three apart are more than 2 h apart.
   const double eps2 = params_.eps * params_.eps;
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   // Each cell's core points, in input order (a stable filter of fine_sorted_).
   core_start_.resize(cells + 1);
-  core_sorted_.clear();
+  core_sorted_.resize(fine_sorted_.size());
+  int num_core = 0;
   for (int c = 0; c < cells; ++c) {
-    core_start_[c] = static_cast<int>(core_sorted_.size());
-    for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k)
-      if (core_[fine_sorted_[k]]) core_sorted_.push_back(fine_sorted_[k]);
+    core_start_[c] = num_core;
+    for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
+      const int i = fine_sorted_[k];
+      core_sorted_[num_core] = i;
+      num_core += core_[i];
+    }
   }
-  core_start_[cells] = static_cast<int>(core_sorted_.size());
+  core_start_[cells] = num_core;
+  core_sorted_.resize(num_core);
   parent_.resize(cells);
   for (int c = 0; c < cells; ++c) parent_[c] = c;
   auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
@@ -180,25 +194,24 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
     return false;
   };
   // Adjacent cells first (they almost always link), then the ring two cells away, which is then
-  // mostly joined already and skipped without a pair search. Cells without core points take no
-  // part (they stay their own roots and get no component).
-  for (const int ring : {1, 2}) {
+  // mostly joined already and skipped without a pair search. Each unordered pair of cells once:
+  // from the cell that sees the other at an offset of the upper half plane (kHalfRing). Cells
+  // without core points take no part (they stay their own roots and get no component).
+  for (const auto& offsets :
+       {std::span<const Offset>(kHalfRing1), std::span<const Offset>(kHalfRing2)}) {
     for (int a = 0; a < cells; ++a) {
       if (core_start_[a] == core_start_[a + 1]) continue;
       const int member = fine_sorted_[fine_start_[a]];  // all members share the coordinates
       const std::int64_t x = fx_[member], y = fy_[member];
-      for (std::int64_t dx = -ring; dx <= ring; ++dx) {
-        for (std::int64_t dy = -ring; dy <= ring; ++dy) {
-          if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
-          const int b = fine_.Find(x + dx, y + dy);
-          if (b <= a || core_start_[b] == core_start_[b + 1]) continue;  // each pair once
-          const int ra = FindRoot(a), rb = FindRoot(b);
-          if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
-        }
+      for (const Offset& d : offsets) {
+        const int b = fine_.Find(x + d.dx, y + d.dy);
+        if (b < 0 || core_start_[b] == core_start_[b + 1]) continue;
+        const int ra = FindRoot(a), rb = FindRoot(b);
+        if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
       }
     }
   }
-  // Compact component ids in cell order.
+  // Compact component ids in cell order; each cell's core points take its component.
   int num_components = 0;
   std::vector<int>& id_of_root = root_component_;
   id_of_root.assign(cells, -1);
@@ -206,8 +219,10 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
     if (core_start_[c] == core_start_[c + 1]) continue;
     const int r = FindRoot(c);
     if (id_of_root[r] < 0) id_of_root[r] = num_components++;
+    const int component = id_of_root[r];
+    for (int s = core_start_[c]; s < core_start_[c + 1]; ++s)
+      component_[core_sorted_[s]] = component;
   }
-  for (const int i : core_sorted_) component_[i] = id_of_root[FindRoot(fine_cell_[i])];
   return num_components;
 }
 

@@ -247,9 +247,12 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
   body.axis = UnitVector(ego.pose.yaw);
   body.half_length = 0.5 * ego.length - kEgoBodySkin;
   body.half_width = 0.5 * ego.width - kEgoBodySkin;
-  const auto occluded = [&](const Position& q, int owner, const Polar& truth) {
-    if (!options_.occlusion) return false;
-    if (has_body && LengthInsideBox(body, s, q) > kEgoBodyMargin) return true;
+  // The ego's body hides q (needs no azimuth).
+  const auto behind_body = [&](const Position& q) {
+    return has_body && LengthInsideBox(body, s, q) > kEgoBodyMargin;
+  };
+  // Another occluder hides q (the azimuth bins'); with behind_body, occluded(q, owner, truth).
+  const auto behind_others = [&](const Position& q, int owner, const Polar& truth) {
     const Vector2 dir_local = local_of(q) / truth.range;
     const Position end = q - kOcclusionShrink * (q - s) / truth.range;
     const int bi =
@@ -262,21 +265,29 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
     }
     return false;
   };
+  const auto occluded = [&](const Position& q, int owner, const Polar& truth) {
+    return options_.occlusion && (behind_body(q) || behind_others(q, owner, truth));
+  };
 
   std::vector<Scatterer> out;
   // Most walked rail samples lie outside the field of view (a rail piece is walked whole once
   // some of it is in view): those that OutsideFov rejects skip the atan2 (the same outcome).
   const double fov_cos_bound = FovCosBound(half_fov);
   // A point q kept by the first tests (range and field of view), with its local coordinates and
-  // range: the azimuth, the window and occlusion decide. True when it became a scatterer.
+  // range: the azimuth, the window and occlusion decide. True when it became a scatterer. The
+  // tests are pure and all must pass, so their order does not change the outcome: the ego's body
+  // first (it needs no azimuth, and a corner radar's view along the car is mostly behind it),
+  // then the atan2 and the rest.
   const auto consider_kept = [&](const Position& q, const Position& local, double range,
                                  const Velocity& v, double rcs_m2, int source_id, int owner) {
+    if (behind_body(q)) return false;
     Scatterer sc;
     sc.truth.range = range;
     sc.truth.azimuth = std::atan2(local.y(), local.x());
     if (std::abs(sc.truth.azimuth) > half_fov) return false;
     sc.truth.range_rate = (v - vs).dot(q - s) / sc.truth.range;
-    if (!model.InWindow(sc.truth) || occluded(q, owner, sc.truth)) return false;
+    if (!model.InWindow(sc.truth) || (options_.occlusion && behind_others(q, owner, sc.truth)))
+      return false;
     sc.position = q;
     sc.velocity = v;
     sc.rcs_m2 = rcs_m2;

@@ -141,6 +141,9 @@ TEST_CASE("DynamicParticles excludes exactly the particles inside the box, where
   cosim::DynamicParticles(grid, s.classes, std::nullopt, &all);
   REQUIRE(all.size() > 100);
   int boxes_cutting = 0;
+  // One vector reused for every box as the scorer reuses its own (longer and shorter results in
+  // turn): its old entries must be overwritten and its size set.
+  std::vector<eval::WeightedParticle> reused(all.size() + 7);
   for (const double yaw : {0.0, 0.3, 1.2, -2.0}) {
     for (const double size : {0.4, 1.5, 4.0}) {
       for (const Position& shift : {Position(0.0, 0.0), Position(0.7, -0.4), Position(60.0, 9.0)}) {
@@ -150,11 +153,15 @@ TEST_CASE("DynamicParticles excludes exactly the particles inside the box, where
         std::vector<eval::WeightedParticle> expected;
         for (const eval::WeightedParticle& p : all)
           if (!box.Contains(p.position)) expected.push_back(p);
+        cosim::DynamicParticles(grid, s.classes, box, &reused);
         REQUIRE(kept.size() == expected.size());
+        REQUIRE(reused.size() == expected.size());
         for (std::size_t i = 0; i < kept.size(); ++i) {
           CHECK(kept[i].position == expected[i].position);
           CHECK(kept[i].velocity == expected[i].velocity);
           CHECK(kept[i].weight == expected[i].weight);
+          CHECK(reused[i].position == expected[i].position);
+          CHECK(reused[i].weight == expected[i].weight);
         }
         boxes_cutting += kept.size() < all.size() && !kept.empty();
       }

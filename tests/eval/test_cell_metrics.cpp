@@ -130,6 +130,18 @@ TEST_CASE("The confusion matrix equals a plain count over random frames", "[cell
   observed[4] = 1;
   CHECK_THROWS_AS(acc.AddFrame(pred, truth, observed), std::invalid_argument);
   CHECK(acc.Result().cells == cells + 8);
+  // The same among cells counted 16 at a time: a predicted class 4 with truth 0 would read as
+  // truth 1, predicted 0 if it were counted.
+  std::vector<std::uint8_t> truth2(100, 0), pred2(100, 0), observed2(100, 0);
+  pred2[40] = 4;
+  acc.AddFrame(pred2, truth2, observed2);
+  CHECK(acc.Result().cells == cells + 8);
+  observed2[40] = 1;
+  observed2[99] = 1;
+  CHECK_THROWS_WITH(acc.AddFrame(pred2, truth2, observed2), Catch::Contains("cell 40 "));
+  CHECK(acc.Result().cells == cells + 8);
+  expected[0][0] += 8;
+  CHECK(acc.Result().confusion == expected);
 }
 
 TEST_CASE("Cell scores are empty without the class", "[cells]") {
