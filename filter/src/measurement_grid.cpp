@@ -290,12 +290,18 @@ void SettleZoned(const RowSensor& c, const double* phi, const double* cot, int n
     const double lc = (dxc - ax) * inv_r, half = per_rho2 * (dxc * dxc + c.dy * c.dy);
     const double l0 = lc - half, l1 = lc + half;
     if (!(l0 <= l1)) continue;  // NaN: no zone (Settle still decides)
-    const int zl = std::max(pos, static_cast<int>(std::clamp(std::ceil(l0), lo_l, hi_l)));
+    const int zl = static_cast<int>(std::clamp(std::ceil(l0), lo_l, hi_l));
     const int zh = std::min(e, static_cast<int>(std::clamp(std::floor(l1), lo_l, hi_l)));
-    if (zh < zl) continue;
-    if (zl > pos) Settle(c, pos, zl - 1, exact, view);
-    for (int lx = zl; lx <= zh; ++lx) exact.Add(lx);
-    pos = zh + 1;
+    if (zl > pos) {  // the stretch before the edge, also when no cell centre lies in its zone
+      const int end = std::min(zl - 1, e);
+      if (end - pos < 4) {  // as Settle would
+        for (; pos <= end; ++pos) exact.Add(pos);
+      } else {
+        Settle(c, pos, end, exact, view);
+        pos = end + 1;
+      }
+    }
+    for (; pos <= zh; ++pos) exact.Add(pos);
   }
   if (pos <= e) Settle(c, pos, e, exact, view);
 }
