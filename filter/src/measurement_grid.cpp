@@ -264,8 +264,9 @@ void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, std::uint8_t*
 }
 
 // Cells [a, e] of the row (inside the sensor's inner wedge), as Settle, segmented first at the
-// sensor's run edges: the cells whose true bearing lies within kEdgeZone of an edge (plus one
-// cell each side) go to the exact test, the stretches between them to Settle. The edges are
+// sensor's run edges: the cells whose true bearing lies within kEdgeZone of an edge go to the
+// exact test, the stretches between them to Settle (an edge whose zone holds no cell centre still
+// ends the stretch before it). The edges are
 // phi[0, n) [rad, ascending, relative to the boresight], cot[k] the cotangent of edge k's global
 // direction, so that its ray meets the row at dx = dy cot. Only the segmentation depends on this
 // geometry, never a cell's bits (Settle and the exact test decide them).
