@@ -27,6 +27,10 @@ constexpr int kStampColumns = 32;
 
 // Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
 constexpr double kAtanError = 5e-4;
+// Half width [rad] of the bearings around a run edge that SettleZoned leaves to the exact test:
+// beyond it a stretch's end points pass Settle's test (their computed bearings stay more than
+// 2 kAtanError + kAtanError inside the run).
+constexpr double kEdgeZone = 4.0 * kAtanError;
 
 namespace hn = hwy::HWY_NAMESPACE;
 using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
@@ -52,12 +56,14 @@ hn::Vec<DD> FastAtan2V(hn::Vec<DD> y, hn::Vec<DD> x) {
 
 // One sensor's constants along one logical row (FieldOfViewRow): cell lx's centre lies at
 // dx = x0 + (lx + 0.5) r - ox, dy from the sensor; cb, sb: cos, sin of the boresight.
-// bins[0, nbins): the sensor's bearing bins' ranges [m], inv_bin their inverse width [1/rad]; the
-// row starts at view + row in storage, logical column 0 at storage column sx0 of nx.
+// bins[0, nbins): the sensor's bearing bins' ranges [m], inv_bin their inverse width [1/rad],
+// run_end[b] the last bin of b's run of equal ranges; the row starts at view + row in storage,
+// logical column 0 at storage column sx0 of nx.
 struct RowSensor {
   double x0, r, ox, dy, cb, sb, tan_hf, half_fov, min2, max2;
   bool narrow;
   const double* bins;
+  const int* run_end;
   int nbins;
   double inv_bin;
   std::int64_t row, sx0, nx;
@@ -117,6 +123,188 @@ void ExactCells(const RowSensor& c, int* lx, int m, std::uint8_t* view) {
     view[s] |= static_cast<std::uint8_t>(kObserved | (br == kInf ? kNoReturn : 0) |
                                          (br != kInf && d2[i] < br * br ? kFreeRay : 0));
   }
+}
+
+// Cells queued for the exact test (ExactCells), in batches of kExactBatch; Flush at the end.
+class ExactQueue {
+ public:
+  ExactQueue(const RowSensor& c, std::uint8_t* view) : c_(c), view_(view) {}
+  void Add(int lx) {
+    lx_[n_++] = lx;
+    if (n_ == kExactBatch) Flush();
+  }
+  void Flush() {
+    ExactCells(c_, lx_, n_, view_);
+    n_ = 0;
+  }
+
+ private:
+  const RowSensor& c_;
+  std::uint8_t* view_;
+  int lx_[kExactBatch + 1];
+  int n_ = 0;
+};
+
+// FastAtan2 bearing [rad] of cell lx relative to the boresight; *fx: its distance along it [m].
+double RelOf(const RowSensor& c, int lx, double* fx) {
+  const double dxe = c.x0 + (lx + 0.5) * c.r - c.ox;
+  *fx = dxe * c.cb + c.dy * c.sb;
+  return FastAtan2(c.dy * c.cb - dxe * c.sb, *fx);
+}
+
+// The dx interval [*dmin, *dmax] [m] of the row's points inside the wedge of half angle
+// atan(tan_w) around the boresight (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0: three linear
+// conditions in dx); false when it is empty.
+bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax) {
+  *dmin = -kInf;
+  *dmax = kInf;
+  const double cb = c.cb, sb = c.sb, dy = c.dy;
+  for (const auto& [k, d] :
+       {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
+        std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
+    if (k > 0.0) {
+      *dmin = std::max(*dmin, -d / k);
+    } else if (k < 0.0) {
+      *dmax = std::min(*dmax, -d / k);
+    } else if (d < 0.0) {
+      *dmax = -kInf;
+    }
+  }
+  return *dmin <= *dmax;
+}
+
+// A narrow sensor's row [*lo_x, *hi_x] clipped to its wedge, two cells of margin (the exact test
+// still decides every cell), and the cells [*in_lo, *in_hi] of the inner wedge (half angle
+// atan(tan_in), one cell of margin; left empty when tan_in <= 0), which pass the field-of-view
+// part of Settle's test at once: segmenting the row there first saves the bisection down to the
+// wedge edges. False when the row misses the wedge.
+bool WedgeSpan(const RowSensor& c, double tan_in, int* lo_x, int* hi_x, int* in_lo, int* in_hi) {
+  const double ax = c.x0 + 0.5 * c.r - c.ox;  // dx of cell lx = ax + lx r
+  const double big = 4.0 * static_cast<double>(c.nx);
+  double dmin, dmax;
+  if (!WedgeInterval(c, c.tan_hf, &dmin, &dmax)) return false;
+  const double l0 = std::clamp(std::floor((dmin - ax) / c.r) - 2.0, -big, big);
+  const double l1 = std::clamp(std::ceil((dmax - ax) / c.r) + 2.0, -big, big);
+  *lo_x = std::max(*lo_x, static_cast<int>(l0));
+  *hi_x = std::min(*hi_x, static_cast<int>(l1));
+  if (tan_in > 0.0 && WedgeInterval(c, tan_in, &dmin, &dmax)) {
+    *in_lo = std::max(*lo_x,
+                      static_cast<int>(std::clamp(std::ceil((dmin - ax) / c.r) + 1.0, -big, big)));
+    *in_hi = std::min(*hi_x,
+                      static_cast<int>(std::clamp(std::floor((dmax - ax) / c.r) - 1.0, -big, big)));
+  }
+  return true;
+}
+
+// Cells [a, e] of the row, each given the bits of the exact test: a segment whose cells' bins
+// provably hold one range (below) is filled without per-cell bearings, any other is split in
+// two; segments under four cells go to the exact test. The true bearing is monotonic along a row
+// where fx > 0, and FastAtan2 is within kAtanError of it, so the cells' computed bearings lie
+// within 2 kAtanError of the hull of the end points' ones and their bins (a monotonic function of
+// the bearing) within the bins of that hull. If all those bins hold the same range, every cell
+// gets the same bin value as in the exact test without its atan2.
+void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, std::uint8_t* view) {
+  int stack[128][2];
+  int top = 0;
+  stack[top][0] = a0;
+  stack[top][1] = e0;
+  ++top;
+  while (top > 0) {
+    --top;
+    const int a = stack[top][0], e = stack[top][1];
+    if (e - a < 4) {
+      for (int lx = a; lx <= e; ++lx) exact.Add(lx);
+      continue;
+    }
+    double fxa, fxe;
+    const double ra = RelOf(c, a, &fxa), re = RelOf(c, e, &fxe);
+    const double lo = std::min(ra, re) - 2.0 * kAtanError, hi = std::max(ra, re) + 2.0 * kAtanError;
+    bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -c.half_fov && hi <= c.half_fov;
+    double br = kInf;
+    if (uniform) {
+      const int b0 = std::clamp(static_cast<int>((lo + c.half_fov) * c.inv_bin), 0, c.nbins - 1);
+      const int b1 = std::clamp(static_cast<int>((hi + c.half_fov) * c.inv_bin), 0, c.nbins - 1);
+      br = c.bins[b0];
+      uniform = c.run_end[b0] >= b1;
+    }
+    if (!uniform) {
+      const int mid = a + (e - a) / 2;
+      stack[top][0] = mid + 1;
+      stack[top][1] = e;
+      ++top;
+      stack[top][0] = a;
+      stack[top][1] = mid;
+      ++top;
+      continue;
+    }
+    // Branch-free over the segment (vectorises), split where the storage row wraps.
+    const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
+    const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
+    const double br2 = br * br;
+    const int wrap = static_cast<int>(c.nx - c.sx0);  // first lx whose storage column wraps
+    // Locals, not c's fields: the byte stores below may alias them (no vectorisation otherwise).
+    const double x0 = c.x0, r = c.r, ox = c.ox, dy = c.dy, cb = c.cb, sb = c.sb;
+    const double min2 = c.min2, max2 = c.max2, tan_hf = c.tan_hf;
+    const bool narrow = c.narrow;
+    for (int part = 0; part < 2; ++part) {
+      const int pa = part == 0 ? a : std::max(a, wrap);
+      const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+      std::uint8_t* dst = view + c.row + c.sx0 - (part == 0 ? 0 : c.nx);
+      for (int lx = pa; lx <= pe; ++lx) {
+        const double dx = x0 + (lx + 0.5) * r - ox;
+        const double d2 = dx * dx + dy * dy;
+        const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
+        const bool in = (d2 >= min2) & (d2 <= max2) &
+                        ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
+        const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
+        dst[lx] |= in ? v : 0;
+      }
+    }
+  }
+}
+
+// Cells [a, e] of the row (inside the sensor's inner wedge), as Settle, segmented first at the
+// sensor's run edges: the cells whose true bearing lies within kEdgeZone of an edge go to the
+// exact test, the stretches between them to Settle (an edge whose zone holds no cell centre still
+// ends the stretch before it). The edges are
+// phi[0, n) [rad, ascending, relative to the boresight], cot[k] the cotangent of edge k's global
+// direction, so that its ray meets the row at dx = dy cot. Only the segmentation depends on this
+// geometry, never a cell's bits (Settle and the exact test decide them).
+void SettleZoned(const RowSensor& c, const double* phi, const double* cot, int n, int a, int e,
+                 ExactQueue& exact, std::uint8_t* view) {
+  double fxa, fxe;
+  const double ra = RelOf(c, a, &fxa), re = RelOf(c, e, &fxe);
+  const double margin = kAtanError + kEdgeZone;
+  const int k0 = static_cast<int>(std::lower_bound(phi, phi + n, std::min(ra, re) - margin) - phi);
+  const int k1 = static_cast<int>(std::upper_bound(phi, phi + n, std::max(ra, re) + margin) - phi);
+  const bool up = ra <= re;                   // the bearing grows with lx
+  const double ax = c.x0 + 0.5 * c.r - c.ox;  // dx of cell lx = ax + lx r
+  const double lo_l = a - 1.0, hi_l = e + 1.0;
+  // Zone half width per unit rho^2 [cells / m^2], and 1 / r (inverses: zones only).
+  const double per_rho2 = 1.25 * kEdgeZone / (std::abs(c.dy) * c.r), inv_r = 1.0 / c.r;
+  int pos = a;  // cells [a, pos) are done
+  for (int i = 0; i < k1 - k0; ++i) {
+    const int k = up ? k0 + i : k1 - 1 - i;
+    // dx of the bearings phi[k] +- kEdgeZone, to first order in the angle (d dx / d phi =
+    // rho^2 / |dy|), with a quarter of margin for the curvature.
+    const double dxc = c.dy * cot[k];
+    const double lc = (dxc - ax) * inv_r, half = per_rho2 * (dxc * dxc + c.dy * c.dy);
+    const double l0 = lc - half, l1 = lc + half;
+    if (!(l0 <= l1)) continue;  // NaN: no zone (Settle still decides)
+    const int zl = static_cast<int>(std::clamp(std::ceil(l0), lo_l, hi_l));
+    const int zh = std::min(e, static_cast<int>(std::clamp(std::floor(l1), lo_l, hi_l)));
+    if (zl > pos) {  // the stretch before the edge, also when no cell centre lies in its zone
+      const int end = std::min(zl - 1, e);
+      if (end - pos < 4) {  // as Settle would
+        for (; pos <= end; ++pos) exact.Add(pos);
+      } else {
+        Settle(c, pos, end, exact, view);
+        pos = end + 1;
+      }
+    }
+    for (; pos <= zh; ++pos) exact.Add(pos);
+  }
+  if (pos <= e) Settle(c, pos, e, exact, view);
 }
 
 }  // namespace
@@ -228,6 +416,9 @@ void MeasurementGrid::Prepare(const Position& centre, std::span<const Measuremen
   }
   bin_range_.assign(bin_offset_[ns], kInf);
   bin_run_end_.resize(bin_range_.size());
+  edge_offset_.resize(ns + 1);
+  edge_phi_.resize(bin_range_.size());
+  edge_cot_.resize(bin_range_.size());
   sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
   PlaceDetections();
 }
@@ -417,6 +608,32 @@ void MeasurementGrid::FieldOfViewTables(std::span<const SensorCoverage> cov) {
                             : static_cast<int>(b - b_lo);
     }
   }
+  RunEdges(cov);
+}
+
+void MeasurementGrid::RunEdges(std::span<const SensorCoverage> cov) {
+  const int ns = static_cast<int>(cov.size());
+  const double w = params_.free_angle_bin;
+  const double cw = std::cos(w), sw = std::sin(w);
+  std::int64_t n = 0;
+  for (int k = 0; k < ns; ++k) {
+    edge_offset_[k] = n;
+    const std::int64_t b_lo = bin_offset_[k], b_hi = bin_offset_[k + 1];
+    const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
+    // (c, s): the direction of bin b's lower edge, -half_fov + b w, in the sensor frame, by
+    // rotation (its rounding only moves the zones, never a cell's bits).
+    double c = std::cos(cov[k].half_fov), s = -std::sin(cov[k].half_fov);
+    for (std::int64_t b = b_lo + 1; b < b_hi; ++b) {
+      const double c1 = c * cw - s * sw;
+      s = s * cw + c * sw;
+      c = c1;
+      if (bin_range_[b] == bin_range_[b - 1]) continue;
+      edge_phi_[n] = -cov[k].half_fov + static_cast<double>(b - b_lo) * w;
+      edge_cot_[n] = (c * cb - s * sb) / (c * sb + s * cb);  // global direction's x / y
+      ++n;
+    }
+  }
+  edge_offset_[ns] = n;
 }
 
 void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov) {
@@ -440,141 +657,40 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
     const bool narrow = sc.half_fov < 0.5 * kPi;
     const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
-    const int* const run_end = bin_run_end_.data() + bin_offset_[k];
     const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
-    const double* bins = bin_range_.data() + bin_offset_[k];
-    const int nbins = static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]);
-    const double inv_bin = 1.0 / params_.free_angle_bin;
-    const double ax = x0 + 0.5 * r - sc.origin.x();  // dx of cell lx = ax + lx * r
-    // Cells left to the exact per-cell test, in batches (ExactCells).
-    const RowSensor rs{x0,   r,      sc.origin.x(), dy,    cb,      sb,  tan_hf, sc.half_fov, min2,
-                       max2, narrow, bins,          nbins, inv_bin, row, sx0,    nx_};
-    int pending[kExactBatch + 1];
-    int np = 0;
-    const auto exact = [&](int lx) {
-      pending[np++] = lx;
-      if (np == kExactBatch) {
-        ExactCells(rs, pending, np, view_.data());
-        np = 0;
-      }
-    };
-    int lo_x = lx_lo, hi_x = lx_hi;
-    // Cells inside a wedge of half angle atan(tan_w) satisfy three linear conditions in dx
-    // (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0): their interval of dx.
-    const auto wedge = [&](double tan_w, double* dmin, double* dmax) {
-      *dmin = -kInf;
-      *dmax = kInf;
-      for (const auto& [c, d] :
-           {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
-            std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
-        if (c > 0.0) {
-          *dmin = std::max(*dmin, -d / c);
-        } else if (c < 0.0) {
-          *dmax = std::min(*dmax, -d / c);
-        } else if (d < 0.0) {
-          *dmax = -kInf;
-        }
-      }
-      return *dmin <= *dmax;
-    };
-    const double big = 4.0 * nx_;
-    int in_lo = 1, in_hi = 0;  // cells well inside the wedge (empty unless narrow)
-    if (narrow) {
-      // Clip the row to the wedge, two cells of margin (the exact test still decides every
-      // cell).
-      double dmin, dmax;
-      if (!wedge(tan_hf, &dmin, &dmax)) continue;
-      const double l0 = std::clamp(std::floor((dmin - ax) / r) - 2.0, -big, big);
-      const double l1 = std::clamp(std::ceil((dmax - ax) / r) + 2.0, -big, big);
-      lo_x = std::max(lo_x, static_cast<int>(l0));
-      hi_x = std::min(hi_x, static_cast<int>(l1));
-      // The cells of the inner wedge (half_fov - 4 kAtanError, one cell of margin) pass the
-      // field-of-view part of the segment test below: segmenting the row there first saves the
-      // bisection down to the wedge edges. Only the segmentation changes, not any cell's bits.
-      if (tan_in > 0.0 && wedge(tan_in, &dmin, &dmax)) {
-        in_lo = std::max(lo_x,
-                         static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big)));
-        in_hi = std::min(
-            hi_x, static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big)));
-      }
-    }
+    const RowSensor rs{x0,
+                       r,
+                       sc.origin.x(),
+                       dy,
+                       cb,
+                       sb,
+                       tan_hf,
+                       sc.half_fov,
+                       min2,
+                       max2,
+                       narrow,
+                       bin_range_.data() + bin_offset_[k],
+                       bin_run_end_.data() + bin_offset_[k],
+                       static_cast<int>(bin_offset_[k + 1] - bin_offset_[k]),
+                       1.0 / params_.free_angle_bin,
+                       row,
+                       sx0,
+                       nx_};
+    int lo_x = lx_lo, hi_x = lx_hi, in_lo = 1, in_hi = 0;  // inner cells: none unless narrow
+    if (narrow && !WedgeSpan(rs, tan_in, &lo_x, &hi_x, &in_lo, &in_hi)) continue;
     if (lo_x > hi_x) continue;
-    // Segments of the row: the true bearing is monotonic along a row where fx > 0, and FastAtan2
-    // is within kAtanError of it, so the cells' computed bearings lie within 2 kAtanError of the
-    // hull of the end points' ones and their bins (a monotonic function of the bearing) within
-    // the bins of that hull. If all those bins hold the same range, every cell gets the same bin
-    // value as in the exact test without its atan2; otherwise the segment is split.
-    const auto rel_of = [&](int lx, double* fx_out) {
-      const double dxe = x0 + (lx + 0.5) * r - sc.origin.x();
-      const double fx = dxe * cb + dy * sb, fy = dy * cb - dxe * sb;
-      *fx_out = fx;
-      return FastAtan2(fy, fx);
-    };
-    int stack[128][2];
-    int top = 0;
+    ExactQueue exact(rs, view_.data());
     if (in_lo <= in_hi) {
-      for (const auto& [sa, se] :
-           {std::pair{lo_x, in_lo - 1}, std::pair{in_lo, in_hi}, std::pair{in_hi + 1, hi_x}}) {
-        if (sa > se) continue;
-        stack[top][0] = sa;
-        stack[top][1] = se;
-        ++top;
-      }
+      // The inner wedge's cells (the most) segmented at the run edges first.
+      if (lo_x < in_lo) Settle(rs, lo_x, in_lo - 1, exact, view_.data());
+      const std::int64_t e0 = edge_offset_[k], n = edge_offset_[k + 1] - e0;
+      SettleZoned(rs, edge_phi_.data() + e0, edge_cot_.data() + e0, static_cast<int>(n), in_lo,
+                  in_hi, exact, view_.data());
+      if (in_hi < hi_x) Settle(rs, in_hi + 1, hi_x, exact, view_.data());
     } else {
-      stack[top][0] = lo_x;
-      stack[top][1] = hi_x;
-      ++top;
+      Settle(rs, lo_x, hi_x, exact, view_.data());
     }
-    while (top > 0) {
-      --top;
-      const int a = stack[top][0], e = stack[top][1];
-      if (e - a < 4) {
-        for (int lx = a; lx <= e; ++lx) exact(lx);
-        continue;
-      }
-      double fxa, fxe;
-      const double ra = rel_of(a, &fxa), re = rel_of(e, &fxe);
-      const double lo = std::min(ra, re) - 2.0 * kAtanError,
-                   hi = std::max(ra, re) + 2.0 * kAtanError;
-      bool uniform = fxa > 0.0 && fxe > 0.0 && lo >= -sc.half_fov && hi <= sc.half_fov;
-      double br = kInf;
-      if (uniform) {
-        const int b0 = std::clamp(static_cast<int>((lo + sc.half_fov) * inv_bin), 0, nbins - 1);
-        const int b1 = std::clamp(static_cast<int>((hi + sc.half_fov) * inv_bin), 0, nbins - 1);
-        br = bins[b0];
-        uniform = run_end[b0] >= b1;
-      }
-      if (!uniform) {
-        const int mid = a + (e - a) / 2;
-        stack[top][0] = mid + 1;
-        stack[top][1] = e;
-        ++top;
-        stack[top][0] = a;
-        stack[top][1] = mid;
-        ++top;
-        continue;
-      }
-      // Branch-free over the segment (vectorises), split where the storage row wraps.
-      const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
-      const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
-      const double br2 = br * br;
-      const int wrap = static_cast<int>(nx_ - sx0);  // first lx whose storage column wraps
-      for (int part = 0; part < 2; ++part) {
-        const int pa = part == 0 ? a : std::max(a, wrap);
-        const int pe = part == 0 ? std::min(e, wrap - 1) : e;
-        std::uint8_t* dst = view_.data() + row + sx0 - (part == 0 ? 0 : nx_);
-        for (int lx = pa; lx <= pe; ++lx) {
-          const double dx = x0 + (lx + 0.5) * r - sc.origin.x();
-          const double d2 = dx * dx + dy * dy;
-          const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-          const bool in = (d2 >= min2) & (d2 <= max2) &
-                          ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
-          const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
-          dst[lx] |= in ? v : 0;
-        }
-      }
-    }
-    ExactCells(rs, pending, np, view_.data());
+    exact.Flush();
   }
 }
 

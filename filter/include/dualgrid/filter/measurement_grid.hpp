@@ -85,6 +85,10 @@ class MeasurementGrid {
   std::array<std::int64_t, 2> origin_index() const { return {origin_gx_, origin_gy_}; }
   /// The detections of the last Build (a copy).
   std::span<const Measurement> measurements() const { return z_; }
+  /// Per cell of the last Build, in storage order (row Mod(origin_gy + ly, ny), column
+  /// Mod(origin_gx + lx, nx)), the field-of-view and ray free-space bits of eq. (3): 1 in a
+  /// sensor's field of view, 2 in front of its bin's closest detection, 4 in a bin without any.
+  std::span<const std::uint8_t> view() const { return view_; }
   /// Number of Build calls so far (0: never built).
   std::uint64_t builds() const { return builds_; }
 
@@ -113,6 +117,7 @@ class MeasurementGrid {
   void StampBands(int band_lo, int band_hi);
   void Bins(std::span<const SensorCoverage> cov);               // the bins' ranges (serial)
   void FieldOfViewTables(std::span<const SensorCoverage> cov);  // per-sensor constants (serial)
+  void RunEdges(std::span<const SensorCoverage> cov);  // edge_* (FieldOfViewTables, serial)
   void FieldOfViewRow(int ly, std::span<const SensorCoverage> cov);  // view_ of logical row ly
   // Per detection the unit line of sight and the signed radial speed into det_los_ (and, with
   // the fit, in bucket order into det_los_b_: after FillBuckets).
@@ -162,6 +167,10 @@ class MeasurementGrid {
   std::vector<std::int64_t> bin_offset_;
   std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
+  // Per sensor [edge_offset_[k], edge_offset_[k + 1]): the edges between its runs of equal bin
+  // ranges, ascending: bearing from the boresight [rad], cotangent of the global direction.
+  std::vector<std::int64_t> edge_offset_;
+  std::vector<double> edge_phi_, edge_cot_;
 
   std::vector<double> det_los_;                 // per detection: unit line of sight, v_r . u
   std::vector<double> det_los_b_;               // det_los_ in bucket order (the fit's gathering)
