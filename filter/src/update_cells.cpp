@@ -122,7 +122,7 @@ void DynamicGrid::DetectionTables(std::span<const Measurement> z) {
       if (det_fit_k_[j] > 0.0)
         det_fv0_[j] *= ExpUnder(-mg.det_fit_t_[j] * mg.det_fit_t_[j] * det_fit_k_[j]);
   }
-  // Nine float columns (PrepareCycle sized them): bucket-order x, y [m, grid-local]; per
+  // Nine float columns (PrepareCycle sized them): candidate-order x, y [m, grid-local]; per
   // detection u0, u1, u2, fit_k, fit_t, vr_x, vr_y (WeighInputs).
   const std::size_t rows = det_f_.size() / 9;
   float* col[9];
@@ -130,10 +130,9 @@ void DynamicGrid::DetectionTables(std::span<const Measurement> z) {
   const double r = params_.resolution;
   const std::int64_t placed = mg.bucket_start_[static_cast<std::size_t>(mg.nbx_) * mg.nby_];
   const double x0 = static_cast<double>(origin_gx_) * r, y0 = static_cast<double>(origin_gy_) * r;
-  for (std::int64_t k = 0; k < placed; ++k) {  // grid-local metres, as the particles
-    col[0][k] = static_cast<float>(mg.det_x_[k] - x0);
-    col[1][k] = static_cast<float>(mg.det_y_[k] - y0);
-  }
+  // The detections the measurement grid placed, in grid-local metres as the particles.
+  candidates_.Fill(mg.det_x_.data(), mg.det_y_.data(), mg.bucket_items_.data(), placed, x0, y0,
+                   col[0], col[1]);
   for (int j = 0; j < nz; ++j) {
     col[2][j] = static_cast<float>(mg.det_los_[3 * j]);
     col[3][j] = static_cast<float>(mg.det_los_[3 * j + 1]);
@@ -147,7 +146,6 @@ void DynamicGrid::DetectionTables(std::span<const Measurement> z) {
 
 detail::WeighInputs DynamicGrid::WeighTables() const {
   const FilterParams& p = cycle_params_;
-  const MeasurementGrid& mg = *mg_;
   const std::size_t rows = det_f_.size() / 9;
   const float* col[9];
   for (std::size_t c = 0; c < 9; ++c) col[c] = det_f_.data() + c * rows;
@@ -164,7 +162,7 @@ detail::WeighInputs DynamicGrid::WeighTables() const {
   in.radial_fit = radial_fit;
   in.det_x = col[0];
   in.det_y = col[1];
-  in.det_item = mg.bucket_items_.data();
+  in.det_item = candidates_.items();
   in.u0 = col[2];
   in.u1 = col[3];
   in.u2 = col[4];
@@ -249,10 +247,10 @@ void DynamicGrid::UpdateCells(const Team& team, std::span<const Measurement> z) 
   const std::int64_t* const start = cell_start_.data();
   const int* const near = mg.near_det_.data();
   const double* const near_d2 = mg.near_d2_.data();
-  const std::int64_t* const bucket_start = mg.bucket_start_.data();
-  const int nbx = mg.nbx_, nby = mg.nby_;
   const WeighInputs weigh = WeighTables();
-  const float inv_bucket = static_cast<float>(1.0 / (mg.bucket_cells_ * params_.resolution));
+  // The sort's cell arithmetic (PredictAndSort): a cell's first particle gives its logical cell.
+  const float inv_r = static_cast<float>(1.0 / params_.resolution);
+  const float fnx = static_cast<float>(nx_ - 1), fny = static_cast<float>(ny_ - 1);
   const std::uint8_t* const view_bits = mg.view_.data();
   double* const free_l = free_.data();
   double* const static_l = static_.data();
@@ -321,8 +319,8 @@ void DynamicGrid::UpdateCells(const Team& team, std::span<const Measurement> z) 
         f_up *= k;
       }
 
-      // Candidate detections of all particles of the cell: the three contiguous item ranges of the
-      // 3 x 3 buckets around its first particle (buckets are >= cutoff + one cell wide).
+      // Candidate detections of all particles of the cell (CandidateIndex: the bucket rows
+      // around the cell of its first particle).
       CellParticles cp{q.x.data(),
                        q.y.data(),
                        q.vx.data(),
@@ -332,19 +330,15 @@ void DynamicGrid::UpdateCells(const Team& team, std::span<const Measurement> z) 
                        q.w_velocity.data(),
                        lo,
                        hi,
-                       {{0, 0}, {0, 0}, {0, 0}},
+                       {},
+                       0,
                        observed,
                        static_cast<float>(cap),
                        static_cast<float>(literal_norm ? cap : 1.0)};
       if (hi > lo) {
-        const int bx = std::clamp(static_cast<int>(std::floor(q.x[lo] * inv_bucket)), 0, nbx - 1);
-        const int by = std::clamp(static_cast<int>(std::floor(q.y[lo] * inv_bucket)), 0, nby - 1);
-        const int x_lo = std::max(0, bx - 1), x_hi = std::min(nbx - 1, bx + 1);
-        for (int yy = std::max(0, by - 1), r = 0; yy <= std::min(nby - 1, by + 1); ++yy, ++r) {
-          const std::int64_t row = static_cast<std::int64_t>(yy) * nbx;
-          cp.cand[r][0] = bucket_start[row + x_lo];
-          cp.cand[r][1] = bucket_start[row + x_hi + 1];
-        }
+        const float cx = std::clamp(std::floor(q.x[lo] * inv_r), 0.0f, fnx);
+        const float cy = std::clamp(std::floor(q.y[lo] * inv_r), 0.0f, fny);
+        cp.ranges = candidates_.Ranges(static_cast<int>(cx), static_cast<int>(cy), cp.cand);
       }
       // --- Particle weights, eqs. (7) and (8), unnormalised (SIMD lanes: WeighParticles). The
       // per-cycle factors double as the likelihood of each hypothesis in the joint

@@ -24,12 +24,11 @@
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/filter/particles.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
+#include "dualgrid/filter/weigh_particles.hpp"
 
 namespace dualgrid::filter {
 
 namespace detail {
-struct WeighInputs;
-struct CellParticles;
 struct Team;
 }  // namespace detail
 
@@ -314,6 +313,7 @@ class DynamicGrid {
   std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
   std::vector<double> det_fit_k_;       // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
   detail::AlignedVector<float> det_f_;  // WeighTables' columns
+  detail::CandidateIndex candidates_;   // the particle weights' candidates (DetectionTables)
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
