@@ -227,10 +227,6 @@ class DynamicGrid {
   void UpdateCells(const detail::Team& t, std::span<const Measurement> z);
   // The particle kernel's view of the detection tables (pointers into det_f_).
   detail::WeighInputs WeighTables() const;
-  // Eqs. (10-12) for one cell's particles in double (cells whose factors overflow float).
-  void ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
-                       double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
-                       double fast_mass) const;
   // Step 7 in two parts: the birth mass's prefix sums (true when births are to be drawn; false
   // leaves zero-weight births once the team's next barrier is passed), then the births
   // themselves. The sums: block totals `tot` and running sums at each cell chunk's start
