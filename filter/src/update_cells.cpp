@@ -174,9 +174,6 @@ detail::WeighInputs DynamicGrid::WeighTables() const {
 }
 namespace {
 
-// Slow cells per batch of UpdateCells' stages.
-constexpr std::int32_t kSlowBatch = 32;
-
 // The per-cycle inputs of UpdateCells' slow cells (UpdateCells fills them).
 struct UpdateInputs {
   const FilterParams* p;  // cycle_params_
@@ -546,16 +543,12 @@ void DynamicGrid::UpdateCells(const Team& team, std::span<const Measurement> z) 
     // Cells with birth mass, in cell order (Birth reads only these).
     std::int64_t* const born_list = born_cells_.data() + c_lo;
     std::int32_t n_born = 0;
-    // The slow cells in batches, stage by stage: each cell's values are those of one cell at a
-    // time (the stages read and write only their own cell and particles), but the short stages
-    // of neighbouring cells overlap in the core instead of waiting on one cell's chain.
-    SlowCell cells[kSlowBatch];
-    for (std::int32_t t0 = 0; t0 < n_slow; t0 += kSlowBatch) {
-      const std::int32_t nb = std::min<std::int32_t>(kSlowBatch, n_slow - t0);
-      for (std::int32_t b = 0; b < nb; ++b) Prior(u, c_lo + slow[t0 + b], cells[b]);
-      for (std::int32_t b = 0; b < nb; ++b) Weigh(u, cells[b]);
-      for (std::int32_t b = 0; b < nb; ++b)
-        if (Posterior(u, cells[b])) born_list[n_born++] = cells[b].s;
+    // The slow cells, one at a time through the stages of their update.
+    for (std::int32_t t = 0; t < n_slow; ++t) {
+      SlowCell cell;
+      Prior(u, c_lo + slow[t], cell);
+      Weigh(u, cell);
+      if (Posterior(u, cell)) born_list[n_born++] = cell.s;
     }
     born_count_[ch] = n_born;
   });
