@@ -137,6 +137,8 @@ void DynamicGrid::PrepareCycle(std::size_t detections) {
   if (det_f_.size() < 9 * rows) det_f_.assign(9 * rows, 0.0f);    // grow only
   if (det_fv0_.size() < detections) det_fv0_.resize(detections);
   if (det_fit_k_.size() < detections) det_fit_k_.resize(detections);
+  candidates_.Configure(nx_, ny_, params_.resolution, params_.cutoff_sigmas * params_.sigma_f,
+                        detections);
 }
 
 void DynamicGrid::Cycle(const Team& t, std::span<const Measurement> z, double dt,

@@ -5,7 +5,10 @@
 #include "dualgrid/filter/simd.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <hwy/contrib/math/math-inl.h>
 #include <hwy/highway.h>
@@ -71,7 +74,8 @@ inline void Nearest(const WeighInputs& in, const CellParticles& c, VF x, VF y, V
   jn = hn::Set(di, kNone);
   VF d2b = d2;
   VI jnb = jn;
-  for (const auto& range : c.cand) {
+  for (int r = 0; r < c.ranges; ++r) {
+    const std::int64_t* const range = c.cand[r];
     std::int64_t k = range[0];
     for (; k + 2 <= range[1]; k += 2) {
       Fold(Distance2(in, k, x, y), hn::Set(di, in.det_item[k]), d2, jn);
@@ -170,6 +174,84 @@ inline double LaneSum(VF v) {
 }
 
 }  // namespace
+
+void CandidateIndex::Configure(int nx, int ny, double r, double cutoff, std::size_t detections) {
+  if (nx < 1 || ny < 1 || !(std::isfinite(r) && r > 0.0) ||
+      !(std::isfinite(cutoff) && cutoff > 0.0))
+    throw std::invalid_argument("CandidateIndex: grid " + std::to_string(nx) + " x " +
+                                std::to_string(ny) + " cells of " + std::to_string(r) +
+                                " m, cutoff " + std::to_string(cutoff) + " m out of range");
+  nx_ = nx;
+  ny_ = ny;
+  inv_r_ = static_cast<float>(1.0 / r);
+  // The margin covers float's rounding of grid-local positions (relative 2^-24 of the grid's
+  // extent per coordinate, a few times over: the cells of the particles and the detections, and
+  // e2 against cutoff2) with a factor of ~100 to spare.
+  const double reach_m = cutoff + 1e-5 * (cutoff + (nx + ny) * r);
+  gap_ = static_cast<int>(std::floor(reach_m / r));
+  reach_.assign(static_cast<std::size_t>(gap_) + 1, 0);
+  for (int g = 0; g <= gap_; ++g) {
+    const double gy = g * r;
+    reach_[g] = static_cast<int>(std::floor(std::sqrt(reach_m * reach_m - gy * gy) / r));
+  }
+  // Buckets of 2 x 2 cells at least (a quarter of the cells to scan per cycle), more while the
+  // 2 gap_ + 3 rows of cells around a cell could touch more than kMaxRanges bucket rows.
+  const int span = 2 * gap_ + 3;
+  shift_ = 1;
+  while ((span + (1 << shift_) - 2) / (1 << shift_) + 1 > kMaxRanges) ++shift_;
+  nbx_ = ((nx - 1) >> shift_) + 1;
+  const int nby = ((ny - 1) >> shift_) + 1;
+  start_.resize(static_cast<std::size_t>(nbx_) * nby + 1);  // Fill clears it
+  if (bucket_.size() < detections) bucket_.resize(detections);
+  if (item_.size() < std::max<std::size_t>(detections, 1))
+    item_.resize(std::max<std::size_t>(detections, 1));
+}
+
+void CandidateIndex::Fill(const double* xd, const double* yd, const int* item, std::int64_t n,
+                          double x0, double y0, float* out_x, float* out_y) {
+  const std::int32_t nb = static_cast<std::int32_t>(start_.size()) - 1;
+  std::fill(start_.begin(), start_.end(), 0);
+  const float fnx = static_cast<float>(nx_ - 1), fny = static_cast<float>(ny_ - 1);
+  for (std::int64_t k = 0; k < n; ++k) {
+    // The cell of the float position (NaN-free: clamped first), clamped to the grid.
+    const float x = static_cast<float>(xd[k] - x0), y = static_cast<float>(yd[k] - y0);
+    const float cx = std::clamp(std::floor(x * inv_r_), 0.0f, fnx);
+    const float cy = std::clamp(std::floor(y * inv_r_), 0.0f, fny);
+    const std::int32_t b = (static_cast<std::int32_t>(cy) >> shift_) * nbx_ +
+                           (static_cast<std::int32_t>(cx) >> shift_);
+    bucket_[k] = b;
+    ++start_[b];
+  }
+  for (std::int32_t b = 1; b < nb; ++b) start_[b] += start_[b - 1];  // ends of the buckets
+  start_[nb] = static_cast<std::int32_t>(n);
+  // Backwards, each bucket's end counting down to its start: the sort is stable.
+  for (std::int64_t k = n - 1; k >= 0; --k) {
+    const std::int32_t at = --start_[bucket_[k]];
+    out_x[at] = static_cast<float>(xd[k] - x0);
+    out_y[at] = static_cast<float>(yd[k] - y0);
+    item_[at] = item[k];
+  }
+}
+
+int CandidateIndex::Ranges(int cx, int cy, std::int64_t (*cand)[2]) const {
+  cx = std::clamp(cx, 0, nx_ - 1);
+  cy = std::clamp(cy, 0, ny_ - 1);
+  const int k1 = (1 << shift_) - 1;
+  const int y_lo = std::max(0, cy - gap_ - 1), y_hi = std::min(ny_ - 1, cy + gap_ + 1);
+  int n = 0;
+  for (int by = y_lo >> shift_; by <= y_hi >> shift_; ++by) {
+    // Whole cells between the cell and the bucket row's nearest cell row.
+    const int c0 = by << shift_, c1 = c0 + k1;
+    const int g = cy < c0 ? c0 - cy - 1 : cy > c1 ? cy - c1 - 1 : 0;
+    const int rx = reach_[g] + 1;
+    const int bx0 = std::max(0, cx - rx) >> shift_, bx1 = std::min(nx_ - 1, cx + rx) >> shift_;
+    const std::int64_t row = static_cast<std::int64_t>(by) * nbx_;
+    cand[n][0] = start_[row + bx0];
+    cand[n][1] = start_[row + bx1 + 1];
+    n += cand[n][1] > cand[n][0] ? 1 : 0;
+  }
+  return n;
+}
 
 CellSums WeighParticles(const WeighInputs& in, const CellParticles& c) {
   const DF df;

@@ -3,6 +3,8 @@
 // sums.
 // Random cells with detections exactly at the cutoff, ties (two detections at one position),
 // particles on the grid's edge (coordinates near 0), cells larger than a vector and tails.
+// CandidateIndex against a brute-force scan: every detection within the cutoff of a particle is
+// among its cell's candidates.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -12,6 +14,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <set>
 #include <vector>
 
 #include "dualgrid/filter/weigh_particles.hpp"
@@ -170,7 +173,8 @@ CellParticles Cell(Scene& s, bool observed) {
                   s.w_velocity.data(),
                   s.lo,
                   s.hi,
-                  {{0, 0}, {0, 0}, {0, 0}},
+                  {},
+                  3,
                   observed,
                   0.8f,
                   1.0f};
@@ -232,4 +236,124 @@ TEST_CASE("WeighParticles: many candidates, one, and none", "[filter][weigh]") {
     const Scene s = MakeScene(rng, 13, 20.0f, 30.0f, nd);
     for (int variant = 0; variant < 4; ++variant) CHECK(SameAsReference(s, variant, true));
   }
+}
+
+namespace {
+
+// Squared distance [m^2] as WeighParticles computes it (float, the same operations).
+float Distance2(float dx, float dy, float px, float py) {
+  const float ex = dx - px, ey = dy - py;
+  return ex * ex + ey * ey;
+}
+
+struct IndexCase {
+  int nx, ny;
+  double r, cutoff;
+};
+
+// Detections around (and some beyond) an nx x ny grid: uniform, clustered, exactly at the
+// cutoff from a particle (one float step either side), on cell edges. Returns the index's misses
+// (a detection within the cutoff of a particle but not among its cell's candidates) and counts
+// the candidates and the detections within the cutoff.
+int Misses(const IndexCase& g, std::mt19937& rng, long& candidates, long& within) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double w = g.nx * g.r, h = g.ny * g.r, x0 = 1000.0 * g.r, y0 = -300.0 * g.r;
+  const float inv_r = static_cast<float>(1.0 / g.r);
+  const float cutoff2 = static_cast<float>(g.cutoff * g.cutoff);
+  // Particles: uniform over the grid and on cell edges, in the sort's cells.
+  std::vector<float> px, py;
+  for (int i = 0; i < 400; ++i) {
+    float x = static_cast<float>(u(rng) * w), y = static_cast<float>(u(rng) * h);
+    if (i % 4 == 1) x = static_cast<float>(std::floor(u(rng) * g.nx) * g.r);
+    if (i % 4 == 2) y = std::nextafter(static_cast<float>(std::ceil(u(rng) * g.ny) * g.r), 0.0f);
+    const float fx = std::floor(x * inv_r), fy = std::floor(y * inv_r);
+    if (!(fx >= 0.0f && fy >= 0.0f && fx < g.nx && fy < g.ny)) continue;  // off the grid
+    px.push_back(x);
+    py.push_back(y);
+  }
+  std::vector<double> dx, dy;
+  for (int k = 0; k < 300; ++k) {
+    double x = (u(rng) * 1.2 - 0.1) * w, y = (u(rng) * 1.2 - 0.1) * h;
+    if (k % 3 == 1) {  // at the cutoff from a particle, along an axis or a diagonal
+      const std::size_t i = std::uniform_int_distribution<std::size_t>(0, px.size() - 1)(rng);
+      const double ang = 0.7853981633974483 * std::floor(u(rng) * 8.0);
+      x = px[i] + g.cutoff * std::cos(ang);
+      y = py[i] + g.cutoff * std::sin(ang);
+      const int nudge = static_cast<int>(u(rng) * 3.0) - 1;
+      float fx = static_cast<float>(x);
+      if (nudge != 0) fx = std::nextafter(fx, nudge * 1e30f);
+      x = fx;
+    }
+    if (k % 7 == 3) x = std::floor(u(rng) * g.nx) * g.r;  // on a cell edge
+    dx.push_back(x0 + x);
+    dy.push_back(y0 + y);
+  }
+  const std::int64_t n = static_cast<std::int64_t>(dx.size());
+  std::vector<int> item(dx.size());
+  std::iota(item.begin(), item.end(), 100);
+  std::shuffle(item.begin(), item.end(), rng);
+  dualgrid::filter::detail::CandidateIndex index;
+  index.Configure(g.nx, g.ny, g.r, g.cutoff, dx.size());
+  std::vector<float> cx(dx.size()), cy(dx.size());
+  index.Fill(dx.data(), dy.data(), item.data(), n, x0, y0, cx.data(), cy.data());
+  // Candidate order is a permutation of the input with its positions.
+  std::vector<int> seen(index.items(), index.items() + n);
+  std::sort(seen.begin(), seen.end());
+  for (std::int64_t k = 0; k < n; ++k) REQUIRE(seen[k] == 100 + k);
+  for (std::int64_t k = 0; k < n; ++k) {
+    const int j = index.items()[k] - 100;
+    const auto at = std::find(item.begin(), item.end(), index.items()[k]) - item.begin();
+    REQUIRE(j >= 0);
+    REQUIRE(cx[k] == static_cast<float>(dx[at] - x0));
+    REQUIRE(cy[k] == static_cast<float>(dy[at] - y0));
+  }
+  int misses = 0;
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    std::int64_t cand[dualgrid::filter::detail::kMaxRanges][2];
+    const int ranges = index.Ranges(static_cast<int>(std::floor(px[i] * inv_r)),
+                                    static_cast<int>(std::floor(py[i] * inv_r)), cand);
+    REQUIRE(ranges >= 0);
+    REQUIRE(ranges <= dualgrid::filter::detail::kMaxRanges);
+    std::set<int> mine;
+    for (int r = 0; r < ranges; ++r) {
+      REQUIRE(0 <= cand[r][0]);
+      REQUIRE(cand[r][0] < cand[r][1]);  // non-empty
+      REQUIRE(cand[r][1] <= n);
+      for (std::int64_t k = cand[r][0]; k < cand[r][1]; ++k) mine.insert(index.items()[k]);
+    }
+    candidates += static_cast<long>(mine.size());
+    for (std::int64_t k = 0; k < n; ++k) {
+      if (!(Distance2(cx[k], cy[k], px[i], py[i]) < cutoff2)) continue;
+      ++within;
+      misses += mine.count(index.items()[k]) ? 0 : 1;
+    }
+  }
+  return misses;
+}
+
+}  // namespace
+
+TEST_CASE("CandidateIndex: every detection within the cutoff is a candidate", "[filter][weigh]") {
+  std::mt19937 rng(2611);
+  // The highway's grid, finer cells than the cutoff (larger buckets), a cutoff under one cell.
+  for (const IndexCase g : {IndexCase{400, 50, 0.5, 1.8}, IndexCase{60, 90, 0.1, 1.8},
+                            IndexCase{30, 20, 1.0, 0.4}, IndexCase{1, 7, 0.5, 1.8}}) {
+    long candidates = 0, within = 0;
+    int misses = 0;
+    for (int trial = 0; trial < 5; ++trial) misses += Misses(g, rng, candidates, within);
+    INFO(g.nx << " x " << g.ny << " cells of " << g.r << " m, cutoff " << g.cutoff << ": " << within
+              << " pairs within the cutoff, " << candidates << " candidates");
+    CHECK(within > 0);
+    CHECK(misses == 0);
+    // The buckets prune: fewer candidates than all detections for every particle (300 each).
+    if (g.nx * g.r > 8.0 * g.cutoff) CHECK(candidates < 2000L * 300L / 4);
+  }
+}
+
+TEST_CASE("CandidateIndex: a grid or cutoff out of range is refused", "[filter][weigh]") {
+  dualgrid::filter::detail::CandidateIndex index;
+  CHECK_THROWS_AS(index.Configure(0, 5, 0.5, 1.8, 10), std::invalid_argument);
+  CHECK_THROWS_AS(index.Configure(5, 5, 0.0, 1.8, 10), std::invalid_argument);
+  CHECK_THROWS_AS(index.Configure(5, 5, 0.5, std::nan(""), 10), std::invalid_argument);
+  CHECK_NOTHROW(index.Configure(5, 5, 0.5, 1.8, 0));
 }

@@ -24,12 +24,11 @@
 #include "dualgrid/filter/params.hpp"
 #include "dualgrid/filter/particles.hpp"
 #include "dualgrid/filter/prediction_noise.hpp"
+#include "dualgrid/filter/weigh_particles.hpp"
 
 namespace dualgrid::filter {
 
 namespace detail {
-struct WeighInputs;
-struct CellParticles;
 struct Team;
 }  // namespace detail
 
@@ -228,10 +227,6 @@ class DynamicGrid {
   void UpdateCells(const detail::Team& t, std::span<const Measurement> z);
   // The particle kernel's view of the detection tables (pointers into det_f_).
   detail::WeighInputs WeighTables() const;
-  // Eqs. (10-12) for one cell's particles in double (cells whose factors overflow float).
-  void ScalarNormalise(const detail::CellParticles& c, bool literal_norm, bool fell_back,
-                       double q_norm, double scale, double rho_p, double sum_pos, double sum_vel,
-                       double fast_mass) const;
   // Step 7 in two parts: the birth mass's prefix sums (true when births are to be drawn; false
   // leaves zero-weight births once the team's next barrier is passed), then the births
   // themselves. The sums: block totals `tot` and running sums at each cell chunk's start
@@ -314,6 +309,7 @@ class DynamicGrid {
   std::vector<double> reframe_layers_;  // Reframe: the old free, static and dynamic layers
   std::vector<double> det_fit_k_;       // radial_fit: 1 / (2 (sigma_v^2 + s_t^2)) per detection
   detail::AlignedVector<float> det_f_;  // WeighTables' columns
+  detail::CandidateIndex candidates_;   // the particle weights' candidates (DetectionTables)
 };
 
 inline std::optional<CellIndex> DynamicGrid::CellOf(const Position& p) const {
