@@ -136,6 +136,11 @@ class DynamicGrid {
   /// the scorer reads this every cycle; figures use Cell() for the velocities only when drawn.
   void ExportMasses(std::span<float> free, std::span<float> static_occ, std::span<float> dynamic,
                     std::span<std::uint8_t> observed) const;
+  /// Cell()'s mean_velocity [m/s] of every cell in logical row-major order (as ExportMasses),
+  /// cast to float, without the covariance and without locating each cell: the same values as
+  /// static_cast<float>(Cell({x, y}).mean_velocity.x()) (and .y()). Each span must hold
+  /// cells_x() * cells_y() entries (std::invalid_argument otherwise). O(cells + particles).
+  void ExportMeanVelocities(std::span<float> mean_vx, std::span<float> mean_vy) const;
 
   /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count), in
   /// the caller's frame. The filter keeps them in float grid-local coordinates (docs/algorithm.md,
@@ -194,6 +199,10 @@ class DynamicGrid {
   std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
   // Storage column and row of logical cell (0, 0).
   std::array<std::int64_t, 2> StorageOrigin() const;
+  // f(i, s, count) for each contiguous storage run of the logical rows (cell_moments.cpp):
+  // logical cells [i, i + count) are storage cells [s, s + count), two runs per row.
+  template <typename F>
+  void ForEachStorageRun(F&& f) const;
   // Initialisation around the ego: the origin (serial), then the particles spread over the grid
   // with zero weight (by the team t).
   void InitializeOrigin(const EgoInput& ego);
@@ -295,10 +304,11 @@ class DynamicGrid {
   std::vector<std::int64_t> cell_start_;         // num_cells_ + 2: particle ranges of sorted_
   std::vector<std::int32_t> hist_;               // per-chunk histograms of the counting sort
   std::vector<std::int64_t> hist_total_;
-  std::vector<double> scan_out_;    // resampling prefix sums of the source weights
-  std::vector<double> scan_base_;   // their block totals
-  double scan_persistent_ = 0.0;    // ScanPersistent's running sum
-  std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
+  std::vector<double> scan_out_;               // resampling prefix sums of the source weights
+  std::vector<double> scan_base_;              // their block totals
+  std::vector<std::uint32_t> resample_owner_;  // Resample's scratch: each output slot's source
+  double scan_persistent_ = 0.0;               // ScanPersistent's running sum
+  std::vector<double> born_block_;             // block totals of the birth-mass prefix sums
   // Cells with non-zero birth mass, per UpdateCells chunk (slots [chunk * size, + count)).
   std::vector<std::int64_t> born_cells_;
   std::vector<std::int32_t> born_count_;
