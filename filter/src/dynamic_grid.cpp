@@ -36,7 +36,7 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   particles_.resize(n);
   sorted_.resize(n);
   births_.resize(b);
-  birth_raw_.assign(6 * b, 0);
+  birth_draw_.assign(6 * b, 0.0f);
   cell_of_.assign(n, 0);
   cell_start_.assign(c + 2, 0);
   born_cells_.assign(c, 0);

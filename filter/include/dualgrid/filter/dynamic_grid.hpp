@@ -314,9 +314,9 @@ class DynamicGrid {
   std::vector<std::int32_t> born_count_;
   std::vector<double> det_fv0_;         // per detection: f_v of a particle at v = 0
   std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
-  // The births' Philox words of this cycle, drawn for all num_birth at once (DrawBirths): slot
-  // w * num_birth + k holds word w of birth k (w 0-3: block 0; 4-5: words 0-1 of block 1).
-  std::vector<std::uint32_t> birth_raw_;
+  // The births' draws of this cycle, made for all num_birth at once (DrawBirths): slot
+  // c * num_birth + k holds birth k's uniform c (c 0, 1, 4, 5) or normal c (c 2, 3).
+  std::vector<float> birth_draw_;
   // The measurement grid of the running Update (the caller's or own_measurement_); null between
   // cycles.
   const MeasurementGrid* mg_ = nullptr;
