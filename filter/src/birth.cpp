@@ -129,6 +129,7 @@ void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z, cons
     const bool has_last = last < (ch + 1) * kCellChunk;  // the block's last cell is in this chunk
     double acc = chunk_acc[ch];
     bool last_seen = false;
+    BirthFrame frame;  // the last frame used: neighbouring cells share their nearest detection
     // Inside a block a zero mass leaves the running sum unchanged: empty range. Only the cells
     // with mass and the block's last cell (where the block total takes over) can get births.
     const auto visit = [&](std::int64_t s, double born) {
@@ -138,7 +139,9 @@ void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z, cons
       if (born != 0.0) acc += born;
       const std::int64_t k_lo = start(s, cum_s), k_hi = start(s + 1, block_end ? tot[b + 1] : acc);
       if (k_lo == k_hi) return;
-      GenerateBirths(z, s, k_lo, k_hi, mass, vmax);
+      const int j = mg_->near_det_[s];
+      if (j != frame.j) frame = FrameOf(z, j, vmax);
+      GenerateBirths(s, k_lo, k_hi, mass, frame);
     };
     const std::int64_t* list = born_cells_.data() + ch * kCellChunk;
     for (std::int32_t k = 0; k < born_count_[ch]; ++k) visit(list[k], born_[list[k]]);
@@ -146,15 +149,37 @@ void DynamicGrid::DrawBirths(const Team& t, std::span<const Measurement> z, cons
   });
 }
 
-void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
-                                 std::int64_t k_hi, double mass, double vmax) {
-  const int j = mg_->near_det_[s];
+DynamicGrid::BirthFrame DynamicGrid::FrameOf(std::span<const Measurement> z, int j,
+                                             double vmax) const {
+  BirthFrame f;
+  if (j < 0) return f;
+  f.j = j;
+  const Measurement& m = z[j];
+  Vector2 los = m.position - m.sensor_position;
+  const double los_n = los.norm();
+  f.los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
+  f.tangent = Vector2(-f.los.y(), f.los.x());
+  f.v_radial = m.radial_velocity.dot(f.los);  // signed compensated radial speed
+  f.vt_max = std::min(vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed -
+                                                        f.v_radial * f.v_radial)));
+  // doppler_fit: where the fit knows the tangential part better than the uniform draw (whose
+  // standard deviation is vt_max / sqrt(3)), births draw it from the fit, but for a share kept
+  // uniform (FitDetectionVelocities).
+  f.fitted = params_.birth_velocity == BirthVelocity::kDopplerFit &&
+             mg_->det_fit_sd_[j] < f.vt_max / std::sqrt(3.0);
+  f.fit_t = f.fitted ? mg_->det_fit_t_[j] : 0.0;
+  f.fit_sd = f.fitted ? mg_->det_fit_sd_[j] : 0.0;
+  return f;
+}
+
+void DynamicGrid::GenerateBirths(std::int64_t s, std::int64_t k_lo, std::int64_t k_hi, double mass,
+                                 const BirthFrame& f) {
   // Logical (grid-local) cell of storage index s: the unique one inside the current window.
   const std::int64_t sx = s % nx_, sy = s / nx_;
   const float lx = static_cast<float>(Mod(sx - origin_gx_, nx_));
   const float ly = static_cast<float>(Mod(sy - origin_gy_, ny_));
   const float r = static_cast<float>(params_.resolution);
-  if (j < 0) {
+  if (f.j < 0) {
     // Birth mass needs a detection nearby; only a rounding jump of the prefix sums at a block
     // boundary could land here. Keep the slots harmless (zero mass at the cell centre).
     for (std::int64_t k = k_lo; k < k_hi; ++k) {
@@ -165,22 +190,10 @@ void DynamicGrid::GenerateBirths(std::span<const Measurement> z, std::int64_t s,
     }
     return;
   }
-  const Measurement& m = z[j];
-  Vector2 los = m.position - m.sensor_position;
-  const double los_n = los.norm();
-  los = los_n > 0.0 ? Vector2(los / los_n) : Vector2(1.0, 0.0);
-  const Vector2 tangent(-los.y(), los.x());
-  const double v_radial = m.radial_velocity.dot(los);  // signed compensated radial speed
-  const double vt_max = std::min(
-      vmax, std::sqrt(std::max(0.0, params_.max_speed * params_.max_speed - v_radial * v_radial)));
   const bool uniform = params_.birth_velocity == BirthVelocity::kUniform;
-  // doppler_fit: where the fit knows the tangential part better than the uniform draw (whose
-  // standard deviation is vt_max / sqrt(3)), births draw it from the fit, but for a share kept
-  // uniform (FitDetectionVelocities).
-  const bool fitted = params_.birth_velocity == BirthVelocity::kDopplerFit &&
-                      mg_->det_fit_sd_[j] < vt_max / std::sqrt(3.0);
-  const double fit_t = fitted ? mg_->det_fit_t_[j] : 0.0,
-               fit_sd = fitted ? mg_->det_fit_sd_[j] : 0.0;
+  const Vector2 los = f.los, tangent = f.tangent;
+  const double v_radial = f.v_radial, vt_max = f.vt_max, fit_t = f.fit_t, fit_sd = f.fit_sd;
+  const bool fitted = f.fitted;
   // The draws of CounterRng(seed, kFilterBirth, step, k), made by DrawBirths for every k:
   // uniforms ToUnit24 of words 0, 1, 4, 5 and the normals Normal2FromRaw of words 2, 3.
   const std::int64_t nb = static_cast<std::int64_t>(births_.size());

@@ -253,9 +253,21 @@ class DynamicGrid {
   };
   bool BirthMass(const detail::Team& t, BirthSums& sums);
   void DrawBirths(const detail::Team& t, std::span<const Measurement> z, const BirthSums& sums);
-  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
-  void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
-                      std::int64_t k_hi, double mass, double vmax);
+  // The velocity frame of births near detection j, a function of j alone (DrawBirths reuses it
+  // across the neighbouring cells that share their nearest detection): the unit line of sight,
+  // its tangent, the radial speed and the tangential bound [m/s], the Doppler fit's use. j < 0:
+  // no detection.
+  struct BirthFrame {
+    int j = -1;
+    Vector2 los = Vector2::Zero(), tangent = Vector2::Zero();
+    double v_radial = 0.0, vt_max = 0.0, fit_t = 0.0, fit_sd = 0.0;
+    bool fitted = false;
+  };
+  BirthFrame FrameOf(std::span<const Measurement> z, int j, double vmax) const;
+  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`), their velocities in
+  // the frame of the cell's nearest detection.
+  void GenerateBirths(std::int64_t s, std::int64_t k_lo, std::int64_t k_hi, double mass,
+                      const BirthFrame& f);
   // Step 8: ScanPersistent (serial) may run once the weights are final, beside DrawBirths (it
   // starts the prefix sums over the persistent particles when they fit in one scan block);
   // Resample finishes the sums and copies.
