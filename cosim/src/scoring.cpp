@@ -41,14 +41,7 @@ void TakeVelocities(const filter::DynamicGrid& grid, GridSnapshot& s) {
   const std::size_t n = static_cast<std::size_t>(s.cells_x) * s.cells_y;
   s.mean_vx.resize(n);
   s.mean_vy.resize(n);
-  for (int y = 0; y < s.cells_y; ++y) {
-    for (int x = 0; x < s.cells_x; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * s.cells_x + x;
-      const filter::CellState c = grid.Cell({x, y});
-      s.mean_vx[i] = static_cast<float>(c.mean_velocity.x());
-      s.mean_vy[i] = static_cast<float>(c.mean_velocity.y());
-    }
-  }
+  grid.ExportMeanVelocities(s.mean_vx, s.mean_vy);  // Cell()'s mean_velocity, as float
 }
 
 namespace {

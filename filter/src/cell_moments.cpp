@@ -12,6 +12,37 @@ namespace dualgrid::filter {
 
 using namespace detail;
 
+namespace {
+
+// The weighted mean velocity of particles [lo, hi) of `p` into `mean` (left unchanged when their
+// weights sum to 0); returns the weight sum. Cell and ExportMeanVelocities share it.
+double MeanVelocity(const LocalParticles& p, std::int64_t lo, std::int64_t hi, Velocity& mean) {
+  double wsum = 0.0, mx = 0.0, my = 0.0;
+  for (std::int64_t i = lo; i < hi; ++i) {
+    wsum += p.weight[i];
+    mx += p.weight[i] * static_cast<double>(p.vx[i]);
+    my += p.weight[i] * static_cast<double>(p.vy[i]);
+  }
+  if (wsum > 0.0) mean = {mx / wsum, my / wsum};
+  return wsum;
+}
+
+}  // namespace
+
+// f(i, s, count) for the contiguous storage runs of the logical rows: logical cells [i, i + count)
+// are storage cells [s, s + count). A logical row is its circular storage row from column sx0 on,
+// wrapping once: two runs.
+template <typename F>
+void DynamicGrid::ForEachStorageRun(F&& f) const {
+  const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  for (int y = 0; y < ny_; ++y) {
+    const std::int64_t row = Mod(origin_gy_ + y, ny_) * nx_;
+    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_);
+    f(i, row + sx0, nx_ - sx0);
+    f(i + static_cast<std::size_t>(nx_ - sx0), row, sx0);
+  }
+}
+
 CellState DynamicGrid::Cell(CellIndex c) const {
   if (c.x < 0 || c.y < 0 || c.x >= nx_ || c.y >= ny_) {
     throw std::out_of_range("DynamicGrid::Cell: index (" + std::to_string(c.x) + ", " +
@@ -26,16 +57,11 @@ CellState DynamicGrid::Cell(CellIndex c) const {
   out.unknown = std::max(0.0, 1.0 - out.free - out.static_occ - out.dynamic);
   // Velocity statistics on demand from the weighted particles of the last update (sorted_ and
   // its cell ranges stay valid until the next Update): saves five layers of memory traffic.
-  double wsum = 0.0, mx = 0.0, my = 0.0;
-  for (std::int64_t i = cell_start_[s]; i < cell_start_[s + 1]; ++i) {
-    wsum += sorted_.weight[i];
-    mx += sorted_.weight[i] * static_cast<double>(sorted_.vx[i]);
-    my += sorted_.weight[i] * static_cast<double>(sorted_.vy[i]);
-  }
+  const std::int64_t lo = cell_start_[s], hi = cell_start_[s + 1];
+  const double wsum = MeanVelocity(sorted_, lo, hi, out.mean_velocity);
   if (wsum > 0.0) {
-    out.mean_velocity = {mx / wsum, my / wsum};
     Matrix2 cov = Matrix2::Zero();
-    for (std::int64_t i = cell_start_[s]; i < cell_start_[s + 1]; ++i) {
+    for (std::int64_t i = lo; i < hi; ++i) {
       const Vector2 e(sorted_.vx[i] - out.mean_velocity.x(), sorted_.vy[i] - out.mean_velocity.y());
       cov += sorted_.weight[i] * e * e.transpose();
     }
@@ -53,11 +79,9 @@ void DynamicGrid::ExportMasses(std::span<float> free, std::span<float> static_oc
         "DynamicGrid::ExportMasses: spans of " + std::to_string(free.size()) + "/" +
         std::to_string(static_occ.size()) + "/" + std::to_string(dynamic.size()) + "/" +
         std::to_string(observed.size()) + " entries for " + std::to_string(n) + " cells");
-  // A logical row is its circular storage row from column sx0 on, wrapping once: two contiguous
-  // runs, each a plain loop the compiler vectorises.
+  // Each run a plain loop the compiler vectorises.
   static_assert(kObserved == 1, "observed[] is 0 or 1");
-  const std::int64_t sx0 = Mod(origin_gx_, nx_);
-  const auto copy = [&](std::size_t i, std::int64_t s, std::int64_t count) {
+  ForEachStorageRun([&](std::size_t i, std::int64_t s, std::int64_t count) {
     const double* const f = free_.data() + s;
     const double* const st = static_.data() + s;
     const double* const d = dynamic_.data() + s;
@@ -68,13 +92,24 @@ void DynamicGrid::ExportMasses(std::span<float> free, std::span<float> static_oc
       dynamic[i + k] = static_cast<float>(d[k]);
       observed[i + k] = static_cast<std::uint8_t>(v[k] & kObserved);  // 0 or 1
     }
-  };
-  for (int y = 0; y < ny_; ++y) {
-    const std::int64_t row = Mod(origin_gy_ + y, ny_) * nx_;
-    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_);
-    copy(i, row + sx0, nx_ - sx0);
-    copy(i + static_cast<std::size_t>(nx_ - sx0), row, sx0);
-  }
+  });
+}
+
+void DynamicGrid::ExportMeanVelocities(std::span<float> mean_vx, std::span<float> mean_vy) const {
+  const std::size_t n = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  if (mean_vx.size() != n || mean_vy.size() != n)
+    throw std::invalid_argument(
+        "DynamicGrid::ExportMeanVelocities: spans of " + std::to_string(mean_vx.size()) + "/" +
+        std::to_string(mean_vy.size()) + " entries for " + std::to_string(n) + " cells");
+  ForEachStorageRun([&](std::size_t i, std::int64_t s, std::int64_t count) {
+    const std::int64_t* const start = cell_start_.data() + s;
+    for (std::int64_t k = 0; k < count; ++k) {
+      Velocity mean = Velocity::Zero();
+      if (start[k] != start[k + 1]) MeanVelocity(sorted_, start[k], start[k + 1], mean);
+      mean_vx[i + k] = static_cast<float>(mean.x());
+      mean_vy[i + k] = static_cast<float>(mean.y());
+    }
+  });
 }
 
 }  // namespace dualgrid::filter

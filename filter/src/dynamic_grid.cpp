@@ -36,7 +36,7 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   particles_.resize(n);
   sorted_.resize(n);
   births_.resize(b);
-  birth_raw_.assign(6 * b, 0);
+  birth_draw_.assign(6 * b, 0.0f);
   cell_of_.assign(n, 0);
   cell_start_.assign(c + 2, 0);
   born_cells_.assign(c, 0);
@@ -45,6 +45,7 @@ DynamicGrid::DynamicGrid(const FilterParams& params, std::uint64_t seed)
   hist_total_.assign(static_cast<std::size_t>(num_cells_ / (1 << 10) + 2), 0);
   hist_.assign(static_cast<std::size_t>(kMaxSortChunks) * (c + 1), 0);
   scan_out_.assign(n + b + 1, 0.0);
+  resample_owner_.assign(n, 0);
   scan_base_.assign(static_cast<std::size_t>((n + b + kScanBlock - 1) / kScanBlock + 1), 0.0);
   born_block_.assign(static_cast<std::size_t>((num_cells_ + kScanBlock - 1) / kScanBlock + 1), 0.0);
 }

@@ -101,7 +101,7 @@ double FilterParams::MemoryBytes() const {
   // Counted in double: also meaningful (huge) for sizes IsValid refuses, where int would overflow.
   const double cells = std::max(1.0, std::round(length_x / resolution)) *
                        std::max(1.0, std::round(width_y / resolution));
-  return 94.0 * cells + 68.0 * num_particles + 36.0 * num_birth;
+  return 94.0 * cells + 72.0 * num_particles + 36.0 * num_birth;
 }
 
 FilterParams ForCycle(const FilterParams& p, double dt) {

@@ -76,6 +76,53 @@ inline std::int64_t SystematicStart(const double* cumulative, std::int64_t i, st
   return std::clamp(CeilToInt(cumulative[i] * scale - u), std::int64_t{0}, n);
 }
 
+// The systematic draw positions of one thread: sources [i_lo, i_hi) own output slots [k_lo, k_hi)
+// (k_lo = Start(i_lo), k_hi = Start(i_hi)). Fills owner[k] for k in [k_lo, k_hi) with the source
+// of slot k, the last i with Start(i) <= k, without a branch per source: each source's index is
+// written at its first slot (a later source with the same start overwrites an earlier, empty
+// one), then a running maximum fills the slots between. owner: the caller's n entries; source
+// indices fit 32 bits (num_particles and num_birth are ints).
+struct SystematicOwners {
+  const double* cum;
+  std::int64_t n_src, n;
+  double scale, u;
+
+  std::int64_t Start(std::int64_t i) const { return SystematicStart(cum, i, n_src, scale, u, n); }
+  void Fill(std::int64_t i_lo, std::int64_t i_hi, std::int64_t k_lo, std::int64_t k_hi,
+            std::uint32_t* owner) const {
+    std::fill(owner + k_lo, owner + k_hi, static_cast<std::uint32_t>(i_lo));
+    for (std::int64_t i = i_lo + 1; i < i_hi; ++i) {
+      const std::int64_t k = Start(i);  // >= k_lo: starts never decrease
+      if (k < k_hi) owner[k] = static_cast<std::uint32_t>(i);
+    }
+    for (std::int64_t k = k_lo + 1; k < k_hi; ++k) owner[k] = std::max(owner[k], owner[k - 1]);
+  }
+};
+
+// out's slots [k_a, k_b) = copies of src's particles owner[k] - first, carrying the equal share;
+// w_position / w_velocity keep their ratio to the weight (share / the source's weight).
+void CopyOwned(const LocalParticles& src, std::int64_t first, const std::uint32_t* owner,
+               std::int64_t k_a, std::int64_t k_b, double share, LocalParticles& out) {
+  const float *const sx = src.x.data(), *const sy = src.y.data(), *const svx = src.vx.data(),
+                     *const svy = src.vy.data(), *const sw = src.weight.data(),
+                     *const swp = src.w_position.data(), *const swv = src.w_velocity.data();
+  float *const x = out.x.data(), *const y = out.y.data(), *const vx = out.vx.data(),
+               *const vy = out.vy.data(), *const w = out.weight.data(),
+               *const wp = out.w_position.data(), *const wv = out.w_velocity.data();
+  const auto share_f = static_cast<float>(share);
+  for (std::int64_t k = k_a; k < k_b; ++k) {
+    const std::int64_t i = static_cast<std::int64_t>(owner[k]) - first;
+    x[k] = sx[i];
+    y[k] = sy[i];
+    vx[k] = svx[i];
+    vy[k] = svy[i];
+    const double ratio = share / sw[i];
+    w[k] = share_f;
+    wp[k] = static_cast<float>(swp[i] * ratio);
+    wv[k] = static_cast<float>(swv[i] * ratio);
+  }
+}
+
 }  // namespace
 
 void DynamicGrid::ScanPersistent() {
@@ -126,25 +173,18 @@ void DynamicGrid::Resample(const Team& t) {
   const double scale = static_cast<double>(n) / total;
   const double share = total / static_cast<double>(n);
   const double* const cum = scan_out_.data();
-  // Contiguous source ranges per thread of the team; each range boundary is computed once. No
-  // barrier at the end: the cycle's region ends here.
+  // Contiguous source ranges per thread of the team and their contiguous output slots; each
+  // range boundary is computed once. No barrier at the end: the cycle's region ends here.
+  const SystematicOwners systematic{cum, n_src, n, scale, u};
   const std::int64_t i_lo = n_src * t.id / t.size, i_hi = n_src * (t.id + 1) / t.size;
-  std::int64_t k1 = SystematicStart(cum, i_lo, n_src, scale, u, n);
-  for (std::int64_t i = i_lo; i < i_hi; ++i) {
-    const std::int64_t k0 = k1;
-    k1 = SystematicStart(cum, i + 1, n_src, scale, u, n);
-    if (k0 == k1) continue;
-    const LocalParticles& src = i < n_in ? sorted_ : births_;
-    const std::int64_t si = i < n_in ? i : i - n_in;
-    // Copies carry the new equal share; w_position / w_velocity keep their ratio to the weight.
-    const double ratio = share / src.weight[si];
-    for (std::int64_t k = k0; k < k1; ++k) {
-      particles_.CopyFrom(src, si, k);
-      particles_.weight[k] = share;
-      particles_.w_position[k] *= ratio;
-      particles_.w_velocity[k] *= ratio;
-    }
-  }
+  const std::int64_t k_lo = systematic.Start(i_lo), k_hi = systematic.Start(i_hi);
+  if (k_lo == k_hi) return;
+  std::uint32_t* const owner = resample_owner_.data();
+  systematic.Fill(i_lo, i_hi, k_lo, k_hi, owner);
+  // Slots before start(n_in) copy persistent particles, the rest births.
+  const std::int64_t k_mid = std::clamp(systematic.Start(n_in), k_lo, k_hi);
+  CopyOwned(sorted_, 0, owner, k_lo, k_mid, share, particles_);
+  CopyOwned(births_, n_in, owner, k_mid, k_hi, share, particles_);
 }
 
 }  // namespace dualgrid::filter

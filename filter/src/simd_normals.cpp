@@ -109,14 +109,20 @@ inline void SinCos2Pi(VF u, VF& s, VF& c) {
   c = hn::IfThenElse(neg_c, hn::Neg(c0), c0);
 }
 
-// BoxMuller (fast_normal.hpp) per lane: a = r cos, b = r sin with r = sqrt(-2 log(1 - u1)).
-inline void BoxMuller(VF u1, VF u2, VF& a, VF& b) {
+// Box-Muller per lane from the log's argument v in (0, 1]: a = r cos, b = r sin with
+// r = sqrt(-2 log(v)), the angle 2 pi u2.
+inline void BoxMullerOf(VF v, VF u2, VF& a, VF& b) {
   const DF df;
-  const VF r = hn::Sqrt(hn::Mul(hn::Set(df, -2.0f), Log(hn::Sub(hn::Set(df, 1.0f), u1))));
+  const VF r = hn::Sqrt(hn::Mul(hn::Set(df, -2.0f), Log(v)));
   VF s, c;
   SinCos2Pi(u2, s, c);
   a = hn::Mul(r, c);
   b = hn::Mul(r, s);
+}
+
+// BoxMuller (fast_normal.hpp) per lane: the log of 1 - u1.
+inline void BoxMuller(VF u1, VF u2, VF& a, VF& b) {
+  BoxMullerOf(hn::Sub(hn::Set(DF(), 1.0f), u1), u2, a, b);
 }
 
 // Counters of kU vectors of particles from index0 on: (step lo, step hi, index, purpose|block).
@@ -142,6 +148,15 @@ inline void Put(D d, hn::Vec<D> v, hn::TFromD<D>* p, std::size_t valid) {
   alignas(64) hn::TFromD<D> buf[HWY_MAX_BYTES / sizeof(hn::TFromD<D>)];
   hn::Store(v, d, buf);
   std::memcpy(p, buf, valid * sizeof(buf[0]));
+}
+
+// The first `valid` lanes from p, the others zero (all of them with one load).
+template <class D>
+inline hn::Vec<D> Get(D d, const hn::TFromD<D>* p, std::size_t valid) {
+  if (valid == hn::Lanes(d)) return hn::LoadU(d, p);
+  alignas(64) hn::TFromD<D> buf[HWY_MAX_BYTES / sizeof(hn::TFromD<D>)] = {};
+  std::memcpy(buf, p, valid * sizeof(buf[0]));
+  return hn::Load(d, buf);
 }
 
 }  // namespace
@@ -187,6 +202,34 @@ void PredictionNormalLanes(std::uint64_t seed, std::uint64_t step, std::uint32_t
       const auto valid = static_cast<std::size_t>(std::min(lanes, n - at));
       for (int c = 0; c < 4; ++c) Put(df, out[u][c], g[c] + at, valid);
     }
+  }
+}
+
+void Unit24Lanes(const std::uint32_t* r, std::int64_t n, float* out) {
+  const DU du;
+  const DF df;
+  const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(du));
+  for (std::int64_t k = 0; k < n; k += lanes) {
+    const auto valid = static_cast<std::size_t>(std::min(lanes, n - k));
+    Put(df, Unit24(Get(du, r + k, valid)), out + k, valid);
+  }
+}
+
+void Normal2Lanes(const std::uint32_t* r1, const std::uint32_t* r2, std::int64_t n, float* a,
+                  float* b) {
+  const DU du;
+  const DF df;
+  const DI di;
+  const std::int64_t lanes = static_cast<std::int64_t>(hn::Lanes(du));
+  for (std::int64_t k = 0; k < n; k += lanes) {
+    const auto valid = static_cast<std::size_t>(std::min(lanes, n - k));
+    // ((r1 >> 8) + 1) / 2^24: exact in float (at most 2^24 before the power-of-two scale).
+    const VF m = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<8>(Get(du, r1 + k, valid))));
+    const VF v = hn::Mul(hn::Add(m, hn::Set(df, 1.0f)), hn::Set(df, 1.0f / 16777216.0f));
+    VF va, vb;
+    BoxMullerOf(v, Unit24(Get(du, r2 + k, valid)), va, vb);
+    Put(df, va, a + k, valid);
+    Put(df, vb, b + k, valid);
   }
 }
 

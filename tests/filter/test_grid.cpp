@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
@@ -476,6 +477,48 @@ TEST_CASE("ForEachWeightedCellWhere gives the particles of the cells a layer kee
   g.Reframe(0.1, ego.position);
   CHECK_THROWS_AS(g.ForEachWeightedCellWhere(std::span<const float>(dyn), above(0.5), record),
                   std::logic_error);
+}
+
+TEST_CASE("ExportMeanVelocities gives Cell's mean velocities of every cell, as float",
+          "[filter][grid][property]") {
+  // The ego moves by fractions of a cell each step, so the storage origin wraps in both axes and
+  // a logical row spans two storage runs; the reference is Cell() cell by cell.
+  const std::uint64_t seed = GENERATE(range(1, 4));
+  FilterParams fp;
+  fp.length_x = 60.0;
+  fp.width_y = 30.0;
+  fp.num_particles = 3000;
+  fp.num_birth = 300;
+  DynamicGrid g(fp, seed);
+  const std::size_t cells = static_cast<std::size_t>(g.cells_x()) * g.cells_y();
+  std::vector<float> vx(cells, 7.0f), vy(cells, 7.0f);
+  g.ExportMeanVelocities(vx, vy);  // before the first Update: no particles, zero means
+  CHECK(std::count(vx.begin(), vx.end(), 0.0f) == static_cast<std::ptrdiff_t>(cells));
+  Pose2 ego;
+  CounterRng rng(seed, RngPurpose::kTest, 2001, 0);
+  ego.position = {rng.Uniform(-500.0, 500.0), rng.Uniform(-500.0, 500.0)};
+  int moving = 0;  // cells with a mean speed above 0.5 m/s, over all steps
+  for (int step = 0; step < 6; ++step) {
+    ego.position += Vector2(rng.Uniform(0.0, 1.7), rng.Uniform(-1.0, 1.0));
+    const auto cov = Sensors(ego);
+    g.Update({ego, {20, 0}}, RandomDetections(ego, seed, step, cov), cov, 0.05);
+    g.ExportMeanVelocities(vx, vy);
+    int differ = 0;
+    for (int y = 0; y < g.cells_y(); ++y) {
+      for (int x = 0; x < g.cells_x(); ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * g.cells_x() + x;
+        const CellState c = g.Cell({x, y});
+        differ += vx[i] != static_cast<float>(c.mean_velocity.x()) ||
+                  vy[i] != static_cast<float>(c.mean_velocity.y());
+        moving += c.mean_velocity.norm() > 0.5;
+      }
+    }
+    INFO("seed " << seed << " step " << step);
+    CHECK(differ == 0);
+  }
+  CHECK(moving > 0);  // else equality of zeros would prove little
+  CHECK_THROWS_AS(g.ExportMeanVelocities(std::span<float>(vx).first(cells - 1), vy),
+                  std::invalid_argument);
 }
 
 TEST_CASE("an ego beyond kMaxCentre is refused before the grid moves", "[filter][measurement]") {

@@ -66,6 +66,38 @@ TEST_CASE("prediction normals on lanes are the scalar path's, bit for bit",
   }
 }
 
+TEST_CASE("births' uniforms and normals on lanes are the scalar ToUnit24 and Normal2FromRaw",
+          "[filter][simd][noise]") {
+  // Raw words from CounterRng plus the extremes of the 24 bits used (0, all ones: the log's
+  // argument 1 and 2^-24); n = 203 leaves a tail of three lanes.
+  const std::int64_t n = 203;
+  std::vector<std::uint32_t> r1(n), r2(n);
+  CounterRng rng(11, RngPurpose::kTest, 4, 0);
+  for (std::int64_t k = 0; k < n; ++k) {
+    r1[k] = rng.NextU32();
+    r2[k] = rng.NextU32();
+  }
+  r1[0] = 0u;
+  r1[1] = 0xFFFFFFFFu;
+  r2[2] = 0u;
+  r2[3] = 0xFFFFFFFFu;
+  std::vector<float> u(n + 1, NAN), a(n + 1, NAN), b(n + 1, NAN);
+  detail::Unit24Lanes(r1.data(), n, u.data());
+  detail::Normal2Lanes(r1.data(), r2.data(), n, a.data(), b.data());
+  for (std::int64_t k = 0; k < n; ++k) {
+    float wa, wb;
+    filter_ref::detail::Normal2FromRaw(r1[k], r2[k], &wa, &wb);
+    INFO("k " << k);
+    REQUIRE(u[k] == filter_ref::detail::ToUnit24(r1[k]));
+    REQUIRE(a[k] == wa);
+    REQUIRE(b[k] == wb);
+  }
+  CHECK(std::isnan(u[n]));  // nothing written past n
+  CHECK(std::isnan(a[n]));
+  CHECK(std::isnan(b[n]));
+  CHECK(a[1] == 0.0f);  // log(1) = 0: a zero radius
+}
+
 TEST_CASE("prediction normals on lanes are standard normal", "[filter][simd][noise]") {
   // 4 x 40,000 draws: the mean's standard error is 1/200 and the variance's sqrt(2/40000) = 0.007;
   // 5 standard errors each (the approximations' error, < 2e-5, is far below).

@@ -135,6 +135,11 @@ class DynamicGrid {
   /// the scorer reads this every cycle; figures use Cell() for the velocities only when drawn.
   void ExportMasses(std::span<float> free, std::span<float> static_occ, std::span<float> dynamic,
                     std::span<std::uint8_t> observed) const;
+  /// Cell()'s mean_velocity [m/s] of every cell in logical row-major order (as ExportMasses),
+  /// cast to float, without the covariance and without locating each cell: the same values as
+  /// static_cast<float>(Cell({x, y}).mean_velocity.x()) (and .y()). Each span must hold
+  /// cells_x() * cells_y() entries (std::invalid_argument otherwise). O(cells + particles).
+  void ExportMeanVelocities(std::span<float> mean_vx, std::span<float> mean_vy) const;
 
   /// Particles after the last resampling (all `weight`s equal: total dynamic mass / count), in
   /// the caller's frame. The filter keeps them in float grid-local coordinates (docs/algorithm.md,
@@ -193,6 +198,10 @@ class DynamicGrid {
   std::int64_t Storage(std::int64_t gx, std::int64_t gy) const;
   // Storage column and row of logical cell (0, 0).
   std::array<std::int64_t, 2> StorageOrigin() const;
+  // f(i, s, count) for each contiguous storage run of the logical rows (cell_moments.cpp):
+  // logical cells [i, i + count) are storage cells [s, s + count), two runs per row.
+  template <typename F>
+  void ForEachStorageRun(F&& f) const;
   // Initialisation around the ego: the origin (serial), then the particles spread over the grid
   // with zero weight (by the team t).
   void InitializeOrigin(const EgoInput& ego);
@@ -239,9 +248,21 @@ class DynamicGrid {
   };
   bool BirthMass(const detail::Team& t, BirthSums& sums);
   void DrawBirths(const detail::Team& t, std::span<const Measurement> z, const BirthSums& sums);
-  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`).
-  void GenerateBirths(std::span<const Measurement> z, std::int64_t s, std::int64_t k_lo,
-                      std::int64_t k_hi, double mass, double vmax);
+  // The velocity frame of births near detection j, a function of j alone (DrawBirths reuses it
+  // across the neighbouring cells that share their nearest detection): the unit line of sight,
+  // its tangent, the radial speed and the tangential bound [m/s], the Doppler fit's use. j < 0:
+  // no detection.
+  struct BirthFrame {
+    int j = -1;
+    Vector2 los = Vector2::Zero(), tangent = Vector2::Zero();
+    double v_radial = 0.0, vt_max = 0.0, fit_t = 0.0, fit_sd = 0.0;
+    bool fitted = false;
+  };
+  BirthFrame FrameOf(std::span<const Measurement> z, int j, double vmax) const;
+  // New-born particles [k_lo, k_hi) in storage cell s (each of mass `mass`), their velocities in
+  // the frame of the cell's nearest detection.
+  void GenerateBirths(std::int64_t s, std::int64_t k_lo, std::int64_t k_hi, double mass,
+                      const BirthFrame& f);
   // Step 8: ScanPersistent (serial) may run once the weights are final, beside DrawBirths (it
   // starts the prefix sums over the persistent particles when they fit in one scan block);
   // Resample finishes the sums and copies.
@@ -290,18 +311,19 @@ class DynamicGrid {
   std::vector<std::int64_t> cell_start_;         // num_cells_ + 2: particle ranges of sorted_
   std::vector<std::int32_t> hist_;               // per-chunk histograms of the counting sort
   std::vector<std::int64_t> hist_total_;
-  std::vector<double> scan_out_;    // resampling prefix sums of the source weights
-  std::vector<double> scan_base_;   // their block totals
-  double scan_persistent_ = 0.0;    // ScanPersistent's running sum
-  std::vector<double> born_block_;  // block totals of the birth-mass prefix sums
+  std::vector<double> scan_out_;               // resampling prefix sums of the source weights
+  std::vector<double> scan_base_;              // their block totals
+  std::vector<std::uint32_t> resample_owner_;  // Resample's scratch: each output slot's source
+  double scan_persistent_ = 0.0;               // ScanPersistent's running sum
+  std::vector<double> born_block_;             // block totals of the birth-mass prefix sums
   // Cells with non-zero birth mass, per UpdateCells chunk (slots [chunk * size, + count)).
   std::vector<std::int64_t> born_cells_;
   std::vector<std::int32_t> born_count_;
   std::vector<double> det_fv0_;         // per detection: f_v of a particle at v = 0
   std::vector<double> born_chunk_acc_;  // birth-mass running sum at each chunk start
-  // The births' Philox words of this cycle, drawn for all num_birth at once (DrawBirths): slot
-  // w * num_birth + k holds word w of birth k (w 0-3: block 0; 4-5: words 0-1 of block 1).
-  std::vector<std::uint32_t> birth_raw_;
+  // The births' draws of this cycle, made for all num_birth at once (DrawBirths): slot
+  // c * num_birth + k holds birth k's uniform c (c 0, 1, 4, 5) or normal c (c 2, 3).
+  std::vector<float> birth_draw_;
   // The measurement grid of the running Update (the caller's or own_measurement_); null between
   // cycles.
   const MeasurementGrid* mg_ = nullptr;

@@ -21,4 +21,12 @@ void PhiloxLanes(std::uint64_t seed, std::uint32_t purpose, std::uint64_t step, 
 void PredictionNormalLanes(std::uint64_t seed, std::uint64_t step, std::uint32_t first,
                            std::int64_t n, float* g0, float* g1, float* g2, float* g3);
 
+/// ToUnit24 (fast_normal.hpp) of r[k] for k in [0, n): out[k] = (r[k] >> 8) / 2^24, in [0, 1).
+void Unit24Lanes(const std::uint32_t* r, std::int64_t n, float* out);
+
+/// Normal2FromRaw (fast_normal.hpp) of (r1[k], r2[k]) for k in [0, n) into (a[k], b[k]): the
+/// Box-Muller pair of log argument ((r1 >> 8) + 1) / 2^24 in (0, 1], bit for bit the scalar values.
+void Normal2Lanes(const std::uint32_t* r1, const std::uint32_t* r2, std::int64_t n, float* a,
+                  float* b);
+
 }  // namespace dualgrid::filter::detail
