@@ -50,8 +50,8 @@ std::string FilesystemMessage(const std::filesystem::filesystem_error& e) {
 }
 
 // The command the user ran: the launcher `dualgrid` names itself in DUALGRID_COMMAND before it
-// executes this program (tools/launcher/launcher.cpp); run directly, this program itself. Child runs
-// start it, and the installed data are found from it (PREFIX/bin/dualgrid -> PREFIX/share).
+// executes this program (tools/launcher/launcher.cpp); run directly, this program itself. Child
+// runs start it, and the installed data are found from it (PREFIX/bin/dualgrid -> PREFIX/share).
 std::string CommandPath(const char* argv0) {
   if (const char* command = std::getenv("DUALGRID_COMMAND"); command && *command) return command;
   char buf[4096];
@@ -82,8 +82,8 @@ std::string HelpHint(const CLI::App& app) {
 // every barrier) costs ~30 us per barrier on a quiet machine, though; a spin of ~3 us
 // (GOMP_SPINCOUNT=300) before sleeping keeps most of the quiet speed and the robustness under
 // load. libgomp reads these variables when it is loaded, before main: the launcher `dualgrid`
-// sets them before it executes this program (tools/launcher/launcher.cpp). Run directly without them,
-// the program re-executes itself once with them set (loading every library twice), unless the
+// sets them before it executes this program (tools/launcher/launcher.cpp). Run directly without
+// them, the program re-executes itself once with them set (loading every library twice), unless the
 // user chose a policy or spin count. Returns only if no re-exec happened.
 static void UseShortOpenMpSpinning(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
