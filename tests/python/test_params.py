@@ -132,7 +132,8 @@ class FilterParamsTest(unittest.TestCase):
     def test_memory_bytes(self):
         p = dualgrid.FilterParams()
         # FilterParams::MemoryBytes: 94 B per cell (the grid's 81 and its own MeasurementGrid's
-        # 13), 72 B per particle (with the resampling's owner index) and 36 B per new-born one (float state, docs/algorithm.md).
+        # 13), 72 B per particle (with the resampling's owner index) and 36 B per new-born one
+        # (float state, docs/algorithm.md).
         self.assertAlmostEqual(p.memory_bytes(), 94.0 * 400 * 50 + 72.0 * 10000 + 36.0 * 1000)
 
 
