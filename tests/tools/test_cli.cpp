@@ -97,6 +97,20 @@ TEST_CASE("A launcher without its program says so in one line", "[cli]") {
   CHECK(r.output.find("cannot find dualgrid-bin in " + d.string()) != std::string::npos);
 }
 
+TEST_CASE("A child run whose program cannot be executed says so in the error and its log",
+          "[cli]") {
+  const auto d = TempDir("child_exec");
+  const fs::path program = fs::path(DUALGRID_EXE).parent_path() / "dualgrid-bin";
+  const Result r = Shell("DUALGRID_COMMAND=" + (d / "missing").string() + " " + program.string() +
+                         " experiment scenarios/simple_road.yaml"
+                         " --seeds 1 --duration 1 --no-figures -q --out " +
+                         (d / "e").string());
+  CHECK(r.code != 0);
+  const std::string line = "cannot execute " + (d / "missing").string();
+  CHECK(r.output.find(line) != std::string::npos);
+  CHECK(Slurp(d / "e" / "seeds" / "seed_1.log").find(line) != std::string::npos);
+}
+
 TEST_CASE("Same scenario and seed give identical ground truth; another seed differs", "[cli]") {
   const auto a = TempDir("a"), b = TempDir("b"), c = TempDir("c");
   const std::string common = "sim scenarios/simple_road.yaml --duration 12 -q ";

@@ -28,6 +28,10 @@ pid_t StartChild(std::vector<std::string> args, const std::filesystem::path& log
   argv.push_back(nullptr);
   const std::string log_path = log.string();
   const pid_t parent = getpid();
+  // The child's one line when exec fails (built here: the child may only make async-signal-safe
+  // calls, so no formatting or strerror there).
+  const std::string exec_error = "dualgrid: error: cannot execute " + args[0] +
+                                 " (no such file, or not executable); exit code 127\n";
   int fds[2] = {-1, -1};
   if (stderr_pipe && pipe2(fds, O_CLOEXEC) != 0)
     throw std::runtime_error("cannot start " + args[0] + ": " + std::strerror(errno));
@@ -55,6 +59,7 @@ pid_t StartChild(std::vector<std::string> args, const std::filesystem::path& log
     dup2(stderr_pipe ? fds[1] : fd, 2);  // (dup2 clears O_CLOEXEC on the copies)
     close(fd);
     execv(argv[0], argv.data());
+    [[maybe_unused]] const ssize_t w = write(2, exec_error.data(), exec_error.size());
     _exit(127);
   }
   if (stderr_pipe) {
