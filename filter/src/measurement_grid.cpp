@@ -307,6 +307,32 @@ void SettleZoned(const RowSensor& c, const double* phi, const double* cot, int n
   if (pos <= e) Settle(c, pos, e, exact, view);
 }
 
+// One row of a detection's stamp, n cells at consecutive storage columns: cell i at squared
+// distance exx[i] + eyy [m^2] takes the detection j into d2[i], det[i] when that is within
+// cutoff2 and below d2[i] (the scalar test's operations on lanes, without branches).
+void StampRun(const double* exx, int n, double eyy, double cutoff2, int j, double* d2, int* det) {
+  const DD d;
+  const hn::Rebind<std::int32_t, DD> di;
+  const int lanes = static_cast<int>(hn::Lanes(d));
+  const auto vy = hn::Set(d, eyy), cut = hn::Set(d, cutoff2);
+  const auto vj = hn::Set(d, static_cast<double>(j));  // indices are exact in a double
+  int i = 0;
+  for (; i + lanes <= n; i += lanes) {
+    const auto v = hn::Add(hn::LoadU(d, exx + i), vy);
+    const auto old = hn::LoadU(d, d2 + i);
+    const auto take = hn::And(hn::Le(v, cut), hn::Lt(v, old));
+    hn::StoreU(hn::IfThenElse(take, v, old), d, d2 + i);
+    const auto old_j = hn::PromoteTo(d, hn::LoadU(di, det + i));
+    hn::StoreU(hn::DemoteTo(di, hn::IfThenElse(take, vj, old_j)), di, det + i);
+  }
+  for (; i < n; ++i) {
+    const double v = exx[i] + eyy;
+    const bool take = (v <= cutoff2) & (v < d2[i]);
+    d2[i] = take ? v : d2[i];
+    det[i] = take ? j : det[i];
+  }
+}
+
 }  // namespace
 
 void detail::FastAtan2Lanes(const double* y, const double* x, int n, double* out) {
@@ -333,10 +359,7 @@ MeasurementGrid::MeasurementGrid(const FilterParams& params) : params_(params) {
   view_.assign(c, 0);
   near_det_.assign(c, -1);
   near_d2_.assign(c, kInf);
-  band_of_row_.resize(static_cast<std::size_t>(ny_));
-  for (int b = 0; b < kStampBands; ++b)
-    for (int row = b * ny_ / kStampBands; row < (b + 1) * ny_ / kStampBands; ++row)
-      band_of_row_[row] = b;
+  stamp_span_.assign(static_cast<std::size_t>(ny_), {nx_, -1});
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f;
   // Buckets at least cutoff + one cell wide: every detection within the cutoff of any point of a
   // cell lies in the 3 x 3 buckets around any particle of that cell (UpdateCells relies on it).
@@ -458,8 +481,6 @@ void MeasurementGrid::PlaceDetections() {
   const int rc = static_cast<int>(std::ceil(cutoff / r));
   std::fill(bucket_count_.begin(), bucket_count_.end(), 0);
   const int nz = static_cast<int>(z.size());
-  // Per band an upper bound of the cells its stamps touch (the touched lists never grow in Fill).
-  std::int64_t bound[kStampBands] = {};
   for (int j = 0; j < nz; ++j) {
     det_bucket_[j] = -1;
     const Position& p = z[j].position;
@@ -471,16 +492,9 @@ void MeasurementGrid::PlaceDetections() {
     const auto [bx, by] = BucketOf(p.x(), p.y());
     det_bucket_[j] = static_cast<std::int64_t>(by) * nbx_ + bx;
     ++bucket_count_[det_bucket_[j]];
-    const int cy_lo = std::max(0, ly - rc), cy_hi = std::min(ny_ - 1, ly + rc);
+    const int cy_lo = std::max(0, ly - rc);
     const int row_lo = static_cast<int>(Mod(origin_gy_ + cy_lo, ny_));
     det_stamp_[j] = {lx, ly, row_lo};
-    const int ncx = std::max(0, std::min(nx_ - 1, lx + rc) - std::max(0, lx - rc) + 1);
-    for (int cy = cy_lo, row = row_lo; cy <= cy_hi; ++cy, row = row + 1 == ny_ ? 0 : row + 1)
-      bound[band_of_row_[row]] += ncx;
-  }
-  for (int b = 0; b < kStampBands; ++b) {
-    const std::int64_t rows = (b + 1) * ny_ / kStampBands - b * ny_ / kStampBands;
-    touched_[b].reserve(static_cast<std::size_t>(std::min(bound[b], rows * nx_)));
   }
 }
 
@@ -509,15 +523,19 @@ void MeasurementGrid::StampBands(int band_lo, int band_hi) {
   const double r = params_.resolution;
   const double cutoff = params_.cutoff_sigmas * params_.sigma_f, cutoff2 = cutoff * cutoff;
   const int rc = static_cast<int>(std::ceil(cutoff / r));
-  for (int band = band_lo; band < band_hi; ++band) {
-    for (std::int64_t s : touched_[band]) {
-      near_det_[s] = -1;
-      near_d2_[s] = kInf;
-    }
-    touched_[band].clear();  // keeps the capacity PlaceDetections reserved
-  }
   const int row_a = band_lo * ny_ / kStampBands, row_b = band_hi * ny_ / kStampBands;
+  for (int srow = row_a; srow < row_b; ++srow) {  // the last build's stamps in these rows
+    auto& [lo, hi] = stamp_span_[srow];
+    const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
+    if (lo <= hi) {
+      std::fill(near_det_.begin() + row + lo, near_det_.begin() + row + hi + 1, -1);
+      std::fill(near_d2_.begin() + row + lo, near_d2_.begin() + row + hi + 1, kInf);
+    }
+    lo = nx_;
+    hi = -1;
+  }
   const std::int64_t sx0 = Mod(origin_gx_, nx_);
+  const int wrap = static_cast<int>(nx_ - sx0);  // first logical column whose storage wraps
   const int nz = static_cast<int>(z.size());
   for (int j = 0; j < nz; ++j) {
     if (det_bucket_[j] < 0) continue;
@@ -540,20 +558,20 @@ void MeasurementGrid::StampBands(int band_lo, int band_hi) {
       for (int cy = cy_lo, srow = row_lo; cy <= cy_hi;
            ++cy, srow = srow + 1 == ny_ ? 0 : srow + 1) {
         if (srow < row_a || srow >= row_b) continue;
-        std::vector<std::int64_t>& touched = touched_[band_of_row_[srow]];
         const std::int64_t row = static_cast<std::int64_t>(srow) * nx_;
         const double ey = (static_cast<double>(origin_gy_ + cy) + 0.5) * r - p.y();
         const double eyy = ey * ey;
-        for (int cx = c0; cx <= c1; ++cx) {
-          const double d2 = exx[cx - c0] + eyy;
-          if (d2 > cutoff2) continue;
-          const std::int64_t sx = sx0 + cx;
-          const std::int64_t s = row + (sx >= nx_ ? sx - nx_ : sx);
-          if (near_det_[s] < 0) touched.push_back(s);
-          if (d2 < near_d2_[s]) {
-            near_d2_[s] = d2;
-            near_det_[s] = j;
-          }
+        auto& [lo, hi] = stamp_span_[srow];
+        // Storage columns sx0 + cx, in at most two runs (the second from the row's wrap).
+        for (int part = 0; part < 2; ++part) {
+          const int pa = part == 0 ? c0 : std::max(c0, wrap);
+          const int pe = part == 0 ? std::min(c1, wrap - 1) : c1;
+          if (pa > pe) continue;
+          const int first = static_cast<int>(sx0 + pa - (part == 0 ? 0 : nx_));
+          StampRun(exx + (pa - c0), pe - pa + 1, eyy, cutoff2, j, near_d2_.data() + row + first,
+                   near_det_.data() + row + first);
+          lo = std::min(lo, first);
+          hi = std::max(hi, first + pe - pa);
         }
       }
     }

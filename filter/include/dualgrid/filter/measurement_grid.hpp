@@ -92,6 +92,12 @@ class MeasurementGrid {
   /// Number of Build calls so far (0: never built).
   std::uint64_t builds() const { return builds_; }
 
+  /// Per cell of the last Build, in storage order (as view()): the index into measurements() of
+  /// the detection nearest to the cell centre within cutoff_sigmas x sigma_f (the lowest index
+  /// among equally near ones), or -1; and its squared distance [m^2] (inf where -1).
+  std::span<const int> nearest() const { return near_det_; }
+  std::span<const double> nearest_d2() const { return near_d2_; }
+
  private:
   friend class DynamicGrid;
   // test_float_bound.cpp's double reference cycle reads the same tables as DynamicGrid: it links
@@ -145,11 +151,12 @@ class MeasurementGrid {
   std::vector<std::uint8_t> view_;  // field-of-view / ray free-space bits (grid_internal.hpp)
   std::vector<int> near_det_;       // nearest detection index or -1
   std::vector<double> near_d2_;     // its squared distance to the cell centre [m^2]
-  // Cells with near_det_ set (reset by the next Build), per band of storage rows: band b holds
-  // rows [b ny / kStampBands, (b + 1) ny / kStampBands).
+  // Bands of storage rows the stamping runs in: band b holds rows [b ny / kStampBands,
+  // (b + 1) ny / kStampBands).
   static constexpr int kStampBands = 8;
-  std::vector<std::int64_t> touched_[kStampBands];
-  std::vector<int> band_of_row_;  // per storage row
+  // Per storage row, the storage columns [lo, hi] the last build's stamps covered (lo > hi:
+  // none); the next build resets near_det_ and near_d2_ there.
+  std::vector<std::array<int, 2>> stamp_span_;
 
   // Detection bucket index (logical coordinates, bucket edge >= cutoff + one cell).
   int bucket_cells_ = 1, nbx_ = 1, nby_ = 1;
