@@ -248,6 +248,28 @@ bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n
   return true;
 }
 
+bool FitMemo::Find(const int* key, int n, bool* ok, DopplerFit* f) const {
+  for (int s = 0; s < size_; ++s) {
+    const Entry& e = slot_[(next_ + kSlots - 1 - s) % kSlots];  // the newest first
+    if (e.n != n || !std::equal(key, key + n, e.key)) continue;
+    *ok = e.ok;
+    *f = e.f;
+    return true;
+  }
+  return false;
+}
+
+void FitMemo::Add(const int* key, int n, bool ok, const DopplerFit& f) {
+  assert(0 <= n && n <= kFitMaxNeighbours);
+  Entry& e = slot_[next_];
+  e.n = n;
+  std::copy_n(key, n, e.key);
+  e.ok = ok;
+  e.f = f;
+  next_ = (next_ + 1) % kSlots;
+  size_ = std::min(size_ + 1, kSlots);
+}
+
 }  // namespace detail
 
 double MeasurementGrid::BucketGap(double p, int b, int nb, double origin) const {
@@ -268,8 +290,7 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const double oy = static_cast<double>(origin_gy_) * params_.resolution;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
   const double* const los_b = det_los_b_.data();
-  const auto fit = [&](std::int64_t jj) {
-    const int j = static_cast<int>(jj);
+  const auto fit = [&](int j, FitMemo* memo) {
     det_fit_t_[j] = 0.0;
     det_fit_sd_[j] = std::numeric_limits<double>::infinity();
     if (det_bucket_[j] < 0) return;  // not near the grid: no birth from it
@@ -295,6 +316,7 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
       return gx * gx + gy * gy;
     };
     double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
+    int key[kFitMaxNeighbours];  // the gathered neighbours' bucket positions
     int n = 0, looked = 0;
     for (int cy = cy_lo; cy <= cy_hi; ++cy) {
       for (int cx = cx_lo; cx <= cx_hi; ++cx) {
@@ -309,13 +331,20 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
           ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
           uy[n] = los_b[3 * k + 1];
           y[n] = los_b[3 * k + 2];
+          key[n] = static_cast<int>(k);
           n += !(ex * ex + ey * ey > radius2);
         }
       }
     }
   gathered:
+    if (n < 3) return;
     DopplerFit f;
-    if (n < 3 || !RobustDopplerFit(ux, uy, y, n, floor, floor_bound, &f)) return;
+    bool ok = false;
+    if (!memo->Find(key, n, &ok, &f)) {
+      ok = RobustDopplerFit(ux, uy, y, n, floor, floor_bound, &f);
+      memo->Add(key, n, ok, f);
+    }
+    if (!ok) return;
     // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
     // t^T (scale^2 A^-1) t.
     const double tx = -los[3 * j + 1], ty = los[3 * j];
@@ -325,7 +354,15 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
     det_fit_t_[j] = f.vx * tx + f.vy * ty;
     det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
   };
-  ForDynamicNoWait(t, nz, fit, 32);  // Fill's contract: no barrier at the end
+  // Runs of kRun detections (in detection order: one object's detections of one scan side by
+  // side), each with its own memo.
+  constexpr int kRun = 32;
+  const auto run = [&](std::int64_t r) {
+    FitMemo memo;
+    const int end = std::min(nz, static_cast<int>(r + 1) * kRun);
+    for (int j = static_cast<int>(r) * kRun; j < end; ++j) fit(j, &memo);
+  };
+  ForDynamicNoWait(t, (nz + kRun - 1) / kRun, run);  // Fill's contract: no barrier at the end
 }
 
 }  // namespace dualgrid::filter

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "dualgrid/core/random.hpp"
@@ -154,6 +155,57 @@ TEST_CASE("RobustDopplerFit with non-finite inputs fails or matches the plain fi
       CHECK(Bits(got.scale) == Bits(want.scale));
     }
   }
+}
+
+TEST_CASE("FitMemo finds a fit only under its exact key, the newest slots kept",
+          "[filter][doppler_fit]") {
+  using filter::detail::FitMemo;
+  auto memo = std::make_unique<FitMemo>();
+  const auto fit_of = [](int tag) {  // distinct outcomes per tag
+    DopplerFit f;
+    f.vx = 0.5 * tag;
+    f.vy = -1.0 - tag;
+    f.scale = 0.1 + tag;
+    f.a00 = 2.0 * tag;
+    f.a01 = 3.0 * tag;
+    f.a11 = 4.0 * tag;
+    f.inliers = tag;
+    return f;
+  };
+  const auto key_of = [](int tag, int n) {  // keys of one tag share all but the last entry
+    std::vector<int> key(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) key[static_cast<std::size_t>(i)] = 7 * i + (i == n - 1 ? tag : 0);
+    return key;
+  };
+  bool ok = false;
+  DopplerFit got;
+  const std::vector<int> a = key_of(1000, kFitMaxNeighbours);
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));  // empty
+  memo->Add(a.data(), kFitMaxNeighbours, true, fit_of(1000));
+  REQUIRE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));
+  CHECK(ok);
+  CHECK(Bits(got.vx) == Bits(fit_of(1000).vx));
+  CHECK(Bits(got.a11) == Bits(fit_of(1000).a11));
+  CHECK(got.inliers == 1000);
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours - 1, &ok, &got));  // a prefix
+  const std::vector<int> other = key_of(1001, kFitMaxNeighbours);       // the last entry differs
+  CHECK_FALSE(memo->Find(other.data(), kFitMaxNeighbours, &ok, &got));
+  // Failed fits are remembered as failed; keys of 3 to kSlots + 2 entries, each found with its
+  // outcome.
+  for (int tag = 0; tag < FitMemo::kSlots; ++tag) {
+    const std::vector<int> key = key_of(tag, 3 + tag);
+    memo->Add(key.data(), 3 + tag, tag % 2 == 0, fit_of(tag));
+  }
+  for (int tag = 0; tag < FitMemo::kSlots; ++tag) {
+    const std::vector<int> key = key_of(tag, 3 + tag);
+    INFO("tag " << tag);
+    REQUIRE(memo->Find(key.data(), 3 + tag, &ok, &got));
+    CHECK(ok == (tag % 2 == 0));
+    CHECK(got.inliers == tag);
+    CHECK(Bits(got.scale) == Bits(fit_of(tag).scale));
+  }
+  // kSlots later fits took every slot: the first one is gone.
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));
 }
 
 TEST_CASE("FastAtan2 on SIMD lanes gives the scalar bearing bit for bit", "[filter][fov]") {

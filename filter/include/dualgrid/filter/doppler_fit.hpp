@@ -38,4 +38,29 @@ double SelectRank(const double* a, int n, int k, double guess);
 bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n, double floor,
                       double floor_bound, DopplerFit* f);
 
+/// The last few fits of one thread's run of detections, each under its key: the neighbours it
+/// gathered (their positions in the detection buckets, in gathering order). RobustDopplerFit is a
+/// pure function of the gathered arrays, so a detection whose key equals an earlier one's (within
+/// one build: the buckets fixed) takes that fit as it is, bit for bit. Owned by the caller's stack.
+class FitMemo {
+ public:
+  static constexpr int kSlots = 16;  // fits remembered
+
+  /// The fit remembered under key[0, n) (true: found; *ok and *f then hold its outcome).
+  /// 0 <= n <= kFitMaxNeighbours.
+  bool Find(const int* key, int n, bool* ok, DopplerFit* f) const;
+  /// Remembers a fit under key[0, n), in place of the oldest one when all slots are taken.
+  void Add(const int* key, int n, bool ok, const DopplerFit& f);
+
+ private:
+  struct Entry {
+    int n;
+    int key[kFitMaxNeighbours];
+    bool ok;
+    DopplerFit f;
+  };
+  Entry slot_[kSlots];
+  int size_ = 0, next_ = 0;  // slots in use; the slot the next Add takes
+};
+
 }  // namespace dualgrid::filter::detail
