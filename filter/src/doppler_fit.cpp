@@ -37,6 +37,18 @@ constexpr int kWindow = 7;
 
 // Solves sum_i w_i u_i u_i^T v = sum_i w_i u_i y_i; false when the lines of sight (weighted) do
 // not span the plane.
+// Solve's end: v from the sums A = (a00 a01; a01 a11), b = (b0, b1).
+bool SolveSums(double a00, double a01, double a11, double b0, double b1, DopplerFit* f) {
+  const double det = a00 * a11 - a01 * a01;
+  if (!(det > 1e-12 * (a00 + a11) * (a00 + a11))) return false;
+  f->vx = (a11 * b0 - a01 * b1) / det;
+  f->vy = (a00 * b1 - a01 * b0) / det;
+  f->a00 = a00;
+  f->a01 = a01;
+  f->a11 = a11;
+  return true;
+}
+
 bool Solve(const double* ux, const double* uy, const double* y, const double* w, int n,
            DopplerFit* f) {
   double a00 = 0.0, a01 = 0.0, a11 = 0.0, b0 = 0.0, b1 = 0.0;
@@ -47,14 +59,7 @@ bool Solve(const double* ux, const double* uy, const double* y, const double* w,
     b0 += w[i] * ux[i] * y[i];
     b1 += w[i] * uy[i] * y[i];
   }
-  const double det = a00 * a11 - a01 * a01;
-  if (!(det > 1e-12 * (a00 + a11) * (a00 + a11))) return false;
-  f->vx = (a11 * b0 - a01 * b1) / det;
-  f->vy = (a00 * b1 - a01 * b0) / det;
-  f->a00 = a00;
-  f->a01 = a01;
-  f->a11 = a11;
-  return true;
+  return SolveSums(a00, a01, a11, b0, b1, f);
 }
 
 namespace hn = hwy::HWY_NAMESPACE;
@@ -194,6 +199,102 @@ double NthElement(const double* r, int n, int k) {
   return sorted[k];
 }
 
+// The scale max(floor, 1.4826 median) of the residuals r[0, n), of which at_floor are <=
+// MadFloorBound(floor) and some NaN when `unordered`; *guess: the last median selected (updated).
+double Scale(const double* r, int n, int at_floor, bool unordered, double floor, double* guess) {
+  const int k = n / 2;
+  if (unordered) return std::max(floor, kMadToSigma * NthElement(r, n, k));
+  if (at_floor > k) return floor;  // = std::max(floor, kMadToSigma * median): median <= bound
+  *guess = detail::SelectRank(r, n, k, *guess);
+  return std::max(floor, kMadToSigma * *guess);
+}
+
+using D2 = hn::FixedTag<double, 2>;  // RobustDopplerFitPair's lanes: one fit each
+using V2 = hn::Vec<D2>;
+
+V2 Lanes(double a, double b) {  // (a, b)
+  alignas(16) const double v[2] = {a, b};
+  return hn::Load(D2(), v);
+}
+
+// Solve of two fits at once, on interleaved arrays (entry i of fit l at 2 i + l) of n entries:
+// each lane adds the same IEEE products in the same order as Solve's loop, so its sums are
+// bitwise Solve's. A fit with fewer entries is padded with ux = uy = y = w = +0.0: each product
+// is +0.0, and adding +0.0 leaves a sum bitwise unchanged, since a sum is never -0.0 (it starts
+// at +0.0 and, rounding to nearest, x + y is -0.0 only when x and y both are) and s + (+0.0) = s
+// for every other s, infinities and NaN included. ok[l] false: lane l skipped (dead).
+void SolvePair(const double* ux, const double* uy, const double* y, const double* w, int n,
+               DopplerFit f[2], bool ok[2]) {
+  const D2 d;
+  V2 a00 = hn::Zero(d), a01 = hn::Zero(d), a11 = hn::Zero(d), b0 = hn::Zero(d), b1 = hn::Zero(d);
+  for (int i = 0; i < 2 * n; i += 2) {
+    const V2 vw = hn::Load(d, w + i), vx = hn::Load(d, ux + i), vy = hn::Load(d, uy + i);
+    const V2 vv = hn::Load(d, y + i), wx = hn::Mul(vw, vx), wy = hn::Mul(vw, vy);
+    a00 = hn::Add(a00, hn::Mul(wx, vx));
+    a01 = hn::Add(a01, hn::Mul(wx, vy));
+    a11 = hn::Add(a11, hn::Mul(wy, vy));
+    b0 = hn::Add(b0, hn::Mul(wx, vv));
+    b1 = hn::Add(b1, hn::Mul(wy, vv));
+  }
+  alignas(16) double s[5][2];
+  hn::Store(a00, d, s[0]);
+  hn::Store(a01, d, s[1]);
+  hn::Store(a11, d, s[2]);
+  hn::Store(b0, d, s[3]);
+  hn::Store(b1, d, s[4]);
+  for (int l = 0; l < 2; ++l)
+    ok[l] = ok[l] && SolveSums(s[0][l], s[1][l], s[2][l], s[3][l], s[4][l], &f[l]);
+}
+
+// Residuals of two fits at once (interleaved as SolvePair's arrays; lanes as Residuals computes
+// them) into r; per lane the count of valid entries <= bound and whether one is NaN. valid: the
+// lanes' entry counts (entries i >= count are padding).
+void ResidualsPair(const double* ux, const double* uy, const double* y, int n,
+                   const DopplerFit f[2], V2 valid, double bound, double* r, int below[2],
+                   bool unordered[2]) {
+  const D2 d;
+  const V2 vvx = Lanes(f[0].vx, f[1].vx);
+  const V2 vvy = Lanes(f[0].vy, f[1].vy);
+  const V2 vb = hn::Set(d, bound), one = hn::Set(d, 1.0);
+  V2 count = hn::Zero(d), nan = hn::Zero(d);
+  for (int i = 0; i < n; ++i) {
+    const V2 e = hn::Sub(
+        hn::Add(hn::Mul(hn::Load(d, ux + 2 * i), vvx), hn::Mul(hn::Load(d, uy + 2 * i), vvy)),
+        hn::Load(d, y + 2 * i));
+    const V2 a = hn::Abs(e);
+    hn::Store(a, d, r + 2 * i);
+    const auto in = hn::Lt(hn::Set(d, static_cast<double>(i)), valid);
+    count = hn::Add(count, hn::IfThenElseZero(hn::And(in, hn::Le(a, vb)), one));
+    nan = hn::Or(nan, hn::IfThenElseZero(hn::And(in, hn::Ne(a, a)), one));
+  }
+  alignas(16) double c[2], u[2];
+  hn::Store(count, d, c);
+  hn::Store(nan, d, u);
+  for (int l = 0; l < 2; ++l) {
+    below[l] = static_cast<int>(c[l]);
+    unordered[l] = u[l] != 0.0;
+  }
+}
+
+// TukeyWeights of two fits at once (lanes as TukeyWeights computes them; c: the lanes' Tukey
+// constants), padding entries weighted +0.0; the lanes' inliers.
+void TukeyWeightsPair(const double* r, int n, V2 valid, V2 c, double* w, int inliers[2]) {
+  const D2 d;
+  const V2 one = hn::Set(d, 1.0);
+  V2 count = hn::Zero(d);
+  for (int i = 0; i < n; ++i) {
+    const V2 q = hn::Div(hn::Load(d, r + 2 * i), c);
+    const V2 t = hn::Sub(one, hn::Mul(q, q));
+    const auto in = hn::And(hn::Lt(hn::Set(d, static_cast<double>(i)), valid), hn::Lt(q, one));
+    hn::Store(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + 2 * i);
+    count = hn::Add(count, hn::IfThenElseZero(in, one));
+  }
+  alignas(16) double k[2];
+  hn::Store(count, d, k);
+  inliers[0] = static_cast<int>(k[0]);
+  inliers[1] = static_cast<int>(k[1]);
+}
+
 }  // namespace
 
 namespace detail {
@@ -229,19 +330,11 @@ bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n
   double w[kFitMaxNeighbours], r[kFitMaxNeighbours];
   std::fill_n(w, n, 1.0);
   if (!Solve(ux, uy, y, w, n, f)) return false;
-  const int k = n / 2;
   double guess = floor_bound;  // the last median selected
   for (int it = 0; it < kIterations; ++it) {
     bool unordered = false;  // a NaN residual
     const int at_floor = Residuals(ux, uy, y, n, f->vx, f->vy, floor_bound, r, &unordered);
-    if (unordered) {
-      f->scale = std::max(floor, kMadToSigma * NthElement(r, n, k));
-    } else if (at_floor > k) {
-      f->scale = floor;  // = std::max(floor, kMadToSigma * median): median <= floor_bound
-    } else {
-      guess = SelectRank(r, n, k, guess);
-      f->scale = std::max(floor, kMadToSigma * guess);
-    }
+    f->scale = Scale(r, n, at_floor, unordered, floor, &guess);
     f->inliers = TukeyWeights(r, n, kTukey * f->scale, w);
     if (f->inliers < 3 || !Solve(ux, uy, y, w, n, f)) return false;
   }
@@ -270,6 +363,96 @@ void FitMemo::Add(const int* key, int n, bool ok, const DopplerFit& f) {
   size_ = std::min(size_ + 1, kSlots);
 }
 
+// RobustDopplerFit's steps on both lanes: the vector parts (sums, residuals, weights) for both,
+// the median and the scale per lane (scalar, as RobustDopplerFit), a lane's work ending where its
+// fit does.
+void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound, DopplerFit f[2],
+                          bool ok[2]) {
+  assert(in[0].n >= 3 && in[0].n <= kFitMaxNeighbours);
+  assert(in[1].n >= 3 && in[1].n <= kFitMaxNeighbours);
+  const int n = std::max(in[0].n, in[1].n);
+  alignas(16) double ux[2 * kFitMaxNeighbours], uy[2 * kFitMaxNeighbours], y[2 * kFitMaxNeighbours],
+      w[2 * kFitMaxNeighbours], r[2 * kFitMaxNeighbours];
+  for (int l = 0; l < 2; ++l) {
+    for (int i = 0; i < n; ++i) {
+      const bool real = i < in[l].n;  // else padding: +0.0 (SolvePair)
+      ux[2 * i + l] = real ? in[l].ux[i] : 0.0;
+      uy[2 * i + l] = real ? in[l].uy[i] : 0.0;
+      y[2 * i + l] = real ? in[l].y[i] : 0.0;
+      w[2 * i + l] = real ? 1.0 : 0.0;
+    }
+    ok[l] = true;
+  }
+  SolvePair(ux, uy, y, w, n, f, ok);
+  const V2 valid = Lanes(in[0].n, in[1].n);
+  double guess[2] = {floor_bound, floor_bound};  // the lanes' last medians selected
+  for (int it = 0; it < kIterations && (ok[0] || ok[1]); ++it) {
+    int below[2], inliers[2];
+    bool unordered[2];
+    ResidualsPair(ux, uy, y, n, f, valid, floor_bound, r, below, unordered);
+    double c[2] = {1.0, 1.0};  // a dead lane's: any value
+    for (int l = 0; l < 2; ++l) {
+      if (!ok[l]) continue;
+      double rl[kFitMaxNeighbours];
+      for (int i = 0; i < in[l].n; ++i) rl[i] = r[2 * i + l];
+      f[l].scale = Scale(rl, in[l].n, below[l], unordered[l], floor, &guess[l]);
+      c[l] = kTukey * f[l].scale;
+    }
+    TukeyWeightsPair(r, n, valid, Lanes(c[0], c[1]), w, inliers);
+    for (int l = 0; l < 2; ++l) {
+      if (!ok[l]) continue;
+      f[l].inliers = inliers[l];
+      ok[l] = inliers[l] >= 3;
+    }
+    SolvePair(ux, uy, y, w, n, f, ok);
+  }
+}
+
+void RunFits::Submit(int i, int n) {
+  assert(0 <= i && i < kRun);
+  ok_[i] = false;
+  if (n < 3) return;
+  const Gathered& g = queue_[queued_];
+  if (memo_.Find(g.key, n, &ok_[i], &fit_[i])) return;
+  for (int q = 0; q < queued_; ++q) {
+    if (queued_n_[q] == n && std::equal(g.key, g.key + n, queue_[q].key)) {
+      assert(waiters_ < kRun);
+      waiter_i_[waiters_] = i;
+      waiter_of_[waiters_++] = q;
+      return;
+    }
+  }
+  queued_n_[queued_] = n;
+  queued_i_[queued_++] = i;
+  if (queued_ == 2) FitQueued();
+}
+
+void RunFits::Finish() { FitQueued(); }
+
+void RunFits::FitQueued() {
+  DopplerFit f[2];
+  bool ok[2] = {false, false};
+  if (queued_ == 2) {
+    const FitInput in[2] = {{queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0]},
+                            {queue_[1].ux, queue_[1].uy, queue_[1].y, queued_n_[1]}};
+    RobustDopplerFitPair(in, floor_, floor_bound_, f, ok);
+  } else if (queued_ == 1) {
+    ok[0] = RobustDopplerFit(queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0], floor_,
+                             floor_bound_, &f[0]);
+  }
+  for (int q = 0; q < queued_; ++q) {
+    memo_.Add(queue_[q].key, queued_n_[q], ok[q], f[q]);
+    ok_[queued_i_[q]] = ok[q];
+    fit_[queued_i_[q]] = f[q];
+  }
+  for (int k = 0; k < waiters_; ++k) {
+    ok_[waiter_i_[k]] = ok[waiter_of_[k]];
+    fit_[waiter_i_[k]] = f[waiter_of_[k]];
+  }
+  queued_ = 0;
+  waiters_ = 0;
+}
+
 }  // namespace detail
 
 double MeasurementGrid::BucketGap(double p, int b, int nb, double origin) const {
@@ -290,10 +473,9 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const double oy = static_cast<double>(origin_gy_) * params_.resolution;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
   const double* const los_b = det_los_b_.data();
-  const auto fit = [&](int j, FitMemo* memo) {
-    det_fit_t_[j] = 0.0;
-    det_fit_sd_[j] = std::numeric_limits<double>::infinity();
-    if (det_bucket_[j] < 0) return;  // not near the grid: no birth from it
+  // Detection j's neighbours into g; their count (0: not near the grid, no birth from it).
+  const auto gather = [&](int j, RunFits::Gathered& g) {
+    if (det_bucket_[j] < 0) return 0;
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
     const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(nbx_ - 1, bx + reach);
@@ -315,8 +497,6 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
       const double gx = BucketGap(p.x(), cx, nbx_, ox), gy = BucketGap(p.y(), cy, nby_, oy);
       return gx * gx + gy * gy;
     };
-    double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
-    int key[kFitMaxNeighbours];  // the gathered neighbours' bucket positions
     int n = 0, looked = 0;
     for (int cy = cy_lo; cy <= cy_hi; ++cy) {
       for (int cx = cx_lo; cx <= cx_hi; ++cx) {
@@ -328,39 +508,39 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
           if (n == kFitMaxNeighbours || looked == kMaxCandidates) goto gathered;
           // det_x_/det_y_, los_b: the positions and lines of sight in bucket order (contiguous).
           const double ex = det_x_[k] - p.x(), ey = det_y_[k] - p.y();
-          ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
-          uy[n] = los_b[3 * k + 1];
-          y[n] = los_b[3 * k + 2];
-          key[n] = static_cast<int>(k);
+          g.ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
+          g.uy[n] = los_b[3 * k + 1];
+          g.y[n] = los_b[3 * k + 2];
+          g.key[n] = static_cast<int>(k);
           n += !(ex * ex + ey * ey > radius2);
         }
       }
     }
   gathered:
-    if (n < 3) return;
-    DopplerFit f;
-    bool ok = false;
-    if (!memo->Find(key, n, &ok, &f)) {
-      ok = RobustDopplerFit(ux, uy, y, n, floor, floor_bound, &f);
-      memo->Add(key, n, ok, f);
-    }
-    if (!ok) return;
-    // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
-    // t^T (scale^2 A^-1) t.
-    const double tx = -los[3 * j + 1], ty = los[3 * j];
-    const double det = f.a00 * f.a11 - f.a01 * f.a01;
-    const double var =
-        f.scale * f.scale * (tx * tx * f.a11 - 2.0 * tx * ty * f.a01 + ty * ty * f.a00) / det;
-    det_fit_t_[j] = f.vx * tx + f.vy * ty;
-    det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
+    return n;
   };
-  // Runs of kRun detections (in detection order: one object's detections of one scan side by
-  // side), each with its own memo.
-  constexpr int kRun = 32;
+  // Runs of RunFits::kRun detections in detection order (one object's detections of one scan
+  // side by side: often equal neighbourhoods).
+  constexpr int kRun = RunFits::kRun;
   const auto run = [&](std::int64_t r) {
-    FitMemo memo;
-    const int end = std::min(nz, static_cast<int>(r + 1) * kRun);
-    for (int j = static_cast<int>(r) * kRun; j < end; ++j) fit(j, &memo);
+    RunFits fits(floor, floor_bound);
+    const int j0 = static_cast<int>(r) * kRun, end = std::min(nz, j0 + kRun);
+    for (int j = j0; j < end; ++j) fits.Submit(j - j0, gather(j, fits.Next()));
+    fits.Finish();
+    for (int j = j0; j < end; ++j) {
+      det_fit_t_[j] = 0.0;
+      det_fit_sd_[j] = std::numeric_limits<double>::infinity();
+      DopplerFit f;
+      if (!fits.Result(j - j0, &f)) continue;
+      // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
+      // t^T (scale^2 A^-1) t.
+      const double tx = -los[3 * j + 1], ty = los[3 * j];
+      const double det = f.a00 * f.a11 - f.a01 * f.a01;
+      const double var =
+          f.scale * f.scale * (tx * tx * f.a11 - 2.0 * tx * ty * f.a01 + ty * ty * f.a00) / det;
+      det_fit_t_[j] = f.vx * tx + f.vy * ty;
+      det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
+    }
   };
   ForDynamicNoWait(t, (nz + kRun - 1) / kRun, run);  // Fill's contract: no barrier at the end
 }
