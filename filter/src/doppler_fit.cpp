@@ -8,8 +8,11 @@
 #include "dualgrid/filter/doppler_fit.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <hwy/highway.h>
@@ -246,53 +249,71 @@ void SolvePair(const double* ux, const double* uy, const double* y, const double
     ok[l] = ok[l] && SolveSums(s[0][l], s[1][l], s[2][l], s[3][l], s[4][l], &f[l]);
 }
 
-// Residuals of two fits at once (interleaved as SolvePair's arrays; lanes as Residuals computes
-// them) into r; per lane the count of valid entries <= bound and whether one is NaN. valid: the
-// lanes' entry counts (entries i >= count are padding).
-void ResidualsPair(const double* ux, const double* uy, const double* y, int n,
-                   const DopplerFit f[2], V2 valid, double bound, double* r, int below[2],
-                   bool unordered[2]) {
+using DI2 = hn::RebindToSigned<D2>;
+
+// Per lane the count of true entries of masks accumulated by Tally (all-ones lanes: -1).
+std::array<int, 2> Counts(hn::Vec<DI2> tally) {
+  alignas(16) std::int64_t c[2];
+  hn::Store(tally, DI2(), c);
+  return {static_cast<int>(-c[0]), static_cast<int>(-c[1])};
+}
+
+hn::Vec<DI2> Tally(hn::Vec<DI2> tally, hn::Mask<D2> m) {
+  return hn::Add(tally, hn::BitCast(DI2(), hn::VecFromMask(D2(), m)));
+}
+
+// Residuals of two fits at once (interleaved as SolvePair's arrays, n even; lanes as Residuals
+// computes them) into r, and each lane's into rl[l] (vector stores: SelectRank's vector loads of
+// them are forwarded); per lane the count of real entries <= bound and whether one is NaN. real:
+// per entry and lane all-ones bits for a fit's own entries, +0.0 for padding.
+void ResidualsPair(const double* ux, const double* uy, const double* y, const double* real, int n,
+                   const DopplerFit f[2], double bound, double* r, double* const rl[2],
+                   int below[2], bool unordered[2]) {
+  assert(n % 2 == 0);
   const D2 d;
-  const V2 vvx = Lanes(f[0].vx, f[1].vx);
-  const V2 vvy = Lanes(f[0].vy, f[1].vy);
-  const V2 vb = hn::Set(d, bound), one = hn::Set(d, 1.0);
-  V2 count = hn::Zero(d), nan = hn::Zero(d);
-  for (int i = 0; i < n; ++i) {
-    const V2 e = hn::Sub(
-        hn::Add(hn::Mul(hn::Load(d, ux + 2 * i), vvx), hn::Mul(hn::Load(d, uy + 2 * i), vvy)),
-        hn::Load(d, y + 2 * i));
+  const V2 vvx = Lanes(f[0].vx, f[1].vx), vvy = Lanes(f[0].vy, f[1].vy), vb = hn::Set(d, bound);
+  auto count = hn::Zero(DI2());
+  V2 nan = hn::Zero(d);
+  const auto residual = [&](int i) {  // entry i / 2
+    const V2 e =
+        hn::Sub(hn::Add(hn::Mul(hn::Load(d, ux + i), vvx), hn::Mul(hn::Load(d, uy + i), vvy)),
+                hn::Load(d, y + i));
     const V2 a = hn::Abs(e);
-    hn::Store(a, d, r + 2 * i);
-    const auto in = hn::Lt(hn::Set(d, static_cast<double>(i)), valid);
-    count = hn::Add(count, hn::IfThenElseZero(hn::And(in, hn::Le(a, vb)), one));
-    nan = hn::Or(nan, hn::IfThenElseZero(hn::And(in, hn::Ne(a, a)), one));
+    hn::Store(a, d, r + i);
+    const auto in = hn::MaskFromVec(hn::Load(d, real + i));
+    count = Tally(count, hn::And(in, hn::Le(a, vb)));
+    nan = hn::Or(nan, hn::VecFromMask(d, hn::And(in, hn::Ne(a, a))));
+    return a;
+  };
+  for (int i = 0; i < 2 * n; i += 4) {
+    const V2 a = residual(i), b = residual(i + 2);
+    hn::Store(hn::InterleaveLower(d, a, b), d, rl[0] + i / 2);
+    hn::Store(hn::InterleaveUpper(d, a, b), d, rl[1] + i / 2);
   }
-  alignas(16) double c[2], u[2];
-  hn::Store(count, d, c);
-  hn::Store(nan, d, u);
+  const std::array<int, 2> c = Counts(count);
+  const std::array<int, 2> u = Counts(hn::BitCast(DI2(), nan));
   for (int l = 0; l < 2; ++l) {
-    below[l] = static_cast<int>(c[l]);
-    unordered[l] = u[l] != 0.0;
+    below[l] = c[l];
+    unordered[l] = u[l] != 0;
   }
 }
 
 // TukeyWeights of two fits at once (lanes as TukeyWeights computes them; c: the lanes' Tukey
-// constants), padding entries weighted +0.0; the lanes' inliers.
-void TukeyWeightsPair(const double* r, int n, V2 valid, V2 c, double* w, int inliers[2]) {
+// constants; real as ResidualsPair's), padding entries weighted +0.0; the lanes' inliers.
+void TukeyWeightsPair(const double* r, const double* real, int n, V2 c, double* w, int inliers[2]) {
   const D2 d;
   const V2 one = hn::Set(d, 1.0);
-  V2 count = hn::Zero(d);
-  for (int i = 0; i < n; ++i) {
-    const V2 q = hn::Div(hn::Load(d, r + 2 * i), c);
+  auto count = hn::Zero(DI2());
+  for (int i = 0; i < 2 * n; i += 2) {
+    const V2 q = hn::Div(hn::Load(d, r + i), c);
     const V2 t = hn::Sub(one, hn::Mul(q, q));
-    const auto in = hn::And(hn::Lt(hn::Set(d, static_cast<double>(i)), valid), hn::Lt(q, one));
-    hn::Store(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + 2 * i);
-    count = hn::Add(count, hn::IfThenElseZero(in, one));
+    const auto in = hn::And(hn::MaskFromVec(hn::Load(d, real + i)), hn::Lt(q, one));
+    hn::Store(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + i);
+    count = Tally(count, in);
   }
-  alignas(16) double k[2];
-  hn::Store(count, d, k);
-  inliers[0] = static_cast<int>(k[0]);
-  inliers[1] = static_cast<int>(k[1]);
+  const std::array<int, 2> k = Counts(count);
+  inliers[0] = k[0];
+  inliers[1] = k[1];
 }
 
 }  // namespace
@@ -370,35 +391,36 @@ void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound
                           bool ok[2]) {
   assert(in[0].n >= 3 && in[0].n <= kFitMaxNeighbours);
   assert(in[1].n >= 3 && in[1].n <= kFitMaxNeighbours);
-  const int n = std::max(in[0].n, in[1].n);
+  const int n = (std::max(in[0].n, in[1].n) + 1) & ~1;  // even: ResidualsPair
   alignas(16) double ux[2 * kFitMaxNeighbours], uy[2 * kFitMaxNeighbours], y[2 * kFitMaxNeighbours],
-      w[2 * kFitMaxNeighbours], r[2 * kFitMaxNeighbours];
+      w[2 * kFitMaxNeighbours], r[2 * kFitMaxNeighbours], real[2 * kFitMaxNeighbours],
+      r0[kFitMaxNeighbours], r1[kFitMaxNeighbours];
+  double* const rl[2] = {r0, r1};  // the lanes' residuals, where Scale reads them
+  const double all_ones = std::bit_cast<double>(~std::uint64_t{0});
   for (int l = 0; l < 2; ++l) {
     for (int i = 0; i < n; ++i) {
-      const bool real = i < in[l].n;  // else padding: +0.0 (SolvePair)
-      ux[2 * i + l] = real ? in[l].ux[i] : 0.0;
-      uy[2 * i + l] = real ? in[l].uy[i] : 0.0;
-      y[2 * i + l] = real ? in[l].y[i] : 0.0;
-      w[2 * i + l] = real ? 1.0 : 0.0;
+      const bool own = i < in[l].n;  // else padding: +0.0 (SolvePair)
+      ux[2 * i + l] = own ? in[l].ux[i] : 0.0;
+      uy[2 * i + l] = own ? in[l].uy[i] : 0.0;
+      y[2 * i + l] = own ? in[l].y[i] : 0.0;
+      w[2 * i + l] = own ? 1.0 : 0.0;
+      real[2 * i + l] = own ? all_ones : 0.0;
     }
     ok[l] = true;
   }
   SolvePair(ux, uy, y, w, n, f, ok);
-  const V2 valid = Lanes(in[0].n, in[1].n);
   double guess[2] = {floor_bound, floor_bound};  // the lanes' last medians selected
   for (int it = 0; it < kIterations && (ok[0] || ok[1]); ++it) {
     int below[2], inliers[2];
     bool unordered[2];
-    ResidualsPair(ux, uy, y, n, f, valid, floor_bound, r, below, unordered);
+    ResidualsPair(ux, uy, y, real, n, f, floor_bound, r, rl, below, unordered);
     double c[2] = {1.0, 1.0};  // a dead lane's: any value
     for (int l = 0; l < 2; ++l) {
       if (!ok[l]) continue;
-      double rl[kFitMaxNeighbours];
-      for (int i = 0; i < in[l].n; ++i) rl[i] = r[2 * i + l];
-      f[l].scale = Scale(rl, in[l].n, below[l], unordered[l], floor, &guess[l]);
+      f[l].scale = Scale(rl[l], in[l].n, below[l], unordered[l], floor, &guess[l]);
       c[l] = kTukey * f[l].scale;
     }
-    TukeyWeightsPair(r, n, valid, Lanes(c[0], c[1]), w, inliers);
+    TukeyWeightsPair(r, real, n, Lanes(c[0], c[1]), w, inliers);
     for (int l = 0; l < 2; ++l) {
       if (!ok[l]) continue;
       f[l].inliers = inliers[l];
