@@ -4,7 +4,9 @@
 // outline, other sensors), so together they fix the whole velocity vector where those lines spread
 // enough: v with u_i . v = v_r,i for every detection i near it. Fitted robustly (Tukey's biweight
 // by iteratively reweighted least squares), since detections of another object, of the ground or
-// clutter may lie within reach.
+// clutter may lie within reach. A run of detections' fits goes two at a time, one per SIMD lane,
+// and detections with equal neighbour lists share one fit (RunFits): the same bits as one
+// RobustDopplerFit per detection.
 #include "dualgrid/filter/doppler_fit.hpp"
 
 #include <algorithm>
@@ -38,9 +40,7 @@ constexpr int kNearRanks = 4;
 // Bucket columns and rows of a fit's window whose gaps are tabled (reach <= 3 buckets).
 constexpr int kWindow = 7;
 
-// Solves sum_i w_i u_i u_i^T v = sum_i w_i u_i y_i; false when the lines of sight (weighted) do
-// not span the plane.
-// Solve's end: v from the sums A = (a00 a01; a01 a11), b = (b0, b1).
+// Solve's end: v from the sums A = (a00 a01; a01 a11), b = (b0, b1); false when A is singular.
 bool SolveSums(double a00, double a01, double a11, double b0, double b1, DopplerFit* f) {
   const double det = a00 * a11 - a01 * a01;
   if (!(det > 1e-12 * (a00 + a11) * (a00 + a11))) return false;
@@ -52,6 +52,8 @@ bool SolveSums(double a00, double a01, double a11, double b0, double b1, Doppler
   return true;
 }
 
+// Solves sum_i w_i u_i u_i^T v = sum_i w_i u_i y_i; false when the lines of sight (weighted) do
+// not span the plane.
 bool Solve(const double* ux, const double* uy, const double* y, const double* w, int n,
            DopplerFit* f) {
   double a00 = 0.0, a01 = 0.0, a11 = 0.0, b0 = 0.0, b1 = 0.0;
