@@ -2,7 +2,8 @@
 // median (filter/src/doppler_fit.cpp: SelectRank against std::nth_element, MadFloorBound against
 // its defining property, RobustDopplerFit against the plain fit of reference/doppler_fit.hpp on
 // random neighbourhoods that take every path: the floor, a median near the last one, the
-// quickselect, failures, NaN) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
+// quickselect, failures, NaN; RobustDopplerFitPair and RunFits against RobustDopplerFit; FitMemo's
+// keys) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
