@@ -4,12 +4,17 @@
 // outline, other sensors), so together they fix the whole velocity vector where those lines spread
 // enough: v with u_i . v = v_r,i for every detection i near it. Fitted robustly (Tukey's biweight
 // by iteratively reweighted least squares), since detections of another object, of the ground or
-// clutter may lie within reach.
+// clutter may lie within reach. A run of detections' fits goes two at a time, one per SIMD lane,
+// and detections with equal neighbour lists share one fit (RunFits): the same bits as one
+// RobustDopplerFit per detection.
 #include "dualgrid/filter/doppler_fit.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <hwy/highway.h>
@@ -35,6 +40,18 @@ constexpr int kNearRanks = 4;
 // Bucket columns and rows of a fit's window whose gaps are tabled (reach <= 3 buckets).
 constexpr int kWindow = 7;
 
+// Solve's end: v from the sums A = (a00 a01; a01 a11), b = (b0, b1); false when A is singular.
+bool SolveSums(double a00, double a01, double a11, double b0, double b1, DopplerFit* f) {
+  const double det = a00 * a11 - a01 * a01;
+  if (!(det > 1e-12 * (a00 + a11) * (a00 + a11))) return false;
+  f->vx = (a11 * b0 - a01 * b1) / det;
+  f->vy = (a00 * b1 - a01 * b0) / det;
+  f->a00 = a00;
+  f->a01 = a01;
+  f->a11 = a11;
+  return true;
+}
+
 // Solves sum_i w_i u_i u_i^T v = sum_i w_i u_i y_i; false when the lines of sight (weighted) do
 // not span the plane.
 bool Solve(const double* ux, const double* uy, const double* y, const double* w, int n,
@@ -47,14 +64,7 @@ bool Solve(const double* ux, const double* uy, const double* y, const double* w,
     b0 += w[i] * ux[i] * y[i];
     b1 += w[i] * uy[i] * y[i];
   }
-  const double det = a00 * a11 - a01 * a01;
-  if (!(det > 1e-12 * (a00 + a11) * (a00 + a11))) return false;
-  f->vx = (a11 * b0 - a01 * b1) / det;
-  f->vy = (a00 * b1 - a01 * b0) / det;
-  f->a00 = a00;
-  f->a01 = a01;
-  f->a11 = a11;
-  return true;
+  return SolveSums(a00, a01, a11, b0, b1, f);
 }
 
 namespace hn = hwy::HWY_NAMESPACE;
@@ -194,6 +204,120 @@ double NthElement(const double* r, int n, int k) {
   return sorted[k];
 }
 
+// The scale max(floor, 1.4826 median) of the residuals r[0, n), of which at_floor are <=
+// MadFloorBound(floor) and some NaN when `unordered`; *guess: the last median selected (updated).
+double Scale(const double* r, int n, int at_floor, bool unordered, double floor, double* guess) {
+  const int k = n / 2;
+  if (unordered) return std::max(floor, kMadToSigma * NthElement(r, n, k));
+  if (at_floor > k) return floor;  // = std::max(floor, kMadToSigma * median): median <= bound
+  *guess = detail::SelectRank(r, n, k, *guess);
+  return std::max(floor, kMadToSigma * *guess);
+}
+
+using D2 = hn::FixedTag<double, 2>;  // RobustDopplerFitPair's lanes: one fit each
+using V2 = hn::Vec<D2>;
+
+V2 Lanes(double a, double b) {  // (a, b)
+  alignas(16) const double v[2] = {a, b};
+  return hn::Load(D2(), v);
+}
+
+// Solve of two fits at once, on interleaved arrays (entry i of fit l at 2 i + l) of n entries:
+// each lane adds the same IEEE products in the same order as Solve's loop, so its sums are
+// bitwise Solve's. A fit with fewer entries is padded with ux = uy = y = w = +0.0: each product
+// is +0.0, and adding +0.0 leaves a sum bitwise unchanged, since a sum is never -0.0 (it starts
+// at +0.0 and, rounding to nearest, x + y is -0.0 only when x and y both are) and s + (+0.0) = s
+// for every other s, infinities and NaN included. ok[l] false: lane l skipped (dead).
+void SolvePair(const double* ux, const double* uy, const double* y, const double* w, int n,
+               DopplerFit f[2], bool ok[2]) {
+  const D2 d;
+  V2 a00 = hn::Zero(d), a01 = hn::Zero(d), a11 = hn::Zero(d), b0 = hn::Zero(d), b1 = hn::Zero(d);
+  for (int i = 0; i < 2 * n; i += 2) {
+    const V2 vw = hn::Load(d, w + i), vx = hn::Load(d, ux + i), vy = hn::Load(d, uy + i);
+    const V2 vv = hn::Load(d, y + i), wx = hn::Mul(vw, vx), wy = hn::Mul(vw, vy);
+    a00 = hn::Add(a00, hn::Mul(wx, vx));
+    a01 = hn::Add(a01, hn::Mul(wx, vy));
+    a11 = hn::Add(a11, hn::Mul(wy, vy));
+    b0 = hn::Add(b0, hn::Mul(wx, vv));
+    b1 = hn::Add(b1, hn::Mul(wy, vv));
+  }
+  alignas(16) double s[5][2];
+  hn::Store(a00, d, s[0]);
+  hn::Store(a01, d, s[1]);
+  hn::Store(a11, d, s[2]);
+  hn::Store(b0, d, s[3]);
+  hn::Store(b1, d, s[4]);
+  for (int l = 0; l < 2; ++l)
+    ok[l] = ok[l] && SolveSums(s[0][l], s[1][l], s[2][l], s[3][l], s[4][l], &f[l]);
+}
+
+using DI2 = hn::RebindToSigned<D2>;
+
+// Per lane the count of true entries of masks accumulated by Tally (all-ones lanes: -1).
+std::array<int, 2> Counts(hn::Vec<DI2> tally) {
+  alignas(16) std::int64_t c[2];
+  hn::Store(tally, DI2(), c);
+  return {static_cast<int>(-c[0]), static_cast<int>(-c[1])};
+}
+
+hn::Vec<DI2> Tally(hn::Vec<DI2> tally, hn::Mask<D2> m) {
+  return hn::Add(tally, hn::BitCast(DI2(), hn::VecFromMask(D2(), m)));
+}
+
+// Residuals of two fits at once (interleaved as SolvePair's arrays, n even; lanes as Residuals
+// computes them) into r, and each lane's into rl[l] (vector stores: SelectRank's vector loads of
+// them are forwarded); per lane the count of real entries <= bound and whether one is NaN. real:
+// per entry and lane all-ones bits for a fit's own entries, +0.0 for padding.
+void ResidualsPair(const double* ux, const double* uy, const double* y, const double* real, int n,
+                   const DopplerFit f[2], double bound, double* r, double* const rl[2],
+                   int below[2], bool unordered[2]) {
+  assert(n % 2 == 0);
+  const D2 d;
+  const V2 vvx = Lanes(f[0].vx, f[1].vx), vvy = Lanes(f[0].vy, f[1].vy), vb = hn::Set(d, bound);
+  auto count = hn::Zero(DI2());
+  V2 nan = hn::Zero(d);
+  const auto residual = [&](int i) {  // entry i / 2
+    const V2 e =
+        hn::Sub(hn::Add(hn::Mul(hn::Load(d, ux + i), vvx), hn::Mul(hn::Load(d, uy + i), vvy)),
+                hn::Load(d, y + i));
+    const V2 a = hn::Abs(e);
+    hn::Store(a, d, r + i);
+    const auto in = hn::MaskFromVec(hn::Load(d, real + i));
+    count = Tally(count, hn::And(in, hn::Le(a, vb)));
+    nan = hn::Or(nan, hn::VecFromMask(d, hn::And(in, hn::Ne(a, a))));
+    return a;
+  };
+  for (int i = 0; i < 2 * n; i += 4) {
+    const V2 a = residual(i), b = residual(i + 2);
+    hn::Store(hn::InterleaveLower(d, a, b), d, rl[0] + i / 2);
+    hn::Store(hn::InterleaveUpper(d, a, b), d, rl[1] + i / 2);
+  }
+  const std::array<int, 2> c = Counts(count);
+  const std::array<int, 2> u = Counts(hn::BitCast(DI2(), nan));
+  for (int l = 0; l < 2; ++l) {
+    below[l] = c[l];
+    unordered[l] = u[l] != 0;
+  }
+}
+
+// TukeyWeights of two fits at once (lanes as TukeyWeights computes them; c: the lanes' Tukey
+// constants; real as ResidualsPair's), padding entries weighted +0.0; the lanes' inliers.
+void TukeyWeightsPair(const double* r, const double* real, int n, V2 c, double* w, int inliers[2]) {
+  const D2 d;
+  const V2 one = hn::Set(d, 1.0);
+  auto count = hn::Zero(DI2());
+  for (int i = 0; i < 2 * n; i += 2) {
+    const V2 q = hn::Div(hn::Load(d, r + i), c);
+    const V2 t = hn::Sub(one, hn::Mul(q, q));
+    const auto in = hn::And(hn::MaskFromVec(hn::Load(d, real + i)), hn::Lt(q, one));
+    hn::Store(hn::IfThenElseZero(in, hn::Mul(t, t)), d, w + i);
+    count = Tally(count, in);
+  }
+  const std::array<int, 2> k = Counts(count);
+  inliers[0] = k[0];
+  inliers[1] = k[1];
+}
+
 }  // namespace
 
 namespace detail {
@@ -229,23 +353,128 @@ bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n
   double w[kFitMaxNeighbours], r[kFitMaxNeighbours];
   std::fill_n(w, n, 1.0);
   if (!Solve(ux, uy, y, w, n, f)) return false;
-  const int k = n / 2;
   double guess = floor_bound;  // the last median selected
   for (int it = 0; it < kIterations; ++it) {
     bool unordered = false;  // a NaN residual
     const int at_floor = Residuals(ux, uy, y, n, f->vx, f->vy, floor_bound, r, &unordered);
-    if (unordered) {
-      f->scale = std::max(floor, kMadToSigma * NthElement(r, n, k));
-    } else if (at_floor > k) {
-      f->scale = floor;  // = std::max(floor, kMadToSigma * median): median <= floor_bound
-    } else {
-      guess = SelectRank(r, n, k, guess);
-      f->scale = std::max(floor, kMadToSigma * guess);
-    }
+    f->scale = Scale(r, n, at_floor, unordered, floor, &guess);
     f->inliers = TukeyWeights(r, n, kTukey * f->scale, w);
     if (f->inliers < 3 || !Solve(ux, uy, y, w, n, f)) return false;
   }
   return true;
+}
+
+bool FitMemo::Find(const int* key, int n, bool* ok, DopplerFit* f) const {
+  for (int s = 0; s < size_; ++s) {
+    const Entry& e = slot_[(next_ + kSlots - 1 - s) % kSlots];  // the newest first
+    if (e.n != n || !std::equal(key, key + n, e.key)) continue;
+    *ok = e.ok;
+    *f = e.f;
+    return true;
+  }
+  return false;
+}
+
+void FitMemo::Add(const int* key, int n, bool ok, const DopplerFit& f) {
+  assert(0 <= n && n <= kFitMaxNeighbours);
+  Entry& e = slot_[next_];
+  e.n = n;
+  std::copy_n(key, n, e.key);
+  e.ok = ok;
+  e.f = f;
+  next_ = (next_ + 1) % kSlots;
+  size_ = std::min(size_ + 1, kSlots);
+}
+
+// RobustDopplerFit's steps on both lanes: the vector parts (sums, residuals, weights) for both,
+// the median and the scale per lane (scalar, as RobustDopplerFit), a lane's work ending where its
+// fit does.
+void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound, DopplerFit f[2],
+                          bool ok[2]) {
+  assert(in[0].n >= 3 && in[0].n <= kFitMaxNeighbours);
+  assert(in[1].n >= 3 && in[1].n <= kFitMaxNeighbours);
+  const int n = (std::max(in[0].n, in[1].n) + 1) & ~1;  // even: ResidualsPair
+  alignas(16) double ux[2 * kFitMaxNeighbours], uy[2 * kFitMaxNeighbours], y[2 * kFitMaxNeighbours],
+      w[2 * kFitMaxNeighbours], r[2 * kFitMaxNeighbours], real[2 * kFitMaxNeighbours],
+      r0[kFitMaxNeighbours], r1[kFitMaxNeighbours];
+  double* const rl[2] = {r0, r1};  // the lanes' residuals, where Scale reads them
+  const double all_ones = std::bit_cast<double>(~std::uint64_t{0});
+  for (int l = 0; l < 2; ++l) {
+    for (int i = 0; i < n; ++i) {
+      const bool own = i < in[l].n;  // else padding: +0.0 (SolvePair)
+      ux[2 * i + l] = own ? in[l].ux[i] : 0.0;
+      uy[2 * i + l] = own ? in[l].uy[i] : 0.0;
+      y[2 * i + l] = own ? in[l].y[i] : 0.0;
+      w[2 * i + l] = own ? 1.0 : 0.0;
+      real[2 * i + l] = own ? all_ones : 0.0;
+    }
+    ok[l] = true;
+  }
+  SolvePair(ux, uy, y, w, n, f, ok);
+  double guess[2] = {floor_bound, floor_bound};  // the lanes' last medians selected
+  for (int it = 0; it < kIterations && (ok[0] || ok[1]); ++it) {
+    int below[2], inliers[2];
+    bool unordered[2];
+    ResidualsPair(ux, uy, y, real, n, f, floor_bound, r, rl, below, unordered);
+    double c[2] = {1.0, 1.0};  // a dead lane's: any value
+    for (int l = 0; l < 2; ++l) {
+      if (!ok[l]) continue;
+      f[l].scale = Scale(rl[l], in[l].n, below[l], unordered[l], floor, &guess[l]);
+      c[l] = kTukey * f[l].scale;
+    }
+    TukeyWeightsPair(r, real, n, Lanes(c[0], c[1]), w, inliers);
+    for (int l = 0; l < 2; ++l) {
+      if (!ok[l]) continue;
+      f[l].inliers = inliers[l];
+      ok[l] = inliers[l] >= 3;
+    }
+    SolvePair(ux, uy, y, w, n, f, ok);
+  }
+}
+
+void RunFits::Submit(int i, int n) {
+  assert(0 <= i && i < kRun);
+  ok_[i] = false;
+  if (n < 3) return;
+  const Gathered& g = queue_[queued_];
+  if (memo_.Find(g.key, n, &ok_[i], &fit_[i])) return;
+  for (int q = 0; q < queued_; ++q) {
+    if (queued_n_[q] == n && std::equal(g.key, g.key + n, queue_[q].key)) {
+      assert(waiters_ < kRun);
+      waiter_i_[waiters_] = i;
+      waiter_of_[waiters_++] = q;
+      return;
+    }
+  }
+  queued_n_[queued_] = n;
+  queued_i_[queued_++] = i;
+  if (queued_ == 2) FitQueued();
+}
+
+void RunFits::Finish() { FitQueued(); }
+
+void RunFits::FitQueued() {
+  DopplerFit f[2];
+  bool ok[2] = {false, false};
+  if (queued_ == 2) {
+    const FitInput in[2] = {{queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0]},
+                            {queue_[1].ux, queue_[1].uy, queue_[1].y, queued_n_[1]}};
+    RobustDopplerFitPair(in, floor_, floor_bound_, f, ok);
+  } else if (queued_ == 1) {
+    ok[0] = RobustDopplerFit(queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0], floor_,
+                             floor_bound_, &f[0]);
+  }
+  for (int q = 0; q < queued_; ++q) {
+    memo_.Add(queue_[q].key, queued_n_[q], ok[q], f[q]);
+    ok_[queued_i_[q]] = ok[q];
+    fit_[queued_i_[q]] = f[q];
+  }
+  for (int k = 0; k < waiters_; ++k) {
+    ok_[waiter_i_[k]] = ok[waiter_of_[k]];
+    fit_[waiter_i_[k]] = f[waiter_of_[k]];
+  }
+  queued_ = 0;
+  waiters_ = 0;
 }
 
 }  // namespace detail
@@ -268,11 +497,9 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const double oy = static_cast<double>(origin_gy_) * params_.resolution;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
   const double* const los_b = det_los_b_.data();
-  const auto fit = [&](std::int64_t jj) {
-    const int j = static_cast<int>(jj);
-    det_fit_t_[j] = 0.0;
-    det_fit_sd_[j] = std::numeric_limits<double>::infinity();
-    if (det_bucket_[j] < 0) return;  // not near the grid: no birth from it
+  // Detection j's neighbours into g; their count (0: not near the grid, no birth from it).
+  const auto gather = [&](int j, RunFits::Gathered& g) {
+    if (det_bucket_[j] < 0) return 0;
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
     const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(nbx_ - 1, bx + reach);
@@ -294,7 +521,6 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
       const double gx = BucketGap(p.x(), cx, nbx_, ox), gy = BucketGap(p.y(), cy, nby_, oy);
       return gx * gx + gy * gy;
     };
-    double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
     int n = 0, looked = 0;
     for (int cy = cy_lo; cy <= cy_hi; ++cy) {
       for (int cx = cx_lo; cx <= cx_hi; ++cx) {
@@ -306,26 +532,41 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
           if (n == kFitMaxNeighbours || looked == kMaxCandidates) goto gathered;
           // det_x_/det_y_, los_b: the positions and lines of sight in bucket order (contiguous).
           const double ex = det_x_[k] - p.x(), ey = det_y_[k] - p.y();
-          ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
-          uy[n] = los_b[3 * k + 1];
-          y[n] = los_b[3 * k + 2];
+          g.ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
+          g.uy[n] = los_b[3 * k + 1];
+          g.y[n] = los_b[3 * k + 2];
+          g.key[n] = static_cast<int>(k);
           n += !(ex * ex + ey * ey > radius2);
         }
       }
     }
   gathered:
-    DopplerFit f;
-    if (n < 3 || !RobustDopplerFit(ux, uy, y, n, floor, floor_bound, &f)) return;
-    // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
-    // t^T (scale^2 A^-1) t.
-    const double tx = -los[3 * j + 1], ty = los[3 * j];
-    const double det = f.a00 * f.a11 - f.a01 * f.a01;
-    const double var =
-        f.scale * f.scale * (tx * tx * f.a11 - 2.0 * tx * ty * f.a01 + ty * ty * f.a00) / det;
-    det_fit_t_[j] = f.vx * tx + f.vy * ty;
-    det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
+    return n;
   };
-  ForDynamicNoWait(t, nz, fit, 32);  // Fill's contract: no barrier at the end
+  // Runs of RunFits::kRun detections in detection order (one object's detections of one scan
+  // side by side: often equal neighbourhoods).
+  constexpr int kRun = RunFits::kRun;
+  const auto run = [&](std::int64_t r) {
+    RunFits fits(floor, floor_bound);
+    const int j0 = static_cast<int>(r) * kRun, end = std::min(nz, j0 + kRun);
+    for (int j = j0; j < end; ++j) fits.Submit(j - j0, gather(j, fits.Next()));
+    fits.Finish();
+    for (int j = j0; j < end; ++j) {
+      det_fit_t_[j] = 0.0;
+      det_fit_sd_[j] = std::numeric_limits<double>::infinity();
+      DopplerFit f;
+      if (!fits.Result(j - j0, &f)) continue;
+      // The velocity's part along this detection's tangent (-u_y, u_x), and its variance
+      // t^T (scale^2 A^-1) t.
+      const double tx = -los[3 * j + 1], ty = los[3 * j];
+      const double det = f.a00 * f.a11 - f.a01 * f.a01;
+      const double var =
+          f.scale * f.scale * (tx * tx * f.a11 - 2.0 * tx * ty * f.a01 + ty * ty * f.a00) / det;
+      det_fit_t_[j] = f.vx * tx + f.vy * ty;
+      det_fit_sd_[j] = std::sqrt(std::max(0.0, var));
+    }
+  };
+  ForDynamicNoWait(t, (nz + kRun - 1) / kRun, run);  // Fill's contract: no barrier at the end
 }
 
 }  // namespace dualgrid::filter

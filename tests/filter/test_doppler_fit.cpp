@@ -2,7 +2,8 @@
 // median (filter/src/doppler_fit.cpp: SelectRank against std::nth_element, MadFloorBound against
 // its defining property, RobustDopplerFit against the plain fit of reference/doppler_fit.hpp on
 // random neighbourhoods that take every path: the floor, a median near the last one, the
-// quickselect, failures, NaN) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
+// quickselect, failures, NaN; RobustDopplerFitPair and RunFits against RobustDopplerFit; FitMemo's
+// keys) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "dualgrid/core/random.hpp"
@@ -42,6 +44,57 @@ std::vector<double> Values(CounterRng& rng, int n, int levels, bool infinite) {
     if (infinite && rng.Uniform() < 0.1) x = kInf;
   }
   return a;
+}
+
+// A neighbourhood as RobustDopplerFit takes it: lines of sight spread over `spread` rad around a
+// random direction, radial speeds of one velocity with Gaussian noise `sigma` and a share
+// `outliers` of another object's (zero) speeds.
+struct Hood {
+  std::vector<double> ux, uy, y;
+  int n() const { return static_cast<int>(ux.size()); }
+};
+
+Hood DrawHood(CounterRng& rng, int n, double sigma, double outliers, double spread) {
+  const double vx = rng.Uniform(-30.0, 30.0), vy = rng.Uniform(-5.0, 5.0);
+  const double dir = rng.Uniform(-kPi, kPi);
+  Hood h;
+  for (int i = 0; i < n; ++i) {
+    const double a = dir + rng.Uniform(-spread, spread);
+    h.ux.push_back(std::cos(a));
+    h.uy.push_back(std::sin(a));
+    const bool out = rng.Uniform() < outliers;
+    h.y.push_back((out ? 0.0 : h.ux.back() * vx + h.uy.back() * vy) + sigma * rng.Normal());
+  }
+  return h;
+}
+
+// A random neighbourhood of every kind: n from 3 to kFitMaxNeighbours; noise at, below and above
+// the floor; outliers; lines of sight parallel or spread; now and then a NaN or infinite entry or
+// a radial speed that overflows the sums.
+Hood AnyHood(CounterRng& rng) {
+  const int n = 3 + static_cast<int>(rng.NextU32() % (kFitMaxNeighbours - 2));
+  const double sigmas[] = {0.0, 0.02, 0.07, 0.1, 0.2, 1.0}, shares[] = {0.0, 0.2, 0.45},
+               spreads[] = {0.0, 0.05, 1.5};
+  Hood h = DrawHood(rng, n, sigmas[rng.NextU32() % 6], shares[rng.NextU32() % 3],
+                    spreads[rng.NextU32() % 3]);
+  const double u = rng.Uniform();
+  const std::size_t at = rng.NextU32() % static_cast<std::uint32_t>(n);
+  if (u < 0.03) h.ux[at] = std::numeric_limits<double>::quiet_NaN();
+  if (u > 0.97) h.y[at] = rng.Uniform() < 0.5 ? kInf : 1e308;
+  return h;
+}
+
+// RobustDopplerFit's outcome on h; true when f equals it bit for bit (when it succeeded).
+bool SameAsSingle(const Hood& h, bool ok, const DopplerFit& f, double floor) {
+  DopplerFit want;
+  const bool ref =
+      filter::detail::RobustDopplerFit(h.ux.data(), h.uy.data(), h.y.data(), h.n(), floor,
+                                       filter::detail::MadFloorBound(floor), &want);
+  if (ok != ref) return false;
+  return !ok || (Bits(f.vx) == Bits(want.vx) && Bits(f.vy) == Bits(want.vy) &&
+                 Bits(f.scale) == Bits(want.scale) && Bits(f.a00) == Bits(want.a00) &&
+                 Bits(f.a01) == Bits(want.a01) && Bits(f.a11) == Bits(want.a11) &&
+                 f.inliers == want.inliers);
 }
 
 }  // namespace
@@ -154,6 +207,133 @@ TEST_CASE("RobustDopplerFit with non-finite inputs fails or matches the plain fi
       CHECK(Bits(got.scale) == Bits(want.scale));
     }
   }
+}
+
+TEST_CASE("RobustDopplerFitPair gives each lane's single fit bit for bit",
+          "[filter][doppler_fit]") {
+  // Pairs of neighbourhoods of every kind, of equal and of different sizes (the shorter one
+  // padded), fits that fail (at the start or in a later reweighting) beside fits that do not.
+  CounterRng rng(13, RngPurpose::kTest, 0, 0);
+  int outcomes[2][2] = {};  // [lane 0 ok][lane 1 ok]
+  for (int pair = 0; pair < 6000; ++pair) {
+    const Hood a = AnyHood(rng);
+    const Hood b = pair % 5 == 0 ? DrawHood(rng, a.n(), 0.1, 0.2, 1.5) : AnyHood(rng);
+    const double floor = pair % 2 == 0 ? 0.1 : 0.5;
+    const filter::detail::FitInput in[2] = {{a.ux.data(), a.uy.data(), a.y.data(), a.n()},
+                                            {b.ux.data(), b.uy.data(), b.y.data(), b.n()}};
+    DopplerFit f[2];
+    bool ok[2];
+    filter::detail::RobustDopplerFitPair(in, floor, filter::detail::MadFloorBound(floor), f, ok);
+    INFO("pair " << pair << " n " << a.n() << ", " << b.n());
+    REQUIRE(SameAsSingle(a, ok[0], f[0], floor));
+    REQUIRE(SameAsSingle(b, ok[1], f[1], floor));
+    ++outcomes[ok[0]][ok[1]];
+  }
+  // Every mix of outcomes was exercised.
+  for (const int lane0 : {0, 1}) {
+    for (const int lane1 : {0, 1}) CHECK(outcomes[lane0][lane1] > 50);
+  }
+}
+
+TEST_CASE("RunFits gives every detection its single fit, repeats and short lists included",
+          "[filter][doppler_fit]") {
+  using filter::detail::RunFits;
+  CounterRng rng(17, RngPurpose::kTest, 0, 0);
+  for (int round = 0; round < 300; ++round) {
+    // A run of distinct neighbourhoods, some of them repeated (right after, or later: while
+    // queued or remembered), and some with fewer than 3 neighbours.
+    const int size = 1 + static_cast<int>(rng.NextU32() % RunFits::kRun);
+    std::vector<Hood> hoods;
+    std::vector<std::vector<int>> keys;
+    for (int i = 0; i < size; ++i) {
+      const double u = rng.Uniform();
+      if (i > 0 && u < 0.4) {  // a repeat of an earlier one (often the last)
+        const std::size_t of = u < 0.25 ? hoods.size() - 1 : rng.NextU32() % hoods.size();
+        hoods.push_back(hoods[of]);
+        keys.push_back(keys[of]);
+        continue;
+      }
+      hoods.push_back(u > 0.95 ? DrawHood(rng, static_cast<int>(rng.NextU32() % 3), 0.1, 0.0, 1.5)
+                               : AnyHood(rng));
+      std::vector<int> key(hoods.back().ux.size());
+      for (std::size_t k = 0; k < key.size(); ++k) key[k] = 1000 * i + static_cast<int>(k);
+      keys.push_back(key);
+    }
+    auto fits = std::make_unique<RunFits>(0.1, filter::detail::MadFloorBound(0.1));
+    for (int i = 0; i < size; ++i) {
+      RunFits::Gathered& g = fits->Next();
+      const Hood& h = hoods[static_cast<std::size_t>(i)];
+      std::copy(h.ux.begin(), h.ux.end(), g.ux);
+      std::copy(h.uy.begin(), h.uy.end(), g.uy);
+      std::copy(h.y.begin(), h.y.end(), g.y);
+      std::copy(keys[static_cast<std::size_t>(i)].begin(), keys[static_cast<std::size_t>(i)].end(),
+                g.key);
+      fits->Submit(i, h.n());
+    }
+    fits->Finish();
+    for (int i = 0; i < size; ++i) {
+      const Hood& h = hoods[static_cast<std::size_t>(i)];
+      DopplerFit f;
+      const bool ok = fits->Result(i, &f);
+      INFO("round " << round << " detection " << i << " n " << h.n());
+      if (h.n() < 3) {
+        REQUIRE_FALSE(ok);
+      } else {
+        REQUIRE(SameAsSingle(h, ok, f, 0.1));
+      }
+    }
+  }
+}
+
+TEST_CASE("FitMemo finds a fit only under its exact key, the newest slots kept",
+          "[filter][doppler_fit]") {
+  using filter::detail::FitMemo;
+  auto memo = std::make_unique<FitMemo>();
+  const auto fit_of = [](int tag) {  // distinct outcomes per tag
+    DopplerFit f;
+    f.vx = 0.5 * tag;
+    f.vy = -1.0 - tag;
+    f.scale = 0.1 + tag;
+    f.a00 = 2.0 * tag;
+    f.a01 = 3.0 * tag;
+    f.a11 = 4.0 * tag;
+    f.inliers = tag;
+    return f;
+  };
+  const auto key_of = [](int tag, int n) {  // keys of one tag share all but the last entry
+    std::vector<int> key(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) key[static_cast<std::size_t>(i)] = 7 * i + (i == n - 1 ? tag : 0);
+    return key;
+  };
+  bool ok = false;
+  DopplerFit got;
+  const std::vector<int> a = key_of(1000, kFitMaxNeighbours);
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));  // empty
+  memo->Add(a.data(), kFitMaxNeighbours, true, fit_of(1000));
+  REQUIRE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));
+  CHECK(ok);
+  CHECK(Bits(got.vx) == Bits(fit_of(1000).vx));
+  CHECK(Bits(got.a11) == Bits(fit_of(1000).a11));
+  CHECK(got.inliers == 1000);
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours - 1, &ok, &got));  // a prefix
+  const std::vector<int> other = key_of(1001, kFitMaxNeighbours);       // the last entry differs
+  CHECK_FALSE(memo->Find(other.data(), kFitMaxNeighbours, &ok, &got));
+  // Failed fits are remembered as failed; keys of 3 to kSlots + 2 entries, each found with its
+  // outcome.
+  for (int tag = 0; tag < FitMemo::kSlots; ++tag) {
+    const std::vector<int> key = key_of(tag, 3 + tag);
+    memo->Add(key.data(), 3 + tag, tag % 2 == 0, fit_of(tag));
+  }
+  for (int tag = 0; tag < FitMemo::kSlots; ++tag) {
+    const std::vector<int> key = key_of(tag, 3 + tag);
+    INFO("tag " << tag);
+    REQUIRE(memo->Find(key.data(), 3 + tag, &ok, &got));
+    CHECK(ok == (tag % 2 == 0));
+    CHECK(got.inliers == tag);
+    CHECK(Bits(got.scale) == Bits(fit_of(tag).scale));
+  }
+  // kSlots later fits took every slot: the first one is gone.
+  CHECK_FALSE(memo->Find(a.data(), kFitMaxNeighbours, &ok, &got));
 }
 
 TEST_CASE("FastAtan2 on SIMD lanes gives the scalar bearing bit for bit", "[filter][fov]") {

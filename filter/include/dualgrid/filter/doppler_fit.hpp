@@ -38,4 +38,81 @@ double SelectRank(const double* a, int n, int k, double guess);
 bool RobustDopplerFit(const double* ux, const double* uy, const double* y, int n, double floor,
                       double floor_bound, DopplerFit* f);
 
+/// One neighbourhood's gathered arrays: RobustDopplerFit's inputs (3 <= n <= kFitMaxNeighbours).
+struct FitInput {
+  const double* ux;
+  const double* uy;
+  const double* y;
+  int n;
+};
+
+/// RobustDopplerFit of two neighbourhoods at once, one per SIMD lane: ok[l] and f[l] are what
+/// RobustDopplerFit(in[l], floor, floor_bound) gives, bit for bit (f[l] partial where ok[l] is
+/// false).
+void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound, DopplerFit f[2],
+                          bool ok[2]);
+
+/// The last few fits of one thread's run of detections, each under its key: the neighbours it
+/// gathered (their positions in the detection buckets, in gathering order). RobustDopplerFit is a
+/// pure function of the gathered arrays, so a detection whose key equals an earlier one's (within
+/// one build: the buckets fixed) takes that fit as it is, bit for bit. Owned by the caller's stack.
+class FitMemo {
+ public:
+  static constexpr int kSlots = 16;  // fits remembered
+
+  /// The fit remembered under key[0, n) (true: found; *ok and *f then hold its outcome).
+  /// 0 <= n <= kFitMaxNeighbours.
+  bool Find(const int* key, int n, bool* ok, DopplerFit* f) const;
+  /// Remembers a fit under key[0, n), in place of the oldest one when all slots are taken.
+  void Add(const int* key, int n, bool ok, const DopplerFit& f);
+
+ private:
+  struct Entry {
+    int n;
+    int key[kFitMaxNeighbours];
+    bool ok;
+    DopplerFit f;
+  };
+  Entry slot_[kSlots];
+  int size_ = 0, next_ = 0;  // slots in use; the slot the next Add takes
+};
+
+/// The fits of one run of up to kRun detections (run-local indices 0 .. kRun - 1), two at a time:
+/// each neighbourhood is looked up in a FitMemo first; a new one is queued (one equal to a queued
+/// one waits for it) and fitted by RobustDopplerFitPair when a second joins it. Results bit for
+/// bit those of RobustDopplerFit on each neighbourhood. About 12 kB: for the caller's stack.
+class RunFits {
+ public:
+  static constexpr int kRun = 32;
+  /// A neighbourhood: the gathered arrays and their key (FitMemo).
+  struct Gathered {
+    double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
+    int key[kFitMaxNeighbours];
+  };
+
+  RunFits(double floor, double floor_bound) : floor_(floor), floor_bound_(floor_bound) {}
+  /// Where the next neighbourhood is gathered before Submit.
+  Gathered& Next() { return queue_[queued_]; }
+  /// Detection i's neighbourhood: the first n entries of Next(). n < 3: no fit. Each i once.
+  void Submit(int i, int n);
+  /// Fits what is still queued; then Result holds every submitted detection's fit.
+  void Finish();
+  /// Detection i's fit after Finish (false: no fit; *f then unspecified).
+  bool Result(int i, DopplerFit* f) const {
+    *f = fit_[i];
+    return ok_[i];
+  }
+
+ private:
+  void FitQueued();  // the queue's one or two fits, their results and their waiters'
+
+  double floor_, floor_bound_;
+  FitMemo memo_;
+  Gathered queue_[2];
+  int queued_ = 0, queued_n_[2] = {0, 0}, queued_i_[2] = {0, 0};
+  int waiters_ = 0, waiter_i_[kRun], waiter_of_[kRun];  // detections waiting for a queued fit
+  bool ok_[kRun] = {};
+  DopplerFit fit_[kRun];
+};
+
 }  // namespace dualgrid::filter::detail
