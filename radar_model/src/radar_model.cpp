@@ -115,12 +115,13 @@ std::vector<Scatterer> RadarModel::VisibleScatterers(int sensor, const EgoMotion
 std::vector<Detection> RadarModel::ScanSensor(int sensor, const EgoMotion& ego, const Scene& scene,
                                               std::uint64_t step) const {
   const std::vector<Scatterer> scatterers = VisibleScatterers(sensor, ego, scene);
-  return Detect(sensor, ego, scatterers, step);
+  std::vector<Detection> out;
+  Detect(sensor, ego, scatterers, step, &out);
+  return out;
 }
 
-std::vector<Detection> RadarModel::Detect(int sensor, const EgoMotion& ego,
-                                          const std::vector<Scatterer>& scatterers,
-                                          std::uint64_t step) const {
+void RadarModel::Detect(int sensor, const EgoMotion& ego, const std::vector<Scatterer>& scatterers,
+                        std::uint64_t step, std::vector<Detection>* out) const {
   const SensorParams& p = params_[sensor];
   const SensorModel& model = models_[sensor];
   const Pose2 pose = SensorWorldPose(p, ego.pose);
@@ -168,7 +169,6 @@ std::vector<Detection> RadarModel::Detect(int sensor, const EgoMotion& ego,
   }
   std::sort(cells.begin(), cells.end());
 
-  std::vector<Detection> out;
   // Random streams per cell: cells holding a direct scatterer are numbered among themselves (so
   // with multipath off nothing changes, and on, a cell without ghosts draws what it drew
   // without them); cells of ghosts alone have their own purpose and numbering.
@@ -211,14 +211,13 @@ std::vector<Detection> RadarModel::Detect(int sensor, const EgoMotion& ego,
       d.reflector_id = strongest->reflector_id;
       d.ghost_of = strongest->source_id;
     }
-    out.push_back(d);
+    out->push_back(d);
   }
 
   if (options_.false_alarms) {
     CounterRng rng(seed_, RngPurpose::kRadarClutter, step, static_cast<std::uint32_t>(sensor));
-    AddFalseAlarms(p, model, rng, make_detection, &out);
+    AddFalseAlarms(p, model, rng, make_detection, out);
   }
-  return out;
 }
 
 std::vector<Detection> RadarModel::Scan(const EgoMotion& ego, const Scene& scene,
@@ -239,14 +238,19 @@ std::vector<Detection> RadarModel::Scan(const EgoMotion& ego, const Scene& scene
   std::vector<SensorScan*> walking;
   for (std::optional<SensorScan>& scan : scans) walking.push_back(&*scan);
   ScanRails(walking, scratch.rails);
-  std::vector<std::vector<Detection>> per_sensor(due.size());
 #pragma omp parallel for schedule(dynamic, 1)
   for (int i = 0; i < n; ++i) {
     scans[i]->AddGhosts();
-    per_sensor[i] = Detect(due[i], ego, scratch.sensors[i].scatterers, step);
+    scratch.sensors[i].detections.clear();
+    Detect(due[i], ego, scratch.sensors[i].scatterers, step, &scratch.sensors[i].detections);
   }
+  std::size_t total = 0;
+  for (int i = 0; i < n; ++i) total += scratch.sensors[i].detections.size();
   std::vector<Detection> out;
-  for (auto& v : per_sensor) out.insert(out.end(), v.begin(), v.end());
+  out.reserve(total);
+  for (int i = 0; i < n; ++i)
+    out.insert(out.end(), scratch.sensors[i].detections.begin(),
+               scratch.sensors[i].detections.end());
   return out;
 }
 

@@ -51,6 +51,7 @@ struct ScanScratch {
   std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
   std::vector<FaceSample> samples;
   std::vector<Scatterer> scatterers;                           // the scan's result
+  std::vector<Detection> detections;                           // RadarModel::Scan's, per sensor
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
 };
 
