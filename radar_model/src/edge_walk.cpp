@@ -1,6 +1,7 @@
 #include "edge_walk.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include <hwy/highway.h>
 
@@ -19,14 +20,45 @@ using VD = hn::Vec<DD>;
 static_assert(HWY_TARGET == HWY_SSE4, "the radar's SIMD target is pinned to SSE4");
 #endif
 
-constexpr int kVectors = 2;                // vectors walked side by side
+constexpr int kVectors = 4;                // vectors walked side by side
 constexpr int kGroup = kLanes * kVectors;  // edges per group
 
-// One group's edges on lanes: start, direction, length; unused lanes have length 0.
+// One group's edges on lanes: start, direction, length, and their cones' sensor position,
+// rotation rows, range limits, field-of-view bound and resolutions; unused lanes have length 0.
 struct Lanes {
   alignas(16) double ax[kGroup] = {}, ay[kGroup] = {}, dx[kGroup] = {}, dy[kGroup] = {};
   alignas(16) double len[kGroup] = {};
+  alignas(16) double sx[kGroup] = {}, sy[kGroup] = {};
+  alignas(16) double m00[kGroup] = {}, m01[kGroup] = {}, m10[kGroup] = {}, m11[kGroup] = {};
+  alignas(16) double min_range[kGroup] = {}, max_range[kGroup] = {}, cos_bound[kGroup] = {};
+  alignas(16) double range_res[kGroup] = {}, azimuth_res[kGroup] = {};
+  int edge[kGroup] = {};  // the walked edge's index
 };
+
+// Lane l of `lanes` set to edge e (index `index`) of cone c; as WalkEdge, nothing for an empty
+// edge (its lane keeps length 0).
+void SetLane(Lanes& lanes, int l, const Edge& e, int index, const SensorCone& c) {
+  lanes.edge[l] = index;
+  const double len = (e.b - e.a).norm();
+  if (!(len > 0.0)) return;
+  const Vector2 dir = (e.b - e.a) / len;
+  lanes.ax[l] = e.a.x();
+  lanes.ay[l] = e.a.y();
+  lanes.dx[l] = dir.x();
+  lanes.dy[l] = dir.y();
+  lanes.len[l] = len;
+  lanes.sx[l] = c.position.x();
+  lanes.sy[l] = c.position.y();
+  lanes.m00[l] = c.to_local(0, 0);
+  lanes.m01[l] = c.to_local(0, 1);
+  lanes.m10[l] = c.to_local(1, 0);
+  lanes.m11[l] = c.to_local(1, 1);
+  lanes.min_range[l] = c.min_range;
+  lanes.max_range[l] = c.max_range;
+  lanes.cos_bound[l] = c.fov_cos_bound;
+  lanes.range_res[l] = c.range_res;
+  lanes.azimuth_res[l] = c.azimuth_res;
+}
 
 // WalkEdge's spacing at pos (min(ds, len - pos)), lane by lane with its comparisons.
 VD Spacing(DD d, VD ax, VD ay, VD dx, VD dy, VD len, VD pos, VD sx, VD sy, VD range_res,
@@ -48,37 +80,36 @@ VD Spacing(DD d, VD ax, VD ay, VD dx, VD dy, VD len, VD pos, VD sx, VD sy, VD ra
   return hn::IfThenElse(hn::Lt(rest, ds), rest, ds);
 }
 
-// The cone's tests of the samples at (qx, qy), lane by lane as the scan's scalar code: the
-// local coordinates and range written to lx, ly, range; the kept lanes returned.
-hn::Mask<DD> Keep(DD d, const SensorCone& cone, VD qx, VD qy, double* lx, double* ly,
+// The cone's tests of the samples at (qx, qy) on lanes [o, o + kLanes), lane by lane as the
+// scan's scalar code: the local coordinates and range written to lx, ly, range; the kept lanes
+// returned.
+hn::Mask<DD> Keep(DD d, const Lanes& c, int o, VD qx, VD qy, double* lx, double* ly,
                   double* range) {
-  const VD ex = hn::Sub(qx, hn::Set(d, cone.position.x()));
-  const VD ey = hn::Sub(qy, hn::Set(d, cone.position.y()));
-  const Matrix2& m = cone.to_local;
-  const VD x = hn::Add(hn::Mul(hn::Set(d, m(0, 0)), ex), hn::Mul(hn::Set(d, m(0, 1)), ey));
-  const VD y = hn::Add(hn::Mul(hn::Set(d, m(1, 0)), ex), hn::Mul(hn::Set(d, m(1, 1)), ey));
+  const VD ex = hn::Sub(qx, hn::Load(d, c.sx + o));
+  const VD ey = hn::Sub(qy, hn::Load(d, c.sy + o));
+  const VD x = hn::Add(hn::Mul(hn::Load(d, c.m00 + o), ex), hn::Mul(hn::Load(d, c.m01 + o), ey));
+  const VD y = hn::Add(hn::Mul(hn::Load(d, c.m10 + o), ex), hn::Mul(hn::Load(d, c.m11 + o), ey));
   const VD r = hn::Sqrt(hn::Add(hn::Mul(x, x), hn::Mul(y, y)));
   hn::Store(x, d, lx);
   hn::Store(y, d, ly);
   hn::Store(r, d, range);
-  const auto out =
-      hn::Or(hn::Or(hn::Lt(r, hn::Set(d, cone.min_range)), hn::Gt(r, hn::Set(d, cone.max_range))),
-             hn::Lt(x, hn::Mul(hn::Set(d, cone.fov_cos_bound), r)));
+  const auto out = hn::Or(
+      hn::Or(hn::Lt(r, hn::Load(d, c.min_range + o)), hn::Gt(r, hn::Load(d, c.max_range + o))),
+      hn::Lt(x, hn::Mul(hn::Load(d, c.cos_bound + o), r)));
   return hn::Not(out);
 }
 
-void WalkGroup(const Lanes& lanes, int first, int used, const SensorCone& cone, double range_res,
-               double azimuth_res, SampleSink sink, void* context) {
+void WalkGroup(const Lanes& lanes, int used, SampleSink sink, void* context) {
   const DD d;
-  const VD sx = hn::Set(d, cone.position.x()), sy = hn::Set(d, cone.position.y());
-  const VD rr = hn::Set(d, range_res), ar = hn::Set(d, azimuth_res), half = hn::Set(d, 0.5);
+  const VD half = hn::Set(d, 0.5);
   VD pos[kVectors];
   for (VD& p : pos) p = hn::Zero(d);
   alignas(16) double keep[kGroup], qx[kGroup], qy[kGroup], step[kGroup];
   alignas(16) double lx[kGroup], ly[kGroup], range[kGroup];
+  const int vectors = (used + kLanes - 1) / kLanes;
   for (;;) {
     bool any = false;
-    for (int k = 0; k < kVectors; ++k) {
+    for (int k = 0; k < vectors; ++k) {
       const int o = k * kLanes;
       const VD ax = hn::Load(d, lanes.ax + o), ay = hn::Load(d, lanes.ay + o);
       const VD dx = hn::Load(d, lanes.dx + o), dy = hn::Load(d, lanes.dy + o);
@@ -89,10 +120,12 @@ void WalkGroup(const Lanes& lanes, int first, int used, const SensorCone& cone, 
         continue;
       }
       any = true;
-      const VD ds = Spacing(d, ax, ay, dx, dy, len, pos[k], sx, sy, rr, ar);
+      const VD ds = Spacing(d, ax, ay, dx, dy, len, pos[k], hn::Load(d, lanes.sx + o),
+                            hn::Load(d, lanes.sy + o), hn::Load(d, lanes.range_res + o),
+                            hn::Load(d, lanes.azimuth_res + o));
       const VD t = hn::Add(pos[k], hn::Mul(half, ds));
       const VD x = hn::Add(ax, hn::Mul(t, dx)), y = hn::Add(ay, hn::Mul(t, dy));
-      const auto kept = hn::And(active, Keep(d, cone, x, y, lx + o, ly + o, range + o));
+      const auto kept = hn::And(active, Keep(d, lanes, o, x, y, lx + o, ly + o, range + o));
       hn::Store(hn::IfThenElseZero(kept, hn::Set(d, 1.0)), d, keep + o);
       hn::Store(x, d, qx + o);
       hn::Store(y, d, qy + o);
@@ -102,32 +135,46 @@ void WalkGroup(const Lanes& lanes, int first, int used, const SensorCone& cone, 
     if (!any) return;
     for (int l = 0; l < used; ++l)
       if (keep[l] != 0.0)
-        sink(context, first + l,
+        sink(context, lanes.edge[l],
              EdgeSample{Position(qx[l], qy[l]), step[l], Position(lx[l], ly[l]), range[l]});
   }
 }
 
+// Squared length of an edge [m^2].
+double Length2(const Edge& e) { return (e.b - e.a).squaredNorm(); }
+
 }  // namespace
 
-void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
-               double azimuth_res, SampleSink sink, void* context) {
+void WalkEdges(const Edge* edges, int n, const SensorCone* cones, SampleSink sink, void* context) {
+  // Longest edges first, so that a group's lanes end at about the same sample (ties by index:
+  // the order is the same on every run; the samples do not depend on it).
+  thread_local std::vector<int> order;
+  order.resize(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](int i, int j) {
+    const double li = Length2(edges[i]), lj = Length2(edges[j]);
+    return li != lj ? li > lj : i < j;
+  });
   for (int first = 0; first < n; first += kGroup) {
     const int used = std::min(kGroup, n - first);
     Lanes lanes;
     for (int l = 0; l < used; ++l) {
-      const Edge& e = edges[first + l];
-      // As WalkEdge: nothing for an empty edge (its lane keeps length 0).
-      const double len = (e.b - e.a).norm();
-      if (!(len > 0.0)) continue;
-      const Vector2 dir = (e.b - e.a) / len;
-      lanes.ax[l] = e.a.x();
-      lanes.ay[l] = e.a.y();
-      lanes.dx[l] = dir.x();
-      lanes.dy[l] = dir.y();
-      lanes.len[l] = len;
+      const int i = order[first + l];
+      SetLane(lanes, l, edges[i], i, cones[edges[i].cone]);
     }
-    WalkGroup(lanes, first, used, cone, range_res, azimuth_res, sink, context);
+    WalkGroup(lanes, used, sink, context);
   }
+}
+
+void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
+               double azimuth_res, SampleSink sink, void* context) {
+  SensorCone c = cone;
+  c.range_res = range_res;
+  c.azimuth_res = azimuth_res;
+  thread_local std::vector<Edge> one_cone;
+  one_cone.assign(edges, edges + n);
+  for (Edge& e : one_cone) e.cone = 0;
+  WalkEdges(one_cone.data(), n, &c, sink, context);
 }
 
 }  // namespace dualgrid::radar::detail

@@ -6,9 +6,11 @@
 
 namespace dualgrid::radar::detail {
 
-/// An edge a -> b [m] (world frame).
+/// An edge a -> b [m] (world frame), walked for the sensor cones[cone] (the multi-cone
+/// WalkEdges; the one-cone overload ignores `cone`).
 struct Edge {
   Position a, b;
+  int cone = 0;
 };
 
 /// What the scan's first tests need of a sensor (RadarModel::VisibleScatterers' `consider`): a
@@ -20,6 +22,9 @@ struct SensorCone {
   Matrix2 to_local = Matrix2::Identity();   // world -> sensor frame rotation
   double min_range = 0.0, max_range = 0.0;  // [m]
   double fov_cos_bound = -1.0;              // FovCosBound(half field of view) [-]
+  // WalkEdge's resolutions, used by the multi-cone WalkEdges (the one-cone overload takes its
+  // own): range [m], azimuth [rad].
+  double range_res = 1.0, azimuth_res = 1.0;
 };
 
 /// One kept sample of a walked edge: its midpoint q [m] and length ds [m] (WalkEdge's), and q
@@ -44,12 +49,31 @@ using SampleSink = void (*)(void* context, int edge, const EdgeSample& sample);
 void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
                double azimuth_res, SampleSink sink, void* context);
 
+/// The same for edges of several sensors at once: edge i is walked as WalkEdge(a, b,
+/// cones[edges[i].cone].position, that cone's range_res, azimuth_res, emit) and its samples kept
+/// by that cone. Each edge's samples come in WalkEdge's order; the edges' come interleaved (in
+/// an order that depends on their lengths), so a sink must not depend on the order across edges.
+/// Lanes of different sensors in one vector overlap their chains: with all sensors' edges in one
+/// call, more chains are in flight than one sensor's 2-3 rail pieces give.
+void WalkEdges(const Edge* edges, int n, const SensorCone* cones, SampleSink sink, void* context);
+
 /// WalkEdges with a callable sink(int edge, const EdgeSample& sample).
 template <class Sink>
 void WalkEdges(const Edge* edges, int n, const SensorCone& cone, double range_res,
                double azimuth_res, Sink& sink) {
   WalkEdges(
       edges, n, cone, range_res, azimuth_res,
+      [](void* context, int edge, const EdgeSample& sample) {
+        (*static_cast<Sink*>(context))(edge, sample);
+      },
+      &sink);
+}
+
+/// The multi-cone WalkEdges with a callable sink(int edge, const EdgeSample& sample).
+template <class Sink>
+void WalkEdges(const Edge* edges, int n, const SensorCone* cones, Sink& sink) {
+  WalkEdges(
+      edges, n, cones,
       [](void* context, int edge, const EdgeSample& sample) {
         (*static_cast<Sink*>(context))(edge, sample);
       },

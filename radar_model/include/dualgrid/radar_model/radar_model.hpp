@@ -72,6 +72,10 @@ class RadarModel {
 
  private:
   void CheckSensor(int sensor) const;
+  /// Resolution-cell merging, detection test, noise and false alarms of one sensor's
+  /// scatterers, appended to *out.
+  void Detect(int sensor, const EgoMotion& ego, const std::vector<Scatterer>& scatterers,
+              std::uint64_t step, std::vector<Detection>* out) const;
 
   std::vector<SensorParams> params_;
   std::vector<SensorModel> models_;

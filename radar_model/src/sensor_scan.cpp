@@ -1,0 +1,297 @@
+#include "sensor_scan.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "ghosts.hpp"
+
+namespace dualgrid::radar::detail {
+namespace {
+
+// Puts (*out)[begin, end) in the order of piece_of (one entry each, values in [0, pieces)),
+// stably: the scatterers of piece 0 first, each piece's in the order they came.
+void GroupByPiece(std::vector<Scatterer>* out, std::size_t begin, const std::vector<int>& piece_of,
+                  int pieces, ScanScratch& scratch) {
+  assert(out->size() - begin == piece_of.size());
+  if (std::is_sorted(piece_of.begin(), piece_of.end())) return;
+  std::vector<int>& starts = scratch.piece_starts;
+  starts.assign(pieces + 1, 0);
+  for (const int k : piece_of) ++starts[k + 1];
+  for (int k = 0; k < pieces; ++k) starts[k + 1] += starts[k];
+  std::vector<Scatterer>& buffer = scratch.rail_buffer;
+  buffer.resize(piece_of.size());
+  for (std::size_t i = 0; i < piece_of.size(); ++i)
+    buffer[starts[piece_of[i]]++] = (*out)[begin + i];
+  std::copy(buffer.begin(), buffer.end(), out->begin() + static_cast<std::ptrdiff_t>(begin));
+}
+
+}  // namespace
+
+TargetGeometry::TargetGeometry(const Target& t)
+    : corners(t.box.Corners()),
+      inside(t.box),
+      half_diagonal(0.5 * std::hypot(t.box.length, t.box.width)),
+      axis(UnitVector(t.box.yaw)),
+      rcs_m2(std::pow(10.0, 0.1 * t.rcs_dbsm)) {}
+
+void ComputeTargetGeometry(const Scene& scene, std::vector<TargetGeometry>* out) {
+  out->clear();
+  out->reserve(scene.targets.size());
+  for (const Target& t : scene.targets) out->emplace_back(t);
+}
+
+SensorScan::SensorScan(const SensorParams& p, const SensorModel& model, const ModelOptions& options,
+                       const EgoMotion& ego, const Scene& scene,
+                       const std::vector<TargetGeometry>& targets, ScanScratch& scratch)
+    : p_(p),
+      model_(model),
+      options_(options),
+      ego_(ego),
+      scene_(scene),
+      targets_(targets),
+      scratch_(scratch) {
+  assert(targets.size() == scene.targets.size());
+  const Pose2 pose = SensorWorldPose(p, ego.pose);
+  s_ = pose.position;
+  vs_ = RigidPointVelocity(ego.velocity, ego.yaw_rate, ego.pose.position, s_);
+  half_fov_ = 0.5 * p.fov;
+  // Pose2::ToLocal recomputes cos/sin per call; this is the per-scatterer hot path.
+  to_local_ = Rotation(pose.yaw).transpose();
+  bin_width_ = p.fov / kAzimuthBins;
+  // Most walked rail samples lie outside the field of view (a rail piece is walked whole once
+  // some of it is in view): those that OutsideFov rejects skip the atan2 (the same outcome).
+  fov_cos_bound_ = FovCosBound(half_fov_);
+  // The ego's own body: checked for every scatterer (the sensors sit on it, so its angular
+  // interval spans up to a half turn and does not fit the azimuth bins).
+  has_body_ =
+      options.occlusion && ego.length > 2.0 * kEgoBodySkin && ego.width > 2.0 * kEgoBodySkin;
+  body_.a = ego.pose.position;
+  body_.axis = UnitVector(ego.pose.yaw);
+  body_.half_length = 0.5 * ego.length - kEgoBodySkin;
+  body_.half_width = 0.5 * ego.width - kEgoBodySkin;
+  cone_.position = s_;
+  cone_.to_local = to_local_;
+  cone_.min_range = p.min_range;
+  cone_.max_range = p.max_range;
+  cone_.fov_cos_bound = fov_cos_bound_;
+  cone_.range_res = p.range_resolution;
+  cone_.azimuth_res = p.azimuth_resolution;
+
+  // 1. Occluders and candidate sources within range and field of view, culled cheaply first.
+  scratch.occluders.clear();
+  CullTargets();
+  CullRails();
+  FillBins();
+  // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
+  scratch.scatterers.clear();
+  AddBoxes();
+  rail_begin_ = scratch.scatterers.size();
+  scratch.piece_of.clear();
+}
+
+bool SensorScan::InFov(const Interval& iv) const {
+  return std::abs(WrapAngle(iv.center)) <= iv.half_width + half_fov_;
+}
+
+void SensorScan::CullTargets() {
+  std::vector<int>& candidates = scratch_.candidate_targets;
+  candidates.clear();
+  for (std::size_t ti = 0; ti < scene_.targets.size(); ++ti) {
+    const OrientedBox& box = scene_.targets[ti].box;
+    const TargetGeometry& g = targets_[ti];
+    const double center_dist = (box.center - s_).norm();
+    if (center_dist - g.half_diagonal > p_.max_range || g.inside.Contains(s_)) continue;
+    Position local[4];
+    for (int k = 0; k < 4; ++k) local[k] = LocalOf(g.corners[k]);
+    const Interval iv = IntervalOf(local, 4);
+    if (!InFov(iv)) continue;
+    candidates.push_back(static_cast<int>(ti));
+    Occluder o;
+    o.owner = static_cast<int>(ti);
+    o.is_box = true;
+    o.min_distance = std::max(0.0, center_dist - g.half_diagonal);
+    o.center_dir = UnitVector(iv.center);
+    o.cos_half_width = std::cos(iv.half_width);
+    o.a = box.center;
+    o.axis = g.axis;
+    o.half_length = 0.5 * box.length;
+    o.half_width = 0.5 * box.width;
+    scratch_.occluders.push_back(o);
+  }
+}
+
+void SensorScan::CullRails() {
+  std::vector<RailPiece>& rail_pieces = scratch_.rail_pieces;
+  rail_pieces.clear();
+  int segment_index = 0;
+  for (std::size_t li = 0; li < scene_.polylines.size(); ++li) {
+    const std::vector<Position>& pts = scene_.polylines[li].points;
+    for (std::size_t k = 0; k + 1 < pts.size(); ++k, ++segment_index) {
+      double t0, t1;
+      if (!ClipToDisc(pts[k], pts[k + 1], s_, p_.max_range, &t0, &t1)) continue;
+      const Position a = pts[k] + t0 * (pts[k + 1] - pts[k]);
+      const Position b = pts[k] + t1 * (pts[k + 1] - pts[k]);
+      const Position local[2] = {LocalOf(a), LocalOf(b)};
+      if (local[0].norm() < 1e-9 || local[1].norm() < 1e-9) continue;
+      const Interval iv = IntervalOf(local, 2);
+      if (!InFov(iv)) continue;
+      rail_pieces.push_back({static_cast<int>(li), a, b, segment_index,
+                             std::pow(10.0, 0.1 * scene_.polylines[li].rcs_dbsm_per_metre)});
+      Occluder o;
+      o.owner = -1 - segment_index;
+      o.is_box = false;
+      o.min_distance = PointSegmentDistance(s_, a, b);
+      o.center_dir = UnitVector(iv.center);
+      o.cos_half_width = std::cos(iv.half_width);
+      o.a = a;
+      o.b = b;
+      scratch_.occluders.push_back(o);
+    }
+  }
+}
+
+// Azimuth bins over the field of view listing the occluders whose interval overlaps them.
+void SensorScan::FillBins() {
+  if (!options_.occlusion) return;
+  std::vector<std::vector<int>>& bins = scratch_.bins;
+  bins.resize(kAzimuthBins);
+  for (std::vector<int>& bin : bins) bin.clear();
+  for (std::size_t k = 0; k < scratch_.occluders.size(); ++k) {
+    const Occluder& o = scratch_.occluders[k];
+    const double c = std::atan2(o.center_dir.y(), o.center_dir.x());
+    const double hw = std::acos(std::clamp(o.cos_half_width, -1.0, 1.0));
+    // The interval may wrap through +-pi; try it shifted by a turn either way (it is narrower
+    // than a half turn, so no bin is listed twice). One bin of slack on each side.
+    for (const double shift : {-2.0 * kPi, 0.0, 2.0 * kPi}) {
+      const int first = static_cast<int>(std::floor((c + shift - hw + half_fov_) / bin_width_)) - 1;
+      const int last = static_cast<int>(std::floor((c + shift + hw + half_fov_) / bin_width_)) + 1;
+      for (int bi = std::max(first, 0); bi <= std::min(last, kAzimuthBins - 1); ++bi)
+        bins[bi].push_back(static_cast<int>(k));
+    }
+  }
+}
+
+void SensorScan::AddBoxes() {
+  for (const int ti : scratch_.candidate_targets) {
+    const Target& t = scene_.targets[ti];
+    BoxScatterers(targets_[ti].corners, targets_[ti].rcs_m2, s_, p_.range_resolution,
+                  p_.azimuth_resolution, scratch_.samples,
+                  [&](const Position& q, double rcs_share) {
+                    Consider(q, RigidPointVelocity(t.velocity, t.yaw_rate, t.box.center, q),
+                             rcs_share, t.id, ti);
+                  });
+  }
+}
+
+// The ego's body hides q (needs no azimuth).
+bool SensorScan::BehindBody(const Position& q) const {
+  return has_body_ && LengthInsideBox(body_, s_, q) > kEgoBodyMargin;
+}
+
+// Another occluder hides q (the azimuth bins'); with BehindBody, the scan's occlusion test.
+bool SensorScan::BehindOthers(const Position& q, int owner, const Polar& truth) const {
+  const Vector2 dir_local = LocalOf(q) / truth.range;
+  const Position end = q - kOcclusionShrink * (q - s_) / truth.range;
+  const int bi =
+      std::clamp(static_cast<int>((truth.azimuth + half_fov_) / bin_width_), 0, kAzimuthBins - 1);
+  for (const int k : scratch_.bins[bi]) {
+    const Occluder& o = scratch_.occluders[k];
+    if (o.owner == owner || o.min_distance >= truth.range) continue;
+    if (dir_local.dot(o.center_dir) < o.cos_half_width - 1e-12) continue;
+    if (o.is_box ? SegmentHitsBox(o, s_, end) : SegmentsIntersect(s_, end, o.a, o.b)) return true;
+  }
+  return false;
+}
+
+// A point q kept by the first tests (range and field of view), with its local coordinates and
+// range: the azimuth, the window and occlusion decide. True when it became a scatterer. The tests
+// are pure and all must pass, so their order does not change the outcome: the ego's body first
+// (it needs no azimuth, and a corner radar's view along the car is mostly behind it), then the
+// atan2 and the rest.
+bool SensorScan::ConsiderKept(const Position& q, const Position& local, double range,
+                              const Velocity& v, double rcs_m2, int source_id, int owner) {
+  if (BehindBody(q)) return false;
+  Scatterer sc;
+  sc.truth.range = range;
+  sc.truth.azimuth = std::atan2(local.y(), local.x());
+  if (std::abs(sc.truth.azimuth) > half_fov_) return false;
+  sc.truth.range_rate = (v - vs_).dot(q - s_) / sc.truth.range;
+  if (!model_.InWindow(sc.truth) || (options_.occlusion && BehindOthers(q, owner, sc.truth)))
+    return false;
+  sc.position = q;
+  sc.velocity = v;
+  sc.rcs_m2 = rcs_m2;
+  sc.source_id = source_id;
+  sc.origin = q;
+  scratch_.scatterers.push_back(sc);
+  return true;
+}
+
+void SensorScan::Consider(const Position& q, const Velocity& v, double rcs_m2, int source_id,
+                          int owner) {
+  const Position local = LocalOf(q);
+  const double range = local.norm();
+  if (range < p_.min_range || range > p_.max_range) return;
+  if (OutsideFov(local, range, fov_cos_bound_)) return;
+  ConsiderKept(q, local, range, v, rcs_m2, source_id, owner);
+}
+
+void SensorScan::ConsiderRailSample(int k, const EdgeSample& e) {
+  const RailPiece& piece = scratch_.rail_pieces[k];
+  if (ConsiderKept(e.q, e.local, e.range, Velocity::Zero(), piece.rcs_per_m * e.ds,
+                   scene_.polylines[piece.polyline].id, -1 - piece.segment))
+    scratch_.piece_of.push_back(k);
+}
+
+void SensorScan::FinishRails() {
+  GroupByPiece(&scratch_.scatterers, rail_begin_, scratch_.piece_of,
+               static_cast<int>(scratch_.rail_pieces.size()), scratch_);
+}
+
+void SensorScan::AddGhosts() {
+  if (!options_.multipath.enabled) return;
+  SensorView view;
+  view.params = &p_;
+  view.model = &model_;
+  view.s = s_;
+  view.vs = vs_;
+  view.to_local = to_local_;
+  view.cos_half_fov = std::cos(half_fov_);
+  view.occlusion = options_.occlusion;
+  view.has_body = has_body_;
+  view.body = body_;
+  if (has_body_)
+    for (const Position& c :
+         OrientedBox{ego_.pose.position, ego_.pose.yaw, ego_.length, ego_.width}.Corners())
+      view.body_box.Add(c);
+  const auto occluded = [this](const Position& q, int owner, const Polar& truth) {
+    return options_.occlusion && (BehindBody(q) || BehindOthers(q, owner, truth));
+  };
+  AddGhostScatterers(view, options_.multipath, scene_, occluded, &scratch_.scatterers);
+}
+
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch) {
+  std::vector<Edge>& edges = scratch.edges;
+  std::vector<SensorCone>& cones = scratch.cones;
+  std::vector<std::pair<int, int>>& owner_of = scratch.owner_of;
+  cones.clear();
+  edges.clear();
+  owner_of.clear();
+  for (std::size_t j = 0; j < scans.size(); ++j) {
+    cones.push_back(scans[j]->cone());
+    const std::vector<RailPiece>& pieces = scans[j]->rail_pieces();
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+      edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
+      owner_of.emplace_back(static_cast<int>(j), static_cast<int>(k));
+    }
+  }
+  auto sink = [&](int edge, const EdgeSample& e) {
+    const auto [scan, piece] = owner_of[edge];
+    scans[scan]->ConsiderRailSample(piece, e);
+  };
+  WalkEdges(edges.data(), static_cast<int>(edges.size()), cones.data(), sink);
+  for (SensorScan* scan : scans) scan->FinishRails();
+}
+
+}  // namespace dualgrid::radar::detail

@@ -1,0 +1,120 @@
+// One sensor's visible scatterers in phases (internal to radar_model/src), so that the sensors of
+// a step can walk their guard rails together on SIMD lanes: the constructor culls the scene and
+// samples the boxes, ScanRails walks the rail pieces of several scans at once, then AddGhosts.
+// RadarModel::VisibleScatterers and RadarModel::Scan run the same phases, so a sensor's
+// scatterers do not depend on which sensors walk with it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "dualgrid/radar_model/radar_model.hpp"
+#include "edge_walk.hpp"
+#include "scan_geometry.hpp"
+
+namespace dualgrid::radar::detail {
+
+/// A rail segment clipped to a sensor's range disc (in its field of view).
+struct RailPiece {
+  int polyline;
+  Position a, b;     ///< [m] world
+  int segment;       ///< the segment's index over all polylines
+  double rcs_per_m;  ///< [m^2 / m]
+};
+
+/// What the scan needs of a target whatever the sensor, computed once per step (the same values
+/// the scan computed per sensor): its corners, inside test, half diagonal, length axis and RCS.
+struct TargetGeometry {
+  std::array<Position, 4> corners;  ///< OrientedBox::Corners()
+  BoxTest inside;
+  double half_diagonal = 0.0;       ///< [m]
+  Vector2 axis = Vector2::UnitX();  ///< UnitVector(yaw)
+  double rcs_m2 = 0.0;              ///< 10^(rcs_dbsm / 10) [m^2]
+  explicit TargetGeometry(const Target& t);
+};
+
+/// The TargetGeometry of every target of `scene`, in its order (`out` reused).
+void ComputeTargetGeometry(const Scene& scene, std::vector<TargetGeometry>* out);
+
+/// One sensor's working memory, kept between steps so that a scan allocates nothing once warmed
+/// up. Each scan in flight has its own; every user clears what it takes.
+struct ScanScratch {
+  std::vector<Occluder> occluders;
+  std::vector<int> candidate_targets;
+  std::vector<RailPiece> rail_pieces;
+  std::vector<int> piece_of;           // the rail piece of each kept rail scatterer
+  std::vector<int> piece_starts;       // GroupByPiece's counts
+  std::vector<Scatterer> rail_buffer;  // GroupByPiece's copy
+  std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
+  std::vector<FaceSample> samples;
+  std::vector<Scatterer> scatterers;                           // the scan's result
+  std::vector<Detection> detections;                           // RadarModel::Scan's, per sensor
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
+};
+
+/// The scan of one sensor. Holds references to its arguments until it is done.
+class SensorScan {
+ public:
+  /// Steps 1 and 2: occluders, azimuth bins and rail pieces, then the boxes' scatterers appended
+  /// to scratch.scatterers (cleared first). `targets` is ComputeTargetGeometry(scene).
+  SensorScan(const SensorParams& p, const SensorModel& model, const ModelOptions& options,
+             const EgoMotion& ego, const Scene& scene, const std::vector<TargetGeometry>& targets,
+             ScanScratch& scratch);
+
+  /// Step 3 input: the rail pieces to walk and the cone that keeps their samples.
+  const std::vector<RailPiece>& rail_pieces() const { return scratch_.rail_pieces; }
+  const SensorCone& cone() const { return cone_; }
+  /// Step 3: a sample of rail piece k that the cone kept, in the walk's order within the piece.
+  void ConsiderRailSample(int k, const EdgeSample& e);
+  /// After the last rail sample: the rail scatterers put piece after piece.
+  void FinishRails();
+  /// Step 4 (multipath on): the boxes' ghosts.
+  void AddGhosts();
+
+ private:
+  void CullTargets();
+  void CullRails();
+  void FillBins();
+  void AddBoxes();
+  Position LocalOf(const Position& q) const { return to_local_ * (q - s_); }
+  bool InFov(const Interval& iv) const;
+  bool BehindBody(const Position& q) const;
+  bool BehindOthers(const Position& q, int owner, const Polar& truth) const;
+  bool ConsiderKept(const Position& q, const Position& local, double range, const Velocity& v,
+                    double rcs_m2, int source_id, int owner);
+  void Consider(const Position& q, const Velocity& v, double rcs_m2, int source_id, int owner);
+
+  const SensorParams& p_;
+  const SensorModel& model_;
+  const ModelOptions& options_;
+  const EgoMotion& ego_;
+  const Scene& scene_;
+  const std::vector<TargetGeometry>& targets_;
+  ScanScratch& scratch_;
+  Position s_;
+  Velocity vs_;
+  double half_fov_;
+  Matrix2 to_local_;
+  double bin_width_;
+  double fov_cos_bound_;
+  Occluder body_;
+  bool has_body_;
+  SensorCone cone_;
+  std::size_t rail_begin_ = 0;  // the first rail scatterer in scratch.scatterers
+};
+
+/// ScanRails' working memory.
+struct RailWalkScratch {
+  std::vector<Edge> edges;
+  std::vector<SensorCone> cones;
+  std::vector<std::pair<int, int>> owner_of;  // (scan, piece) of each edge
+};
+
+/// Step 3 of every scan of `scans`: their rail pieces walked together (WalkEdges with one cone
+/// per scan), each kept sample handed to its scan, then FinishRails.
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch);
+
+}  // namespace dualgrid::radar::detail
