@@ -242,25 +242,24 @@ std::uint64_t EqualBytes(std::uint64_t a, std::uint64_t b) {
   return ~(((x & kLow7) + kLow7) | x) & ~kLow7;
 }
 
-/// Z_RLE's tokens: a byte that repeats the one before it at least kMinMatch times starts a match
-/// of distance 1 (up to kMaxMatch bytes); every other byte is a literal. Eight positions are
-/// tested at once for a match's start. `tokens` holds at least raw.size() entries; returns how
-/// many were written and the bytes' Adler-32.
-std::pair<std::size_t, std::uint32_t> Tokenize(const std::vector<std::uint8_t>& raw,
-                                               std::uint32_t* tokens) {
-  Adler32 adler;
+/// Z_RLE's tokens of raw[at..], at most `capacity` (a block's; it stops up to kWord + 1 short),
+/// advancing `at`: a byte that repeats the one before it at least kMinMatch times starts a match of
+/// distance 1 (up to kMaxMatch bytes); every other byte is a literal. Eight positions are tested at
+/// once for a match's start. Returns how many tokens were written to `tokens`.
+std::size_t Tokenize(const std::vector<std::uint8_t>& raw, std::size_t& at, std::uint32_t* tokens,
+                     std::size_t capacity, Adler32& adler) {
   const std::size_t n = raw.size();
   const std::uint8_t* p = raw.data();
-  std::size_t i = 0, count = 0;
+  std::size_t i = at, count = 0;
   const auto literals = [&](std::size_t k) {
     for (std::size_t j = 0; j < k; ++j) tokens[count + j] = p[i + j];
     adler.Literals(p + i, k);
     count += k;
     i += k;
   };
-  if (n > 0) literals(1);
-  while (i < n) {
-    if (i + kWord + 2 <= n) {  // p[i - 1 .. i + 9] in bounds
+  if (i == 0 && n > 0) literals(1);
+  while (i < n && count + kWord + 1 <= capacity) {  // at most kWord literals and a run below
+    if (i + kWord + 2 <= n) {                       // p[i - 1 .. i + 9] in bounds
       const std::uint64_t starts = EqualBytes(Word(p + i), Word(p + i - 1)) &
                                    EqualBytes(Word(p + i + 1), Word(p + i)) &
                                    EqualBytes(Word(p + i + 2), Word(p + i + 1));
@@ -279,7 +278,8 @@ std::pair<std::size_t, std::uint32_t> Tokenize(const std::vector<std::uint8_t>& 
     adler.Run(p[i], run);
     i += run;
   }
-  return {count, adler.Value()};
+  at = i;
+  return count;
 }
 
 /// The code-length sequence of one block's two codes, run-length coded (RFC 1951 3.2.7): each
@@ -391,26 +391,22 @@ void WriteBlock(const std::uint32_t* tokens, std::size_t count, bool last, BitWr
 }  // namespace
 
 bool DeflateRle(const std::vector<std::uint8_t>& raw, std::vector<std::uint8_t>& packed) {
-  // Tokens count bytes in 32 bits; a frame is at most 1 GiB (the reader's bound).
-  if (raw.size() > UINT32_MAX) return false;
-  // At most one token a byte; kept between frames (the worker compresses one frame at a time).
-  thread_local std::vector<std::uint32_t> token_buffer;
-  if (token_buffer.size() < raw.size()) token_buffer.resize(raw.size());
-  const std::uint32_t* tokens = token_buffer.data();
-  const auto [token_count, adler] = Tokenize(raw, token_buffer.data());
+  if (raw.size() > UINT32_MAX) return false;  // a frame is at most 1 GiB (the reader's bound)
   // RFC 1950 header: deflate with a 32 KiB window (CMF 0x78), no dictionary, "fastest"
   // compression level (FLEVEL 0), check bits making the pair a multiple of 31.
   packed.assign({0x78, 0x01});
   BitWriter bits(packed);
+  Adler32 adler;
+  std::array<std::uint32_t, kBlockTokens> tokens;  // one block's, tokenized as it is written
   std::size_t at = 0;
   do {
-    const std::size_t count = std::min(kBlockTokens, token_count - at);
-    WriteBlock(tokens + at, count, at + count == token_count, bits);
-    at += count;
-  } while (at < token_count);
+    const std::size_t count = Tokenize(raw, at, tokens.data(), tokens.size(), adler);
+    WriteBlock(tokens.data(), count, at == raw.size(), bits);
+  } while (at < raw.size());
   bits.Finish();
+  const std::uint32_t checksum = adler.Value();
   for (int shift = 24; shift >= 0; shift -= 8)
-    packed.push_back(static_cast<std::uint8_t>(adler >> shift));
+    packed.push_back(static_cast<std::uint8_t>(checksum >> shift));
   return true;
 }
 
