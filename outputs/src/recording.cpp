@@ -86,24 +86,6 @@ json HeaderJson(const Header& h) {
 
 }  // namespace
 
-bool DeflateRle(const std::vector<std::uint8_t>& raw, std::vector<std::uint8_t>& packed) {
-  z_stream z{};
-  // Z_RLE matches runs of one byte only (distance 1), so the level chooses nothing but the
-  // header's FLEVEL bits; 1 says "fastest".
-  // One call takes at most 4 GiB (zlib's uInt); a frame is at most 1 GiB (the reader's bound).
-  if (raw.size() > UINT32_MAX || deflateInit2(&z, 1, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK)
-    return false;
-  packed.resize(deflateBound(&z, static_cast<uLong>(raw.size())));
-  z.next_in = const_cast<Bytef*>(raw.data());  // zlib's API is not const-correct; never written
-  z.avail_in = static_cast<uInt>(raw.size());
-  z.next_out = packed.data();
-  z.avail_out = static_cast<uInt>(packed.size());
-  const bool done = deflate(&z, Z_FINISH) == Z_STREAM_END;
-  packed.resize(z.total_out);
-  deflateEnd(&z);
-  return done;
-}
-
 double ParticleUnit(double extent_x, double extent_y) {
   const double extent = std::max(extent_x, extent_y);
   return std::max(0.01, extent / 65000.0);

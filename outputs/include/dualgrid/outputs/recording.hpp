@@ -114,8 +114,10 @@ struct Header {
 
 /// One frame's bytes as frames.bin holds them: `raw` deflated into one zlib stream (RFC 1950,
 /// which any inflater reads: zlib's uncompress, the browser's DecompressionStream("deflate"),
-/// Python's zlib.decompress) with zlib's run-length strategy (Z_RLE; docs/replay.md, "Cost", says
-/// why). Replaces `packed`; false if zlib fails (then `packed` holds nothing usable).
+/// Python's zlib.decompress) by dualgrid's own run-length encoder: the tokens of zlib's Z_RLE
+/// strategy (literals and runs of one byte) with dynamic Huffman codes per block of 16,383
+/// tokens (docs/replay.md, "Cost", says why). Replaces `packed`; false if `raw` is larger than
+/// 4 GiB (then `packed` holds nothing usable).
 bool DeflateRle(const std::vector<std::uint8_t>& raw, std::vector<std::uint8_t>& packed);
 
 /// The particle unit for a grid of this extent: 1 cm up to 655 m, coarser beyond (uint16).
