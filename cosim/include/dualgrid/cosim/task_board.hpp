@@ -56,6 +56,11 @@ class TaskBoard {
   /// threads look again.
   void Wake();
   int size() const { return tasks_; }
+  /// Tasks claimed and not yet done (a snapshot: other threads may change it at once).
+  int running() const {
+    const int done = done_count_.load(std::memory_order_acquire);  // first: never above claimed
+    return claimed_count_.load(std::memory_order_acquire) - done;
+  }
 
  private:
   struct Slot {
@@ -76,7 +81,7 @@ class TaskBoard {
 
   int tasks_;
   std::unique_ptr<Slot[]> slots_;
-  std::atomic<int> claimed_count_{0};
+  std::atomic<int> claimed_count_{0}, done_count_{0};
   std::atomic<std::uint32_t> progress_{0};  // bumped by Finish and Wake
 };
 
