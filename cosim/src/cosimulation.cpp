@@ -101,7 +101,7 @@ std::vector<std::exception_ptr> CoSimulation::FilterAndScore(const StepView& vie
   StepRegion region(*this, view, read_ahead_ && team > 1 && modes % team != 0);
   const auto run_thread = [&](int t) {
     for (int m : schedule.filters(t)) region.Filter(m);
-    region.Work();
+    region.Work(schedule.filters(t));
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and

@@ -43,8 +43,11 @@ void StepRegion::Filter(int m) {
   board_.Wake();
 }
 
-void StepRegion::Work() {
-  board_.Work([this](int task) { return Ready(task); }, [this](int task) { Run(task); });
+void StepRegion::Work(std::span<const int> own) {
+  std::vector<int> preferred;
+  for (int m : own) preferred.push_back(FilteredTask(m));
+  for (int m : own) preferred.push_back(ScoredTask(m));
+  board_.Work([this](int task) { return Ready(task); }, [this](int task) { Run(task); }, preferred);
 }
 
 bool StepRegion::Ready(int task) const {

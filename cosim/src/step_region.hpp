@@ -16,6 +16,7 @@
 #include <atomic>
 #include <exception>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
@@ -32,8 +33,9 @@ class StepRegion {
   /// Mode m's filter cycle, snapshot and classes; once per mode per step, on any one thread.
   void Filter(int m);
   /// Takes tasks until none is left to take (TaskBoard::Work); every thread of the region, after
-  /// its filters.
-  void Work();
+  /// its filters `own` (the observers' parts of these modes first: they read the filter's
+  /// particles and cells, still in this core's cache).
+  void Work(std::span<const int> own);
   /// After the region: the first error of the truth, the noise or a mode (in mode order).
   void Rethrow() const;
   /// After the region: per observer, the first error of its Prepare parts (step part first,
