@@ -76,8 +76,9 @@ bool StepRegion::Ready(int task) const {
 }
 
 bool StepRegion::OthersBusy() const {
-  // The caller's own task is one of the running ones.
-  return filters_done_.load(std::memory_order_acquire) < modes_ || board_.running() > 1;
+  // Besides the caller's own task: a task still to run or running (nothing waits for the
+  // caller's, so another thread takes it), or a filter.
+  return filters_done_.load(std::memory_order_acquire) < modes_ || board_.unfinished() > 1;
 }
 
 void StepRegion::Run(int task) {

@@ -66,7 +66,8 @@ class StepRegion {
   void Score(int m);
   // The observers' part `part` (of mode m, -1 for the step's) into errors slot `slot`.
   void Observe(StepObserver::Part part, int m, int slot);
-  // Whether some thread other than the caller is busy: a filter or another task still runs.
+  // Whether another thread has work besides the caller's task: a filter still runs, or another
+  // task is not done.
   bool OthersBusy() const;
 
   CoSimulation& cs_;

@@ -364,7 +364,7 @@ void CheckSameEnding(const Ending& off, const Ending& on) {
   for (std::size_t m = 0; m < on.metrics.size(); ++m) CHECK(on.metrics[m] == off.metrics[m]);
   CHECK(off.read == 0u);
   CHECK(off.hits == 0u);
-  // The grid read ahead is built only while a filter still runs (timing): taken or not.
+  // The grid read ahead is built only while another thread has work (timing): taken or not.
   CHECK(on.hits <= on.read);
 }
 

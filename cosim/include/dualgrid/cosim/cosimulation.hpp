@@ -35,8 +35,9 @@ struct CoSimOptions {
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
   /// threads), the step's region also reads the next step (SUMO's step and the radar scan; for
   /// recorded data a twin of the source) and builds that step's measurement grid, on whichever
-  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while a
-  /// filter still runs, else Advance builds it with every thread). Results do not depend on it:
+  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while
+  /// another thread has work left in the region, else Advance builds it with every thread).
+  /// Results do not depend on it:
   /// the grid is taken only for the same inputs, and an error or the end met reading ahead
   /// surfaces at the next Step(), where it would have without it. SUMO then stands one step ahead
   /// between steps: a run stopped early has simulated that step too (sumo(), SUMO's own

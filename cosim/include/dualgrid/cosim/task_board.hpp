@@ -62,11 +62,8 @@ class TaskBoard {
   /// threads look again.
   void Wake();
   int size() const { return tasks_; }
-  /// Tasks claimed and not yet done (a snapshot: other threads may change it at once).
-  int running() const {
-    const int done = done_count_.load(std::memory_order_acquire);  // first: never above claimed
-    return claimed_count_.load(std::memory_order_acquire) - done;
-  }
+  /// Tasks not yet done, claimed or not (a snapshot: other threads may change it at once).
+  int unfinished() const { return tasks_ - done_count_.load(std::memory_order_acquire); }
 
  private:
   struct Slot {
