@@ -49,11 +49,15 @@ bool CoSimulation::Step() {
   // Every observer is asked (no short cut): each may keep its own schedule.
   for (StepObserver* o : observers_)
     with_velocities = o->WantsVelocities(steps_, f.time) || with_velocities;
-  FilterAndScore(with_velocities);
+  // The view refers to members the region fills (snapshots, scorers, objects, truth classes).
   const StepView view{steps_,   f,        pipeline_,      mode_names_,    snapshots_,
                       scorers_, objects_, truth_classes_, with_velocities};
+  const std::vector<std::exception_ptr> early = FilterAndScore(view);
   ++steps_;
-  for (StepObserver* o : observers_) o->OnStep(view);
+  for (std::size_t i = 0; i < observers_.size(); ++i) {
+    if (early[i]) std::rethrow_exception(early[i]);  // where its OnStep would have thrown
+    observers_[i]->OnStep(view);
+  }
   return true;
 }
 
@@ -64,16 +68,23 @@ bool CoSimulation::Step() {
 // filter's state (~2-3 MB) then stays in the cache of the core that updated it last step, and its
 // snapshot is taken there at once. With tasks, a mode moved between cores from step to step and
 // every pass over its cells paid for the move (+28 % CPU time on the recorded loop,
-// docs/performance.md). The rest of the step (RegionTask: the truth, the scoring, the next
-// step's reading and measurement grid, the next cycle's noise) is taken by whichever thread is
+// docs/performance.md). The rest of the step (StepRegion's tasks: the truth, the scoring, the
+// next step's reading and measurement grid, the observers' Prepare parts, the next cycle's noise)
+// is taken by whichever thread is
 // free first (TaskBoard), so that a thread slowed down (by another process, or the output thread)
 // does not leave the other idle at the region's end. Results do not depend on either: every value
 // is computed by one thread from the same inputs.
-void CoSimulation::FilterAndScore(bool with_velocities) {
+std::vector<std::exception_ptr> CoSimulation::FilterAndScore(const StepView& view) {
   const int modes = static_cast<int>(mode_names_.size());
   objects_.clear();
   truth_classes_.clear();
-  if (modes == 0) return;
+  if (modes == 0) {  // no region: the observers' only part, here
+    std::vector<std::exception_ptr> errors(observers_.size());
+    for (std::size_t i = 0; i < observers_.size(); ++i)
+      StepRegion::Guarded(errors[i],
+                          [&] { observers_[i]->Prepare(view, StepObserver::Part::kStep, -1); });
+    return errors;
+  }
   if (threads_ > 0) omp_set_num_threads(threads_);
   const int threads = omp_get_max_threads();
   const int team = std::min(modes, threads);
@@ -87,10 +98,10 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   pipeline_.DrawNoise(false);
   // Reading ahead only when a thread filters fewer modes than another (3 modes on 2 threads):
   // otherwise there is no time to spare in the region, and Advance does it all between regions.
-  StepRegion region(*this, with_velocities, read_ahead_ && team > 1 && modes % team != 0);
+  StepRegion region(*this, view, read_ahead_ && team > 1 && modes % team != 0);
   const auto run_thread = [&](int t) {
     for (int m : schedule.filters(t)) region.Filter(m);
-    region.Work();
+    region.Work(schedule.filters(t));
   };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and
@@ -106,6 +117,7 @@ void CoSimulation::FilterAndScore(bool with_velocities) {
   }
   ++timed_steps_;
   region.Rethrow();
+  return region.ObserverErrors();
 }
 
 // The first kWarmUp steps are not timed (the first cycles fill the grid and are not typical);

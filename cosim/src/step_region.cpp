@@ -4,29 +4,18 @@
 
 namespace dualgrid::cosim {
 
-namespace {
-
-template <typename Work>
-void Guarded(std::exception_ptr& slot, Work&& work) {
-  try {
-    work();
-  } catch (...) {
-    slot = std::current_exception();
-  }
-}
-
-}  // namespace
-
-StepRegion::StepRegion(CoSimulation& cs, bool with_velocities, bool read_ahead)
+StepRegion::StepRegion(CoSimulation& cs, const StepView& view, bool read_ahead)
     : cs_(cs),
+      view_(view),
       modes_(static_cast<int>(cs.mode_names_.size())),
-      with_velocities_(with_velocities),
+      with_velocities_(view.with_velocities),
       read_ahead_(read_ahead),
       ego_box_(cs.pipeline_.grid_frame().ToGrid(cs.pipeline_.frame().ego.box)),
       score_points_(cs.pipeline_.source().has_labels()),
       errors_(modes_),
+      observer_errors_(cs.observers_.size() * static_cast<std::size_t>(1 + 2 * modes_)),
       filtered_(std::make_unique<std::atomic<int>[]>(modes_)),
-      board_(kFirstScore + modes_ + 1) {
+      board_(NoiseTask() + 1) {
   // Labelled recorded points, scored per mode at their cells.
   Pipeline& p = cs_.pipeline_;
   cs_.point_positions_.clear();
@@ -48,14 +37,17 @@ void StepRegion::Filter(int m) {
   cs_.filter_seconds_[m] +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // filtered_[m] first: a thread that sees the counts (Ready's truth) then sees it too (Truth).
-  filtered_[m].store(1, std::memory_order_release);
+  filtered_[m].store(errors_[m] ? kFilterFailed : kFilterOk, std::memory_order_release);
   if (!errors_[m]) filters_ok_.fetch_add(1, std::memory_order_acq_rel);
   filters_done_.fetch_add(1, std::memory_order_acq_rel);
   board_.Wake();
 }
 
-void StepRegion::Work() {
-  board_.Work([this](int task) { return Ready(task); }, [this](int task) { Run(task); });
+void StepRegion::Work(std::span<const int> own) {
+  std::vector<int> preferred;
+  for (int m : own) preferred.push_back(FilteredTask(m));
+  for (int m : own) preferred.push_back(ScoredTask(m));
+  board_.Work([this](int task) { return Ready(task); }, [this](int task) { Run(task); }, preferred);
 }
 
 bool StepRegion::Ready(int task) const {
@@ -68,10 +60,25 @@ bool StepRegion::Ready(int task) const {
     case kPrepareAhead:
       return board_.done(kReadAhead);
     default:
-      if (task == NoiseTask()) return true;
-      return filtered_[task - kFirstScore].load(std::memory_order_acquire) != 0 &&
-             board_.done(kTruth);
+      break;
   }
+  if (task == NoiseTask()) return true;
+  if (task == ObserveStepTask()) return board_.done(kTruth) && board_.done(kReadAhead);
+  if (task >= ScoredTask(0)) {
+    const int m = task - ScoredTask(0);
+    return board_.done(kFirstScore + m) && board_.done(FilteredTask(m));
+  }
+  if (task >= FilteredTask(0)) {
+    const int m = task - FilteredTask(0);
+    return filtered_[m].load(std::memory_order_acquire) != 0 && board_.done(ObserveStepTask());
+  }
+  return filtered_[task - kFirstScore].load(std::memory_order_acquire) != 0 && board_.done(kTruth);
+}
+
+bool StepRegion::OthersBusy() const {
+  // Besides the caller's own task: a task still to run or running (nothing waits for the
+  // caller's, so another thread takes it), or a filter.
+  return filters_done_.load(std::memory_order_acquire) < modes_ || board_.unfinished() > 1;
 }
 
 void StepRegion::Run(int task) {
@@ -84,20 +91,54 @@ void StepRegion::Run(int task) {
       if (read_ahead_) p.ReadAhead();  // noexcept: an error waits for the next Advance
       return;
     case kPrepareAhead:
-      // For SUMO, only while a filter still runs: once every thread is free, the next Advance
-      // builds the grid faster with all of them than this thread alone (which of the two
-      // happens depends on timing, never a result). Recorded data: always (a twin's read).
-      if (read_ahead_ &&
-          (filters_done_.load(std::memory_order_acquire) < modes_ || !p.source().can_run_ahead()))
+      // For SUMO, only while another thread is busy (a filter or a task): once every thread is
+      // free, the next Advance builds the grid faster with all of them than this thread alone
+      // (which of the two happens depends on timing, never a result). Recorded data: always (a
+      // twin's read).
+      if (read_ahead_ && (OthersBusy() || !p.source().can_run_ahead()))
         p.PrepareAhead();  // noexcept likewise
       return;
     default:
-      if (task == NoiseTask()) {
-        Guarded(noise_error_, [&] { p.DrawNoise(true); });  // the other slot: no race
-      } else {
-        Score(task - kFirstScore);
-      }
+      break;
   }
+  using Part = StepObserver::Part;
+  if (task == NoiseTask()) {
+    Guarded(noise_error_, [&] { p.DrawNoise(true); });  // the other slot: no race
+  } else if (task == ObserveStepTask()) {
+    Observe(Part::kStep, -1, 0);
+  } else if (task >= ScoredTask(0)) {
+    const int m = task - ScoredTask(0);
+    Observe(Part::kScored, m, 2 + 2 * m);
+  } else if (task >= FilteredTask(0)) {
+    const int m = task - FilteredTask(0);
+    Observe(Part::kFiltered, m, 1 + 2 * m);
+  } else {
+    Score(task - kFirstScore);
+  }
+}
+
+void StepRegion::Observe(StepObserver::Part part, int m, int slot) {
+  // A failed truth, filter or score ends the step with its error (Rethrow): nothing to prepare.
+  // The filtered part reads only the filter's outcome: the mode's score may be running.
+  if (!truth_ok_) return;
+  if (part == StepObserver::Part::kFiltered &&
+      filtered_[m].load(std::memory_order_acquire) != kFilterOk)
+    return;
+  if (part == StepObserver::Part::kScored && errors_[m]) return;
+  const std::size_t per_observer = static_cast<std::size_t>(1 + 2 * modes_);
+  for (std::size_t o = 0; o < cs_.observers_.size(); ++o) {
+    std::exception_ptr& error = observer_errors_[o * per_observer + static_cast<std::size_t>(slot)];
+    Guarded(error, [&] { cs_.observers_[o]->Prepare(view_, part, m); });
+  }
+}
+
+std::vector<std::exception_ptr> StepRegion::ObserverErrors() const {
+  const std::size_t per_observer = static_cast<std::size_t>(1 + 2 * modes_);
+  std::vector<std::exception_ptr> first(cs_.observers_.size());
+  for (std::size_t o = 0; o < first.size(); ++o)
+    for (std::size_t k = 0; k < per_observer && !first[o]; ++k)
+      first[o] = observer_errors_[o * per_observer + k];
+  return first;
 }
 
 // All filters share one grid geometry (centred on the same ego), so the ground truth per cell

@@ -4,14 +4,19 @@
 // whichever thread is free first takes (Work, a TaskBoard), in this order of priority: the ground
 // truth (from any filter finished: they share one geometry), the next step read ahead (SUMO's
 // step and the radar scan, or a recorded source's twin), the next step's measurement grid (for
-// SUMO only while a filter still runs), each mode's scoring, the next cycle's prediction noise. A
-// task starts once its inputs are complete (a score after its filter and the truth, the
-// read-ahead after the truth, which reads the source's ids, the grid after the read-ahead), so no
-// value depends on the thread that computes it. Exceptions never leave a thread: kept per task
-// and rethrown by Rethrow after the region.
+// SUMO only while another thread is busy), each mode's scoring, the observers' Prepare parts
+// (StepObserver: the step's, then per mode the filtered and the scored part), the next cycle's
+// prediction noise. A task starts once its inputs are complete (a score after its filter and the
+// truth; the read-ahead after the truth, which reads the source's ids; the grid after the
+// read-ahead; the observers' step part after the truth and the read-ahead, so that the ids and
+// SUMO stand as OnStep sees them; a mode's filtered part after its filter and the step part, its
+// scored part after its score and its filtered part), so no value depends on the thread that
+// computes it. Exceptions never leave a thread: kept per task and rethrown by Rethrow after the
+// region (the observers' by CoSimulation::Step, where their OnStep would run).
 #include <atomic>
 #include <exception>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "dualgrid/core/types.hpp"
@@ -24,32 +29,61 @@ class StepRegion {
  public:
   /// Before the region, on the calling thread. `read_ahead`: this step reads the next one ahead
   /// (CoSimOptions::read_ahead, and a thread has time to spare).
-  StepRegion(CoSimulation& cs, bool with_velocities, bool read_ahead);
+  StepRegion(CoSimulation& cs, const StepView& view, bool read_ahead);
   /// Mode m's filter cycle, snapshot and classes; once per mode per step, on any one thread.
   void Filter(int m);
   /// Takes tasks until none is left to take (TaskBoard::Work); every thread of the region, after
-  /// its filters.
-  void Work();
+  /// its filters `own` (the observers' parts of these modes first: they read the filter's
+  /// particles and cells, still in this core's cache).
+  void Work(std::span<const int> own);
   /// After the region: the first error of the truth, the noise or a mode (in mode order).
   void Rethrow() const;
+  /// After the region: per observer, the first error of its Prepare parts (step part first,
+  /// then by mode, filtered before scored), null if none.
+  std::vector<std::exception_ptr> ObserverErrors() const;
+
+  /// Runs `work`, keeping what it throws in `slot` (which it overwrites).
+  template <typename Work>
+  static void Guarded(std::exception_ptr& slot, Work&& work) {
+    try {
+      work();
+    } catch (...) {
+      slot = std::current_exception();
+    }
+  }
 
  private:
-  // Task indices, in order of priority: then mode m's score at kFirstScore + m, the noise last.
+  // Task indices, in order of priority: mode m's score at kFirstScore + m, then the observers'
+  // step part, their filtered parts by mode, their scored parts by mode, and the noise last.
   enum Task { kTruth, kReadAhead, kPrepareAhead, kFirstScore };
-  int NoiseTask() const { return kFirstScore + modes_; }
+  int ObserveStepTask() const { return kFirstScore + modes_; }
+  int FilteredTask(int m) const { return ObserveStepTask() + 1 + m; }
+  int ScoredTask(int m) const { return ObserveStepTask() + 1 + modes_ + m; }
+  int NoiseTask() const { return ObserveStepTask() + 1 + 2 * modes_; }
   bool Ready(int task) const;
   void Run(int task);
   void Truth();
   void Score(int m);
+  // The observers' part `part` (of mode m, -1 for the step's) into errors slot `slot`.
+  void Observe(StepObserver::Part part, int m, int slot);
+  // Whether another thread has work besides the caller's task: a filter still runs, or another
+  // task is not done.
+  bool OthersBusy() const;
 
   CoSimulation& cs_;
+  const StepView& view_;
   const int modes_;
   const bool with_velocities_, read_ahead_;
   OrientedBox ego_box_;
   bool score_points_;
   std::vector<std::exception_ptr> errors_;  // per mode: its filter's or its scoring's
   std::exception_ptr truth_error_, noise_error_;
-  std::unique_ptr<std::atomic<int>[]> filtered_;  // per mode: 1 once its filter ran (or failed)
+  // The observers' parts' errors: observer o, part slot k at o * (1 + 2 * modes) + k, k = 0 the
+  // step part, 1 + 2m mode m's filtered, 2 + 2m its scored part.
+  std::vector<std::exception_ptr> observer_errors_;
+  // Per mode: 0 while its filter runs, then kFilterOk or kFilterFailed.
+  static constexpr int kFilterOk = 1, kFilterFailed = 2;
+  std::unique_ptr<std::atomic<int>[]> filtered_;
   std::atomic<int> filters_done_{0}, filters_ok_{0};
   bool truth_ok_ = false;  // written by the truth task, read by scores after it
   TaskBoard board_;

@@ -13,6 +13,7 @@ TaskBoard::TaskBoard(int tasks) : tasks_(tasks) {
 
 void TaskBoard::Finish(int i) {
   slots_[i].done.store(1, std::memory_order_release);
+  done_count_.fetch_add(1, std::memory_order_acq_rel);
   Wake();
 }
 

@@ -100,18 +100,14 @@ Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string
   return h;
 }
 
-Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
-              const std::vector<cosim::ModeScorer>& scorers,
-              const std::vector<LiveCounter>& counters, const std::vector<Live>& live,
-              const std::vector<eval::TruthObject>& objects, const Header& header) {
+Frame CaptureStep(const cosim::Pipeline& pipeline, const std::vector<eval::TruthObject>& objects,
+                  std::size_t modes) {
   const GridFrame& g = pipeline.grid_frame();
   const sim::Frame& sf = pipeline.frame();
   Frame f;
   f.time = sf.time;
   f.yaw_deg = RadToDeg(g.yaw());
   f.ego = ToBox(-1, g.ToGrid(sf.ego.box), g.VectorToGrid(sf.ego.velocity));
-  f.origin_x = snapshots[0].origin.x();
-  f.origin_y = snapshots[0].origin.y();
   for (const eval::TruthObject& o : objects) f.truth.push_back(ToBox(o.id, o.box, o.velocity));
   for (const radar::Detection& d : pipeline.detections()) {
     const Position p = g.ToGrid(d.position_world);
@@ -119,55 +115,70 @@ Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnap
     f.detections.push_back(
         {d.sensor, p.x(), p.y(), v.x(), v.y(), d.is_clutter, static_cast<int>(d.path)});
   }
-  f.modes.resize(snapshots.size());
-  for (std::size_t m = 0; m < snapshots.size(); ++m) {
-    const cosim::GridSnapshot& s = snapshots[m];
-    ModeFrame& mf = f.modes[m];
-    const std::size_t n = s.free.size();
-    assert(s.mean_vx.size() == n);
-    mf.free.resize(n);
-    mf.static_occ.resize(n);
-    mf.dynamic.resize(n);
-    mf.vx_cm.resize(n);
-    mf.vy_cm.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      mf.free[k] = Quantise(s.free[k]);
-      mf.static_occ[k] = Quantise(s.static_occ[k]);
-      mf.dynamic[k] = Quantise(s.dynamic[k]);
-      const bool moving = mf.dynamic[k] >= kVelocityMinDynamic;
-      mf.vx_cm[k] = moving ? Centimetres(s.mean_vx[k]) : 0;
-      mf.vy_cm[k] = moving ? Centimetres(s.mean_vy[k]) : 0;
-    }
-    // An even subsample of the persistent particles (their order is the filter's, which is
-    // deterministic), as offsets from the grid's corner.
-    const filter::ParticleSet& ps = pipeline.grid(m).particles();
-    const std::size_t total = ps.size();
-    const std::size_t want =
-        std::min<std::size_t>(total, static_cast<std::size_t>(header.max_particles));
-    const double extent_x = header.cells_x * header.resolution;
-    const double extent_y = header.cells_y * header.resolution;
-    mf.particles.reserve(2 * want);
-    for (std::size_t j = 0; j < want; ++j) {
-      const std::size_t i = j * total / want;
-      const double dx = ps.x[i] - f.origin_x, dy = ps.y[i] - f.origin_y;
-      if (!(dx >= 0.0 && dy >= 0.0 && dx < extent_x && dy < extent_y)) continue;
-      mf.particles.push_back(static_cast<std::uint16_t>(dx / header.particle_unit));
-      mf.particles.push_back(static_cast<std::uint16_t>(dy / header.particle_unit));
-    }
-    const cosim::ModeScorer& sc = scorers[m];
-    const auto& a = sc.association();
-    for (std::size_t c = 0; c < sc.clusters().size(); ++c) {
-      const eval::Cluster& cl = sc.clusters()[c];
-      const int o = a.object_of_cluster[c];
-      mf.clusters.push_back({cl.position.x(), cl.position.y(), cl.velocity.x(), cl.velocity.y(),
-                             cl.min.x(), cl.min.y(), cl.max.x(), cl.max.y(),
-                             static_cast<int>(a.role[c]),
-                             o >= 0 ? objects[static_cast<std::size_t>(o)].id : -1,
-                             counters[m].VelocityOk(sc, objects, c)});
-    }
-    mf.live = live[m];
-  }
+  f.modes.resize(modes);
   return f;
+}
+
+namespace {
+
+// Mode m's cells: masses quantised, mean velocities where the cell is dynamic enough.
+void CaptureCells(const cosim::GridSnapshot& s, ModeFrame& mf) {
+  const std::size_t n = s.free.size();
+  assert(s.mean_vx.size() == n);
+  mf.free.resize(n);
+  mf.static_occ.resize(n);
+  mf.dynamic.resize(n);
+  mf.vx_cm.resize(n);
+  mf.vy_cm.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    mf.free[k] = Quantise(s.free[k]);
+    mf.static_occ[k] = Quantise(s.static_occ[k]);
+    mf.dynamic[k] = Quantise(s.dynamic[k]);
+    const bool moving = mf.dynamic[k] >= kVelocityMinDynamic;
+    mf.vx_cm[k] = moving ? Centimetres(s.mean_vx[k]) : 0;
+    mf.vy_cm[k] = moving ? Centimetres(s.mean_vy[k]) : 0;
+  }
+}
+
+}  // namespace
+
+void CaptureMode(const cosim::Pipeline& pipeline, std::size_t m,
+                 const cosim::GridSnapshot& snapshot, const cosim::ModeScorer& scorer,
+                 const LiveCounter& counter, const Live& live,
+                 const std::vector<eval::TruthObject>& objects, const Header& header, Frame* f) {
+  // Every mode's grid lies on the same cells (one ego, one origin), so each mode's own origin is
+  // the frame's; mode 0 writes it.
+  const double origin_x = snapshot.origin.x(), origin_y = snapshot.origin.y();
+  if (m == 0) f->origin_x = origin_x, f->origin_y = origin_y;
+  ModeFrame& mf = f->modes[m];
+  CaptureCells(snapshot, mf);
+  // An even subsample of the persistent particles (their order is the filter's, which is
+  // deterministic), as offsets from the grid's corner.
+  const filter::ParticleSet& ps = pipeline.grid(m).particles();
+  const std::size_t total = ps.size();
+  const std::size_t want =
+      std::min<std::size_t>(total, static_cast<std::size_t>(header.max_particles));
+  const double extent_x = header.cells_x * header.resolution;
+  const double extent_y = header.cells_y * header.resolution;
+  mf.particles.reserve(2 * want);
+  for (std::size_t j = 0; j < want; ++j) {
+    const std::size_t i = j * total / want;
+    const double dx = ps.x[i] - origin_x, dy = ps.y[i] - origin_y;
+    if (!(dx >= 0.0 && dy >= 0.0 && dx < extent_x && dy < extent_y)) continue;
+    mf.particles.push_back(static_cast<std::uint16_t>(dx / header.particle_unit));
+    mf.particles.push_back(static_cast<std::uint16_t>(dy / header.particle_unit));
+  }
+  const auto& a = scorer.association();
+  for (std::size_t c = 0; c < scorer.clusters().size(); ++c) {
+    const eval::Cluster& cl = scorer.clusters()[c];
+    const int o = a.object_of_cluster[c];
+    mf.clusters.push_back({cl.position.x(), cl.position.y(), cl.velocity.x(), cl.velocity.y(),
+                           cl.min.x(), cl.min.y(), cl.max.x(), cl.max.y(),
+                           static_cast<int>(a.role[c]),
+                           o >= 0 ? objects[static_cast<std::size_t>(o)].id : -1,
+                           counter.VelocityOk(scorer, objects, c)});
+  }
+  mf.live = live;
 }
 
 }  // namespace dualgrid::outputs::replay

@@ -196,13 +196,13 @@ ClusterWriter::ClusterWriter(const std::filesystem::path& path) : out_(path) {
   out_.buffer() += "step,time,mode,x,y,vx,vy,weight,particles,role,object,x_ego,y_ego\n";
 }
 
-void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::string& mode,
-                          const cosim::ModeScorer& scorer,
-                          const std::vector<eval::TruthObject>& objects,
-                          const cosim::IdRegistry& ids) {
+void ClusterWriter::Rows(std::string& out, const sim::Frame& f, const GridFrame& g,
+                         const std::string& mode, const cosim::ModeScorer& scorer,
+                         const std::vector<eval::TruthObject>& objects,
+                         const cosim::IdRegistry& ids) {
   static const char* kRole[] = {"matched", "duplicate", "false"};
   const auto& a = scorer.association();
-  CsvRow row(out_.buffer());
+  CsvRow row(out);
   for (std::size_t c = 0; c < scorer.clusters().size(); ++c) {
     const eval::Cluster& cl = scorer.clusters()[c];
     const Position pos = g.ToWorld(cl.position);
@@ -214,6 +214,10 @@ void ClusterWriter::Write(const sim::Frame& f, const GridFrame& g, const std::st
     row.Text(a.object_of_cluster[c] >= 0 ? ids.Name(objects[a.object_of_cluster[c]].id) : "");
     row.Fixed(local.x(), 2).Fixed(local.y(), 2).End();
   }
+}
+
+void ClusterWriter::Append(const std::string& rows) {
+  out_.buffer() += rows;
   out_.MaybeFlush();
 }
 

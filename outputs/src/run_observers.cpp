@@ -34,15 +34,30 @@ RunFilesObserver::RunFilesObserver(const std::filesystem::path& out,
   if (detections && exact) scans_ = std::make_unique<ScanWriter>(out / "scans.csv");
 }
 
+void RunFilesObserver::Prepare(const cosim::StepView& v, Part part, int mode) {
+  const auto m = static_cast<std::size_t>(mode);
+  switch (part) {
+    case Part::kStep:
+      truth_.Write(v.frame);
+      if (detections_) detections_->Write(v.pipeline);
+      if (scans_) scans_->Write(v.pipeline);
+      cluster_rows_.resize(v.scorers.size());
+      return;
+    case Part::kFiltered:
+      if (m == trace_mode_) traces_.Add(v.pipeline, trace_mode_);
+      return;
+    case Part::kScored:
+      cluster_rows_[m].clear();
+      ClusterWriter::Rows(cluster_rows_[m], v.frame, v.pipeline.grid_frame(), v.mode_names[m],
+                          v.scorers[m], v.objects, v.pipeline.ids());
+      return;
+  }
+}
+
 void RunFilesObserver::OnStep(const cosim::StepView& v) {
-  truth_.Write(v.frame);
+  // The grid's footprint reads the first filter: here, once every filter ran.
   grid_.Write(v.pipeline);
-  if (detections_) detections_->Write(v.pipeline);
-  if (scans_) scans_->Write(v.pipeline);
-  for (std::size_t m = 0; m < v.scorers.size(); ++m)
-    clusters_.Write(v.frame, v.pipeline.grid_frame(), v.mode_names[m], v.scorers[m], v.objects,
-                    v.pipeline.ids());
-  if (!v.scorers.empty()) traces_.Add(v.pipeline, trace_mode_);
+  for (std::size_t m = 0; m < v.scorers.size(); ++m) clusters_.Append(cluster_rows_[m]);
 }
 
 void RunFilesObserver::Close() {
@@ -83,26 +98,50 @@ bool RecordingObserver::Due(int step) const {
 
 bool RecordingObserver::WantsVelocities(int step, double) { return Due(step); }
 
-void RecordingObserver::OnStep(const cosim::StepView& v) {
-  if (counters_.empty())
-    counters_.assign(v.scorers.size(),
-                     replay::LiveCounter(v.pipeline.config().evaluation.tracking));
-  live_.resize(v.scorers.size());
+void RecordingObserver::Prepare(const cosim::StepView& v, Part part, int mode) {
+  if (part == Part::kStep) {
+    if (counters_.empty())
+      counters_.assign(v.scorers.size(),
+                       replay::LiveCounter(v.pipeline.config().evaluation.tracking));
+    live_.resize(v.scorers.size());
+    if (!Due(v.step)) return;
+    capture_errors_.assign(1 + v.scorers.size(), nullptr);
+    try {
+      if (!header_made_) {
+        header_ = replay::MakeHeader(v.pipeline, v.mode_names,
+                                     every_ * v.pipeline.config().sim.step_length, max_particles_);
+        header_.truth_label = truth_label_;
+        header_made_ = true;
+      }
+      frame_ = replay::CaptureStep(v.pipeline, v.objects, v.scorers.size());
+    } catch (...) {
+      capture_errors_[0] = std::current_exception();
+    }
+    return;
+  }
+  if (part != Part::kScored) return;
+  const auto m = static_cast<std::size_t>(mode);
   // The live totals count every step, recorded or not.
-  for (std::size_t m = 0; m < v.scorers.size(); ++m)
-    live_[m] = counters_[m].Count(v.scorers[m], v.objects);
+  live_[m] = counters_[m].Count(v.scorers[m], v.objects);
+  if (!Due(v.step) || capture_errors_[0]) return;
+  try {
+    replay::CaptureMode(v.pipeline, m, v.snapshots[m], v.scorers[m], counters_[m], live_[m],
+                        v.objects, header_, &frame_);
+  } catch (...) {
+    capture_errors_[1 + m] = std::current_exception();
+  }
+}
+
+void RecordingObserver::OnStep(const cosim::StepView& v) {
   if (!Due(v.step)) return;
   // The replay must never cost the run: a failed write (a full disk) stops the recording with a
-  // warning; replay/ is then left without index.json, so it reads as unusable.
+  // warning; replay/ is then left without index.json, so it reads as unusable. A frame that
+  // could not be taken (Prepare) stops it the same way.
   try {
-    if (!writer_) {
-      header_ = replay::MakeHeader(v.pipeline, v.mode_names,
-                                   every_ * v.pipeline.config().sim.step_length, max_particles_);
-      header_.truth_label = truth_label_;
-      writer_ = std::make_unique<replay::Writer>(out_ / "replay", header_, worker_);
-    }
-    writer_->Add(
-        replay::Capture(v.pipeline, v.snapshots, v.scorers, counters_, live_, v.objects, header_));
+    for (const std::exception_ptr& e : capture_errors_)
+      if (e) std::rethrow_exception(e);
+    if (!writer_) writer_ = std::make_unique<replay::Writer>(out_ / "replay", header_, worker_);
+    writer_->Add(std::move(frame_));
     for (const auto& o : v.objects) ids_.insert(o.id);
   } catch (const std::exception& e) {
     PublishWarning(std::string("replay recording stopped: ") + e.what(), warnings_);

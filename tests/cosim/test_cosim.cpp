@@ -4,9 +4,12 @@
 #include <omp.h>
 #include <catch2/catch.hpp>
 
+#include <array>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <string>
 #include <typeinfo>
 
@@ -120,6 +123,118 @@ TEST_CASE("CoSimulation: observers, velocities on demand, determinism over threa
   CHECK(m1[2].objects_scored > 0);
   CHECK(m1[2].matches > 0);
   CHECK(m1[2].cells.has_value());
+}
+
+// Checks, in each Prepare part, that the part's inputs are complete (docs: StepObserver): the
+// truth and the read-ahead before the step part, mode m's filter cycle before its filtered part,
+// its scoring before its scored part, every part once and before OnStep. With 3 modes on 2
+// threads the parts run while other filters still run, on either thread: a part started before
+// its filter ended would see the filter's step count of the previous cycle.
+struct PartChecker : cosim::StepObserver {
+  explicit PartChecker(int modes, std::size_t cells, int steps)
+      : modes(modes), cells(cells), last_step(steps - 1), seen(modes) {
+    for (auto& mode : seen)
+      for (auto& part : mode) part.store(-1);
+  }
+  int modes;
+  std::size_t cells;
+  int last_step;
+  bool read_ahead = true;
+  std::atomic<int> step_part{-1};
+  std::vector<std::array<std::atomic<int>, 2>> seen;  // per mode: filtered, scored (last step)
+  std::atomic<int> bad{0}, parts{0};
+  std::mutex mutex;
+  std::vector<std::string> failures;
+  void Fail(const std::string& what, int step, int mode) {
+    bad.fetch_add(1);
+    const std::lock_guard<std::mutex> lock(mutex);
+    failures.push_back(what + " at step " + std::to_string(step) + ", mode " +
+                       std::to_string(mode));
+  }
+  bool WantsVelocities(int step, double) override { return step % 3 == 0; }
+  void Prepare(const cosim::StepView& v, Part part, int mode) override {
+    parts.fetch_add(1);
+    if (part == Part::kStep) {
+      if (v.truth_classes.size() != cells) Fail("the truth was not complete", v.step, mode);
+      // The next step was read ahead (in the region of the step before the last).
+      if (read_ahead && v.step < last_step && v.pipeline.ahead_read() != std::uint64_t(v.step) + 1)
+        Fail("the next step was not read ahead yet", v.step, mode);
+      if (step_part.exchange(v.step) != v.step - 1) Fail("the step part twice", v.step, mode);
+      return;
+    }
+    if (step_part.load() != v.step) Fail("a mode's part before the step part", v.step, mode);
+    const auto k = static_cast<std::size_t>(mode);
+    // The filter has finished this step's cycle (its step count counts the cycles).
+    if (v.pipeline.grid(k).step() != std::uint64_t(v.step) + 1)
+      Fail("a part before its filter's cycle ended", v.step, mode);
+    if (part == Part::kFiltered) {
+      if (seen[k][0].exchange(v.step) != v.step - 1) Fail("filtered part twice", v.step, mode);
+      return;
+    }
+    if (seen[k][0].load() != v.step) Fail("scored part before the filtered part", v.step, mode);
+    if (seen[k][1].exchange(v.step) != v.step - 1) Fail("scored part twice", v.step, mode);
+    // The scoring ran: with velocities asked, they are in the snapshot (taken by the score).
+    const auto& s = v.snapshots[k];
+    if (v.with_velocities && s.mean_vx.size() != s.free.size())
+      Fail("a scored part before its mode's velocities", v.step, mode);
+  }
+  void OnStep(const cosim::StepView& v) override {
+    if (step_part.load() != v.step) Fail("OnStep before the step part", v.step, -1);
+    for (int k = 0; k < modes; ++k)
+      if (seen[k][1].load() != v.step) Fail("OnStep before a scored part", v.step, k);
+  }
+};
+
+TEST_CASE("CoSimulation: observers' Prepare parts run after their inputs, before OnStep",
+          "[cosim][sumo]") {
+  for (int threads : {1, 2}) {
+    INFO(threads << " threads");
+    auto config = Highway(3.0);
+    cosim::CoSimulation cs(config, {.threads = threads});
+    cs.Start(sim::DefaultNetworkDir(), WorkDir("parts" + std::to_string(threads)));
+    PartChecker c(3, static_cast<std::size_t>(config.filter.CellsX() * config.filter.CellsY()),
+                  config.sim.StepCount());
+    c.read_ahead = threads == 2;  // 3 modes on 1 thread: nothing to spare, nothing read ahead
+    Recorder r;
+    cs.AddObserver(&c);
+    cs.AddObserver(&r);
+    while (cs.Step()) {
+    }
+    REQUIRE(cs.steps() == config.sim.StepCount());
+    for (const auto& f : c.failures) UNSCOPED_INFO(f);
+    CHECK(c.bad.load() == 0);
+    CHECK(c.parts.load() == cs.steps() * (1 + 2 * 3));
+    CHECK(r.steps.size() == static_cast<std::size_t>(cs.steps()));
+  }
+}
+
+struct PrepareThrower : cosim::StepObserver {
+  int at = 0;
+  int on_steps = 0;
+  void Prepare(const cosim::StepView& v, Part part, int mode) override {
+    if (v.step == at && part == Part::kScored && mode == 1)
+      throw std::runtime_error("prepare failed");
+  }
+  void OnStep(const cosim::StepView&) override { ++on_steps; }
+};
+
+TEST_CASE("CoSimulation: an exception of a Prepare part leaves Step() where its OnStep would run",
+          "[cosim][sumo]") {
+  cosim::CoSimulation cs(Highway(1.0), {.threads = 2});
+  cs.Start(sim::DefaultNetworkDir(), WorkDir("prepare_throw"));
+  Recorder before, after;
+  PrepareThrower t;
+  t.at = 1;
+  cs.AddObserver(&before);
+  cs.AddObserver(&t);
+  cs.AddObserver(&after);
+  CHECK(cs.Step());
+  CHECK_THROWS_WITH(cs.Step(), "prepare failed");
+  CHECK(before.steps == std::vector<int>{0, 1});  // the observers before it ran
+  CHECK(t.on_steps == 1);                         // its own OnStep did not
+  CHECK(after.steps == std::vector<int>{0});      // nor those after it
+  CHECK(cs.Step());
+  CHECK(after.steps == std::vector<int>{0, 2});
 }
 
 TEST_CASE("CoSimulation: errors before SUMO starts, and an observer's error", "[cosim][sumo]") {
@@ -249,7 +364,7 @@ void CheckSameEnding(const Ending& off, const Ending& on) {
   for (std::size_t m = 0; m < on.metrics.size(); ++m) CHECK(on.metrics[m] == off.metrics[m]);
   CHECK(off.read == 0u);
   CHECK(off.hits == 0u);
-  // The grid read ahead is built only while a filter still runs (timing): taken or not.
+  // The grid read ahead is built only while another thread has work (timing): taken or not.
   CHECK(on.hits <= on.read);
 }
 

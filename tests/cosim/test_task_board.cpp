@@ -40,6 +40,25 @@ TEST_CASE("TaskBoard: one thread takes the ready tasks in index order", "[cosim]
   CHECK(order.size() == 6u);
 }
 
+TEST_CASE("TaskBoard: a thread's preferred tasks first, when ready, in the order given",
+          "[cosim]") {
+  TaskBoard board(6);
+  std::vector<int> order;
+  std::vector<int> unfinished;
+  // Task 4 waits for task 2: preferred 4 then 3, the thread runs 3 (4 not ready), then 0, 1, 2 in
+  // index order, then 4 (preferred, ready now), then 5.
+  const std::vector<int> preferred{4, 3};
+  board.Work([&](int i) { return i != 4 || board.done(2); },
+             [&](int i) {
+               order.push_back(i);
+               unfinished.push_back(board.unfinished());
+             },
+             preferred);
+  CHECK(order == std::vector<int>{3, 0, 1, 2, 4, 5});
+  CHECK(unfinished == std::vector<int>{6, 5, 4, 3, 2, 1});  // each task itself counted
+  CHECK(board.unfinished() == 0);
+}
+
 TEST_CASE("TaskBoard: every task runs once, after the tasks it waits for", "[cosim]") {
   std::mt19937 rng(37);
   for (int round = 0; round < 40; ++round) {

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -34,8 +35,9 @@ struct CoSimOptions {
   /// Performance switch: when a thread runs fewer filters than the others (3 modes on 2
   /// threads), the step's region also reads the next step (SUMO's step and the radar scan; for
   /// recorded data a twin of the source) and builds that step's measurement grid, on whichever
-  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while a
-  /// filter still runs, else Advance builds it with every thread). Results do not depend on it:
+  /// thread is free (Pipeline::ReadAhead, PrepareAhead; StepRegion; for SUMO the grid only while
+  /// another thread has work left in the region, else Advance builds it with every thread).
+  /// Results do not depend on it:
   /// the grid is taken only for the same inputs, and an error or the end met reading ahead
   /// surfaces at the next Step(), where it would have without it. SUMO then stands one step ahead
   /// between steps: a run stopped early has simulated that step too (sumo(), SUMO's own
@@ -64,13 +66,35 @@ struct StepView {
 
 /// A hook run after every step, on the calling thread, in the order added. Exceptions thrown by
 /// OnStep propagate out of CoSimulation::Step() (the step itself is complete by then).
+///
+/// Work of a step that needs only part of it may be done earlier, in Prepare, inside the step's
+/// parallel region on whichever thread is free (StepRegion), while other modes' filters still
+/// run. Per step, every observer gets Prepare(view, kStep, -1), then for every mode m
+/// Prepare(view, kFiltered, m) and after it Prepare(view, kScored, m), all before its OnStep. The
+/// parts' inputs are complete when they run, and nothing that runs with them writes them:
+/// - kStep: the step's data (frame, detections, labels, the pipeline's current step and grid
+///   frame) and the ground truth (objects, truth_classes). The next step has been read ahead
+///   by then (CoSimOptions::read_ahead), so pipeline.ids() and sumo() read as in OnStep.
+/// - kFiltered, mode m: also grid(m) after its cycle and snapshots[m]'s masses and classes.
+/// - kScored, mode m: also scorers[m] and snapshots[m]'s mean velocities (when asked).
+/// Other modes' grids, snapshots and scorers may be in the making during a part: it must not
+/// read them. Parts of one step may run at the same time on different threads (other modes',
+/// other observers'), so each writes only state of its own for that part (e.g. one slot per
+/// mode); OnStep then reads it on the calling thread. What a part computes must not depend on
+/// the thread or the time it runs (the run's files are the same bytes on 1, 2 or 4 threads). An
+/// exception thrown by a part is thrown by Step() where this observer's OnStep would have run
+/// (after the earlier observers' OnStep; this observer's OnStep does not run then). When a
+/// filter or the ground truth failed, Step() throws that error and some parts may not run.
 class StepObserver {
  public:
+  enum class Part { kStep, kFiltered, kScored };
   virtual ~StepObserver() = default;
   /// Asked after SUMO and the radar advanced, before the filters run: whether OnStep of this
   /// step needs the cells' mean velocities in the snapshots (a pass over every particle, so only
   /// when drawn or recorded).
   virtual bool WantsVelocities(int /*step*/, double /*time*/) { return false; }
+  /// Early work of this step (see the class comment); the default does none.
+  virtual void Prepare(const StepView& /*view*/, Part /*part*/, int /*mode*/) {}
   virtual void OnStep(const StepView& view) = 0;
 };
 
@@ -92,8 +116,9 @@ class CoSimulation {
   /// One step: SUMO, radar and the measurement grid (unless read ahead in the last step's
   /// region), then one parallel region: every mode's filter cycle (each on the thread
   /// ModeSchedule names), the shared ground truth, every mode's scoring and, with read_ahead, the
-  /// next step's SUMO step and radar scan and (while a filter still runs) its measurement grid,
-  /// each taken by whichever thread is free (StepRegion); then the observers. False at the end
+  /// next step's SUMO step and radar scan and (while another thread is busy) its measurement
+  /// grid, and the observers' Prepare parts, each taken by whichever thread is free
+  /// (StepRegion); then the observers' OnStep. False at the end
   /// of the run (nothing done then). An exception of SUMO or the radar is thrown by the Step() of
   /// the step it belongs to, after the observers of every earlier step ran.
   bool Step();
@@ -119,7 +144,9 @@ class CoSimulation {
 
  private:
   friend class StepRegion;  // one step's parallel region (step_region.hpp)
-  void FilterAndScore(bool with_velocities);
+  // The step's filters, scoring and the observers' Prepare parts; returns per observer the first
+  // exception of its parts (null if none).
+  std::vector<std::exception_ptr> FilterAndScore(const StepView& view);
   // The schedule of this step for `team` threads: round robin at first, then re-planned from the
   // filters' measured times (cosimulation.cpp, before ScheduleFor's definition).
   const ModeSchedule& ScheduleFor(int modes, int team);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 
 namespace dualgrid::cosim {
 
@@ -25,11 +26,16 @@ class TaskBoard {
   /// (outside work calls Wake() when it is; the tasks' dependencies must have no cycle), and
   /// stay true. run(i) must not throw. Returns once nothing
   /// is left to claim (tasks other threads claimed may still be running: see WaitUntil).
+  /// `preferred`: tasks this thread claims before the others when they are ready (e.g. those
+  /// that read what this thread wrote last, still in its core's cache), in the order given.
   template <typename Ready, typename Run>
-  void Work(Ready&& ready, Run&& run) {
+  void Work(Ready&& ready, Run&& run, std::span<const int> preferred = {}) {
     for (;;) {
       const std::uint32_t seen = progress_.load(std::memory_order_acquire);
-      const std::optional<int> task = Claim(ready);
+      std::optional<int> task;
+      for (int i : preferred)
+        if ((task = TryClaim(i, ready))) break;
+      if (!task) task = Claim(ready);
       if (task) {
         run(*task);
         Finish(*task);
@@ -56,27 +62,32 @@ class TaskBoard {
   /// threads look again.
   void Wake();
   int size() const { return tasks_; }
+  /// Tasks not yet done, claimed or not (a snapshot: other threads may change it at once).
+  int unfinished() const { return tasks_ - done_count_.load(std::memory_order_acquire); }
 
  private:
   struct Slot {
     std::atomic<int> claimed{0}, done{0};
   };
   template <typename Ready>
+  std::optional<int> TryClaim(int i, Ready& ready) {
+    Slot& s = slots_[i];
+    if (s.claimed.load(std::memory_order_relaxed) != 0 || !ready(i)) return std::nullopt;
+    if (s.claimed.exchange(1, std::memory_order_acq_rel) != 0) return std::nullopt;  // another
+    claimed_count_.fetch_add(1, std::memory_order_acq_rel);
+    return i;
+  }
+  template <typename Ready>
   std::optional<int> Claim(Ready& ready) {
-    for (int i = 0; i < tasks_; ++i) {
-      Slot& s = slots_[i];
-      if (s.claimed.load(std::memory_order_relaxed) != 0 || !ready(i)) continue;
-      if (s.claimed.exchange(1, std::memory_order_acq_rel) != 0) continue;  // another was first
-      claimed_count_.fetch_add(1, std::memory_order_acq_rel);
-      return i;
-    }
+    for (int i = 0; i < tasks_; ++i)
+      if (const std::optional<int> task = TryClaim(i, ready)) return task;
     return std::nullopt;
   }
   void Finish(int i);
 
   int tasks_;
   std::unique_ptr<Slot[]> slots_;
-  std::atomic<int> claimed_count_{0};
+  std::atomic<int> claimed_count_{0}, done_count_{0};
   std::atomic<std::uint32_t> progress_{0};  // bumped by Finish and Wake
 };
 

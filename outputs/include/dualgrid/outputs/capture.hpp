@@ -29,11 +29,17 @@ class LiveCounter {
 Header MakeHeader(const cosim::Pipeline& pipeline, const std::vector<std::string>& modes,
                   double interval, int max_particles);
 
-/// One frame from the pipeline's current step. `snapshots` must hold velocities
-/// (TakeSnapshot(..., true, ...)); `live` per mode from LiveCounter::Count for this step.
-Frame Capture(const cosim::Pipeline& pipeline, const std::vector<cosim::GridSnapshot>& snapshots,
-              const std::vector<cosim::ModeScorer>& scorers,
-              const std::vector<LiveCounter>& counters, const std::vector<Live>& live,
-              const std::vector<eval::TruthObject>& objects, const Header& header);
+/// The step's part of a frame of the pipeline's current step (time, frame, ego, `objects` as
+/// scored, detections) with `modes` empty mode frames for CaptureMode.
+Frame CaptureStep(const cosim::Pipeline& pipeline, const std::vector<eval::TruthObject>& objects,
+                  std::size_t modes);
+/// Mode m's part of `f` (made by CaptureStep): f->modes[m] from mode m's grid, `snapshot` (with
+/// velocities), `scorer`, `counter` and this step's `live` counts; mode 0 also sets f's origin
+/// (every mode's grid lies on the same cells). Reads nothing of other modes and writes only
+/// f->modes[m] (and the origin for m = 0), so different modes may be captured concurrently.
+void CaptureMode(const cosim::Pipeline& pipeline, std::size_t m,
+                 const cosim::GridSnapshot& snapshot, const cosim::ModeScorer& scorer,
+                 const LiveCounter& counter, const Live& live,
+                 const std::vector<eval::TruthObject>& objects, const Header& header, Frame* f);
 
 }  // namespace dualgrid::outputs::replay

@@ -92,11 +92,15 @@ void WriteObstacles(const sim::ScenarioSpec& spec, const std::filesystem::path& 
 class ClusterWriter {
  public:
   explicit ClusterWriter(const std::filesystem::path& path);
-  /// The clusters of `scorer`'s last frame, for mode `mode`; `objects` as given to the scorer.
-  /// Clusters are scored in the grid frame and written in the world frame.
-  void Write(const sim::Frame& frame, const GridFrame& grid_frame, const std::string& mode,
-             const cosim::ModeScorer& scorer, const std::vector<eval::TruthObject>& objects,
-             const cosim::IdRegistry& ids);
+  /// The rows of the clusters of `scorer`'s last frame, for mode `mode`, appended to `out` (the
+  /// caller's buffer: the modes' rows may be made concurrently, then appended in mode order by
+  /// Append); `objects` as given to the scorer. Clusters are scored in the grid frame and written
+  /// in the world frame.
+  static void Rows(std::string& out, const sim::Frame& frame, const GridFrame& grid_frame,
+                   const std::string& mode, const cosim::ModeScorer& scorer,
+                   const std::vector<eval::TruthObject>& objects, const cosim::IdRegistry& ids);
+  /// Appends rows made by Rows to the file.
+  void Append(const std::string& rows);
   void Close() { out_.Close(); }
 
  private:

@@ -34,6 +34,11 @@ class RunFilesObserver : public cosim::StepObserver {
   RunFilesObserver(const std::filesystem::path& out,
                    const std::optional<std::filesystem::path>& detections, bool multipath,
                    std::size_t trace_mode, const std::string& focus, bool exact = false);
+  /// The step's part: ground_truth.csv's and the detection files' rows; mode m's filtered part:
+  /// the weight traces (m = the trace mode); its scored part: its clusters.csv rows (kept per
+  /// mode until OnStep).
+  void Prepare(const cosim::StepView& v, Part part, int mode) override;
+  /// grid.csv's row, and the modes' clusters.csv rows in mode order.
   void OnStep(const cosim::StepView& v) override;
   /// Checks every write (throws std::runtime_error naming the file).
   void Close();
@@ -45,6 +50,7 @@ class RunFilesObserver : public cosim::StepObserver {
   std::unique_ptr<DetectionWriter> detections_;
   std::unique_ptr<ScanWriter> scans_;  // with --detections exact
   ClusterWriter clusters_;
+  std::vector<std::string> cluster_rows_;  // per mode: this step's rows, made by Prepare
   std::size_t trace_mode_;
   WeightTraces traces_;
 };
@@ -64,6 +70,10 @@ class RecordingObserver : public cosim::StepObserver {
   RecordingObserver(const RecordingObserver&) = delete;
   RecordingObserver& operator=(const RecordingObserver&) = delete;
   bool WantsVelocities(int step, double time) override;
+  /// Mode m's scored part: its live counts and, at a recorded step, its part of the frame; the
+  /// step's part: the frame's own part (and the header, at the first recorded step).
+  void Prepare(const cosim::StepView& v, Part part, int mode) override;
+  /// Hands the frame prepared to the worker.
   void OnStep(const cosim::StepView& v) override;
   /// Writes the index (the recording is usable only then); a failure costs only the replay.
   /// False when there is no recording to finish.
@@ -83,6 +93,11 @@ class RecordingObserver : public cosim::StepObserver {
   std::unique_ptr<replay::Writer> writer_;
   bool failed_ = false;
   replay::Header header_;
+  bool header_made_ = false;
+  // This step's frame (a recorded step), made by Prepare, and the first error making it (per
+  // part: step, then mode m at 1 + m; rethrown by OnStep, where its capture used to run).
+  replay::Frame frame_;
+  std::vector<std::exception_ptr> capture_errors_;
   std::vector<replay::LiveCounter> counters_;
   std::vector<replay::Live> live_;
   std::set<int> ids_;
