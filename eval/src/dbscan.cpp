@@ -268,17 +268,30 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   // mostly joined already and skipped without a pair search. Each unordered pair of cells once:
   // from the cell that sees the other at an offset of the upper half plane (half_). Cells
   // without core points take no part (they stay their own roots and get no component).
+  // In a dense table, a cell's neighbours are at fixed distances from its entry.
+  core_cells_.clear();
+  for (int c = 0; c < cells; ++c)
+    if (core_start_[c] < core_start_[c + 1]) core_cells_.push_back(c);
+  half_delta_.resize(half_.size());
+  for (std::size_t k = 0; k < half_.size(); ++k)
+    half_delta_[k] = half_[k].dy * fine_.w + half_[k].dx;
   for (int r = 1; r <= reach_; ++r) {
-    const std::span<const Offset> offsets(half_.data() + ring_start_[r - 1],
-                                          half_.data() + ring_start_[r]);
-    for (int a = 0; a < cells; ++a) {
-      if (core_start_[a] == core_start_[a + 1]) continue;
-      const std::int64_t x = cx_[a], y = cy_[a];
-      for (const Offset& d : offsets) {
-        const int b = fine_.Find(x + d.dx, y + d.dy);
-        if (b < 0 || core_start_[b] == core_start_[b + 1]) continue;
-        const int ra = FindRoot(a), rb = FindRoot(b);
-        if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
+    for (const int a : core_cells_) {
+      int ra = FindRoot(a);
+      const auto join = [&](int b) {
+        if (b < 0 || core_start_[b] == core_start_[b + 1]) return;
+        const int rb = FindRoot(b);
+        if (ra == rb || !linked(a, b)) return;
+        parent_[std::max(ra, rb)] = std::min(ra, rb);
+        ra = std::min(ra, rb);
+      };
+      if (fine_.dense) {
+        const int* const at =
+            fine_.cells.data() + ((cy_[a] - fine_.y0) * fine_.w + (cx_[a] - fine_.x0));
+        for (int k = ring_start_[r - 1]; k < ring_start_[r]; ++k) join(at[half_delta_[k]]);
+      } else {
+        for (int k = ring_start_[r - 1]; k < ring_start_[r]; ++k)
+          join(fine_.Find(cx_[a] + half_[k].dx, cy_[a] + half_[k].dy));
       }
     }
   }

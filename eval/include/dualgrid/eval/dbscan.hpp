@@ -173,6 +173,8 @@ class Dbscan {
   std::vector<std::int64_t> fx_, fy_, cx_, cy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
   std::vector<int> core_start_, core_sorted_;
+  std::vector<int> core_cells_;             // the cells holding core points
+  std::vector<std::ptrdiff_t> half_delta_;  // half_ as steps in the dense table
   std::vector<int> component_;
   std::vector<int> labels_;
   std::vector<int> relabel_;
