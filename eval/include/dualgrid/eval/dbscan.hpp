@@ -8,7 +8,9 @@
 // the first pair of their core points within eps, so dense clusters cost O(cells), not
 // O(points x density). With the weighted criterion (min_weight > 0), the core test sums the
 // weights over index cells of side eps in a fixed order instead (the 3 x 3 block, own cell
-// first). Speed: docs/performance.md (bench_models' clusterer, bench_scoring).
+// first). RunInCells takes the fine grid from the caller (points already grouped by the cells of
+// a lattice, e.g. the filter's grid cells), with a neighbour block as wide as its side needs.
+// Speed: docs/performance.md (bench_models' clusterer, bench_scoring).
 #pragma once
 
 #include <cstdint>
