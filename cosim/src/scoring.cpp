@@ -118,7 +118,7 @@ std::vector<std::uint8_t> TruthClasses(const GridSnapshot& grid, const GridFrame
 
 void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint8_t> classes,
                       const std::optional<OrientedBox>& exclude,
-                      std::vector<eval::WeightedParticle>* out) {
+                      std::vector<eval::WeightedParticle>* out, eval::PointCells* cells) {
   if (classes.size() != static_cast<std::size_t>(grid.cells_x()) * grid.cells_y())
     throw std::invalid_argument("DynamicParticles: " + std::to_string(classes.size()) +
                                 " cell classes for a grid of " +
@@ -135,6 +135,11 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
   // the grid's arrays per particle.
   constexpr auto kDynamic = static_cast<std::uint8_t>(eval::CellClass::kDynamic);
   const int cells_x = grid.cells_x();
+  if (cells) {
+    cells->origin = grid.CellCenter({0, 0}) - Position::Constant(0.5 * grid.resolution());
+    cells->side = grid.resolution();
+    cells->runs.clear();
+  }
   std::size_t m = 0;  // particles written
   grid.ForEachWeightedCellWhere(
       classes, [](std::uint8_t c) { return c == kDynamic; },
@@ -151,6 +156,9 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
           if (test_ego && ego->Contains(p.position)) continue;
           dst[j++] = {p.position, p.velocity, p.weight};
         }
+        if (cells && j > m)
+          cells->runs.push_back({static_cast<std::int64_t>(k % cells_x),
+                                 static_cast<std::int64_t>(k / cells_x), static_cast<int>(m)});
         m = j;
       });
   out->resize(m);
@@ -177,8 +185,8 @@ void ModeScorer::AddFrame(double time, const filter::DynamicGrid& grid,
                         config_.dynamic_threshold, predicted_);
     classes = predicted_;
   }
-  DynamicParticles(grid, classes, ego_box, &dynamic_particles_);
-  clusters_ = clusterer_.Run(dynamic_particles_);
+  DynamicParticles(grid, classes, ego_box, &dynamic_particles_, &dynamic_cells_);
+  clusters_ = clusterer_.Run(dynamic_particles_, dynamic_cells_);
   association_ = tracking_.AddFrame(time, clusters_, objects);
   cells_.AddFrame(classes, truth_classes, snapshot.observed);
 }

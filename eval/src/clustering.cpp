@@ -27,6 +27,17 @@ void ParticleClusterer::PlainMeans(std::span<const WeightedParticle> particles, 
 }
 
 std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> particles) {
+  TakeParticles(particles);
+  return Clusters(particles, dbscan_.Run(positions_, weights_));
+}
+
+std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> particles,
+                                            const PointCells& cells) {
+  TakeParticles(particles);
+  return Clusters(particles, dbscan_.RunInCells(positions_, weights_, cells));
+}
+
+void ParticleClusterer::TakeParticles(std::span<const WeightedParticle> particles) {
   const int n = static_cast<int>(particles.size());
   positions_.resize(n);
   weights_.resize(n);
@@ -41,7 +52,11 @@ std::vector<Cluster> ParticleClusterer::Run(std::span<const WeightedParticle> pa
     positions_[i] = p.position;
     weights_[i] = p.weight;
   }
-  const std::span<const int> labels = dbscan_.Run(positions_, weights_);
+}
+
+std::vector<Cluster> ParticleClusterer::Clusters(std::span<const WeightedParticle> particles,
+                                                 std::span<const int> labels) {
+  const int n = static_cast<int>(particles.size());
   labels_.assign(labels.begin(), labels.end());
 
   const int k = dbscan_.num_clusters();

@@ -30,11 +30,11 @@ std::int64_t FloorToInt(double v) {
 
 // The cell offsets of Chebyshev distance 1 and 2 in the upper half plane (dy > 0, or dy == 0 and
 // dx > 0): of two cells at one of these distances, exactly one sees the other at such an offset.
-struct Offset {
-  int dx, dy;
-};
-constexpr Offset kHalfRing1[] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-constexpr Offset kHalfRing2[] = {{2, 0}, {-2, 1}, {2, 1}, {-2, 2}, {-1, 2}, {0, 2}, {1, 2}, {2, 2}};
+constexpr int kMaxReach = 4;  // the widest neighbour block: 9 x 9 cells
+
+// Relative margin of a point outside its given cell (RunInCells), in cell sides: far above the
+// rounding of a position stored as a float offset (micrometres on a 0.5 m cell).
+constexpr double kCellSlack = 1e-3;
 
 // Strict order used to break distance ties between core points: lexicographic (x, y).
 bool LexLess(const Position& a, const Position& b) {
@@ -65,6 +65,8 @@ int Dbscan::CellTable::Build(std::span<const std::int64_t> ix, std::span<const s
                              int pad, std::span<int> id) {
   const std::size_t n = ix.size();
   map.clear();
+  for (const std::size_t k : used) cells[k] = -1;  // every entry is -1 again
+  used.clear();
   std::int64_t lo_x = 0, hi_x = -1, lo_y = 0, hi_y = -1;
   for (std::size_t i = 0; i < n; ++i) {
     lo_x = i == 0 ? ix[i] : std::min(lo_x, ix[i]);
@@ -81,10 +83,15 @@ int Dbscan::CellTable::Build(std::span<const std::int64_t> ix, std::span<const s
     x0 = lo_x - pad;
     y0 = lo_y - pad;
     w = hi_x - lo_x + 1 + 2 * pad;
-    cells.assign(static_cast<std::size_t>(area), -1);
+    if (cells.size() < static_cast<std::size_t>(area))
+      cells.resize(static_cast<std::size_t>(area), -1);
     for (std::size_t i = 0; i < n; ++i) {
-      int& c = cells[static_cast<std::size_t>((iy[i] - y0) * w + (ix[i] - x0))];
-      if (c < 0) c = count++;
+      const auto k = static_cast<std::size_t>((iy[i] - y0) * w + (ix[i] - x0));
+      int& c = cells[k];
+      if (c < 0) {
+        c = count++;
+        used.push_back(k);
+      }
       id[i] = c;
     }
     return count;
@@ -157,18 +164,82 @@ void Dbscan::FineCells(std::span<const Position> points) {
     fx_[i] = FloorToInt(points[i].x() * inv_h);
     fy_[i] = FloorToInt(points[i].y() * inv_h);
   }
-  const int cells = fine_.Build(fx_, fy_, 2, fine_cell_);
+  SetBlock(2, 0.0);
+  whole_core_ = true;
+  const int cells = fine_.Build(fx_, fy_, reach_, fine_cell_);
   fine_start_.assign(cells + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++fine_start_[fine_cell_[i] + 1];
   for (int c = 0; c < cells; ++c) fine_start_[c + 1] += fine_start_[c];
   fine_sorted_.resize(n);
   parent_.assign(fine_start_.begin(), fine_start_.end() - 1);  // borrowed as the cursor
   for (std::size_t i = 0; i < n; ++i) fine_sorted_[parent_[fine_cell_[i]]++] = static_cast<int>(i);
+  cx_.resize(cells);
+  cy_.resize(cells);
+  for (int c = 0; c < cells; ++c) {
+    const int member = fine_sorted_[fine_start_[c]];  // all members share the coordinates
+    cx_[c] = fx_[member];
+    cy_[c] = fy_[member];
+  }
+}
+
+void Dbscan::SetBlock(int reach, double side) {
+  if (reach == reach_ && side == block_side_) return;
+  reach_ = reach;
+  block_side_ = side;
+  // The gap between cells d apart along an axis (less the slack of both points), 0 if adjacent.
+  const auto gap = [&](int d) {
+    return side > 0.0 ? std::max((std::abs(d) - 1 - 2.0 * kCellSlack) * side, 0.0) : 0.0;
+  };
+  const double eps2 = params_.eps * params_.eps * (1.0 + 1e-9);
+  const auto near = [&](int dx, int dy) { return gap(dx) * gap(dx) + gap(dy) * gap(dy) <= eps2; };
+  half_.clear();
+  block_.clear();
+  ring_start_.assign(1, 0);
+  for (int r = 1; r <= reach; ++r) {
+    for (int dy = 0; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx)
+        if (std::max(std::abs(dx), dy) == r && (dy > 0 || dx > 0) && near(dx, dy))
+          half_.push_back({dx, dy});
+    ring_start_.push_back(static_cast<int>(half_.size()));
+  }
+  for (int dx = -reach; dx <= reach; ++dx)
+    for (int dy = -reach; dy <= reach; ++dy)
+      if (near(dx, dy)) block_.push_back({dx, dy});
+}
+
+bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& given) {
+  const int n = static_cast<int>(points.size());
+  const int cells = static_cast<int>(given.runs.size());
+  const double inv_side = 1.0 / given.side;
+  cx_.resize(cells);
+  cy_.resize(cells);
+  fine_start_.resize(cells + 1);
+  bool inside = true;
+  for (int c = 0; c < cells; ++c) {
+    const CellRun& run = given.runs[c];
+    cx_[c] = run.x;
+    cy_[c] = run.y;
+    fine_start_[c] = run.first;
+    const int last = c + 1 < cells ? given.runs[c + 1].first : n;
+    const double x = static_cast<double>(run.x), y = static_cast<double>(run.y);
+    for (int i = run.first; i < last; ++i) {  // the position in cell sides, relative to the cell
+      const double u = (points[i].x() - given.origin.x()) * inv_side - x;
+      const double v = (points[i].y() - given.origin.y()) * inv_side - y;
+      inside &=
+          u >= -kCellSlack && u <= 1.0 + kCellSlack && v >= -kCellSlack && v <= 1.0 + kCellSlack;
+    }
+  }
+  fine_start_[cells] = n;
+  if (!inside) return false;
+  fine_cell_.resize(cells);  // the run of each cell (its id is its first run's)
+  if (fine_.Build(cx_, cy_, reach_, fine_cell_) != cells) return false;
+  fine_sorted_.resize(n);
+  for (int i = 0; i < n; ++i) fine_sorted_[i] = i;
+  return true;
 }
 
 int Dbscan::CoreComponents(std::span<const Position> points) {
-  // Cells up to two apart (5 x 5 block) can hold neighbours: h < eps < 2 h, and points of cells
-  // three apart are more than 2 h apart.
+  // Cells up to reach_ apart can hold neighbours (FineCells: h < eps < 2 h, so a 5 x 5 block).
   const double eps2 = params_.eps * params_.eps;
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   // Each cell's core points, in input order (a stable filter of fine_sorted_).
@@ -193,21 +264,34 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
         if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
     return false;
   };
-  // Adjacent cells first (they almost always link), then the ring two cells away, which is then
+  // Adjacent cells first (they almost always link), then the rings further away, which are then
   // mostly joined already and skipped without a pair search. Each unordered pair of cells once:
-  // from the cell that sees the other at an offset of the upper half plane (kHalfRing). Cells
+  // from the cell that sees the other at an offset of the upper half plane (half_). Cells
   // without core points take no part (they stay their own roots and get no component).
-  for (const auto& offsets :
-       {std::span<const Offset>(kHalfRing1), std::span<const Offset>(kHalfRing2)}) {
-    for (int a = 0; a < cells; ++a) {
-      if (core_start_[a] == core_start_[a + 1]) continue;
-      const int member = fine_sorted_[fine_start_[a]];  // all members share the coordinates
-      const std::int64_t x = fx_[member], y = fy_[member];
-      for (const Offset& d : offsets) {
-        const int b = fine_.Find(x + d.dx, y + d.dy);
-        if (b < 0 || core_start_[b] == core_start_[b + 1]) continue;
-        const int ra = FindRoot(a), rb = FindRoot(b);
-        if (ra != rb && linked(a, b)) parent_[std::max(ra, rb)] = std::min(ra, rb);
+  // In a dense table, a cell's neighbours are at fixed distances from its entry.
+  core_cells_.clear();
+  for (int c = 0; c < cells; ++c)
+    if (core_start_[c] < core_start_[c + 1]) core_cells_.push_back(c);
+  half_delta_.resize(half_.size());
+  for (std::size_t k = 0; k < half_.size(); ++k)
+    half_delta_[k] = half_[k].dy * fine_.w + half_[k].dx;
+  for (int r = 1; r <= reach_; ++r) {
+    for (const int a : core_cells_) {
+      int ra = FindRoot(a);
+      const auto join = [&](int b) {
+        if (b < 0 || core_start_[b] == core_start_[b + 1]) return;
+        const int rb = FindRoot(b);
+        if (ra == rb || !linked(a, b)) return;
+        parent_[std::max(ra, rb)] = std::min(ra, rb);
+        ra = std::min(ra, rb);
+      };
+      if (fine_.dense) {
+        const int* const at =
+            fine_.cells.data() + ((cy_[a] - fine_.y0) * fine_.w + (cx_[a] - fine_.x0));
+        for (int k = ring_start_[r - 1]; k < ring_start_[r]; ++k) join(at[half_delta_[k]]);
+      } else {
+        for (int k = ring_start_[r - 1]; k < ring_start_[r]; ++k)
+          join(fine_.Find(cx_[a] + half_[k].dx, cy_[a] + half_[k].dy));
       }
     }
   }
@@ -230,28 +314,27 @@ template <typename F>
 void Dbscan::ForEachFineNeighbour(std::span<const Position> points, int c, int i, F&& f) const {
   const double eps2 = params_.eps * params_.eps;
   const Position p = points[i];
-  const std::int64_t x = fx_[i], y = fy_[i];
-  for (std::int64_t dx = -2; dx <= 2; ++dx) {
-    for (std::int64_t dy = -2; dy <= 2; ++dy) {
-      const int b = dx == 0 && dy == 0 ? c : fine_.Find(x + dx, y + dy);
-      if (b < 0) continue;
-      for (int k = fine_start_[b]; k < fine_start_[b + 1]; ++k) {
-        const int j = fine_sorted_[k];
-        if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return;
-      }
+  const std::int64_t x = cx_[c], y = cy_[c];
+  for (const Offset& d : block_) {
+    const int b = d.dx == 0 && d.dy == 0 ? c : fine_.Find(x + d.dx, y + d.dy);
+    if (b < 0) continue;
+    for (int k = fine_start_[b]; k < fine_start_[b + 1]; ++k) {
+      const int j = fine_sorted_[k];
+      if ((points[j] - p).squaredNorm() <= eps2 && !f(j)) return;
     }
   }
 }
 
 void Dbscan::CountCore(std::span<const Position> points) {
-  // A fine cell holding min_points points makes them all core: they are within eps of each other
-  // (Gunawan's rule). The points of the other cells count their neighbours until min_points.
+  // A fine cell holding min_points points makes them all core when its diameter is below eps:
+  // they are within eps of each other (Gunawan's rule). The points of the other cells count their
+  // neighbours until min_points.
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   ParallelFor(
       cells, Schedule::kDynamic,
       [&](std::int64_t c64) {
         const int c = static_cast<int>(c64);
-        const bool dense = fine_start_[c + 1] - fine_start_[c] >= params_.min_points;
+        const bool dense = whole_core_ && fine_start_[c + 1] - fine_start_[c] >= params_.min_points;
         for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
           const int i = fine_sorted_[k];
           if (dense) {
@@ -318,19 +401,59 @@ void Dbscan::WeightedCore(std::span<const Position> points, std::span<const doub
       /*worth=*/true, /*chunk=*/8);
 }
 
-std::span<const int> Dbscan::Run(std::span<const Position> points,
-                                 std::span<const double> weights) {
-  const int n = static_cast<int>(points.size());
+namespace {
+
+void CheckInput(std::span<const Position> points, std::span<const double> weights) {
   if (!weights.empty() && weights.size() != points.size())
     throw std::invalid_argument("Dbscan::Run: " + std::to_string(weights.size()) + " weights for " +
                                 std::to_string(points.size()) + " points");
-  for (int i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
     if (!points[i].allFinite())
       throw std::invalid_argument("Dbscan::Run: point " + std::to_string(i) + " is not finite");
   }
+}
 
-  // The fine grid of every point: the core test of sparse cells, the components and the borders.
+}  // namespace
+
+std::span<const int> Dbscan::Run(std::span<const Position> points,
+                                 std::span<const double> weights) {
+  CheckInput(points, weights);
   FineCells(points);
+  return LabelOnFineGrid(points, weights);
+}
+
+std::span<const int> Dbscan::RunInCells(std::span<const Position> points,
+                                        std::span<const double> weights, const PointCells& cells) {
+  CheckInput(points, weights);
+  const int n = static_cast<int>(points.size());
+  for (std::size_t c = 0; c < cells.runs.size(); ++c) {
+    const int first = cells.runs[c].first;
+    if ((c == 0 && first != 0) || first >= n || (c > 0 && first <= cells.runs[c - 1].first))
+      throw std::invalid_argument("Dbscan::RunInCells: run " + std::to_string(c) +
+                                  " starts at point " + std::to_string(first) + " of " +
+                                  std::to_string(n) + " (need 0 first, rising, below the count)");
+  }
+  if (cells.runs.empty() && n > 0)
+    throw std::invalid_argument("Dbscan::RunInCells: " + std::to_string(n) + " points, no run");
+  // Cells up to reach apart can hold neighbours: points of cells reach + 1 apart are more than
+  // reach sides minus the slack apart.
+  const double eps = params_.eps, side = cells.side;
+  const bool weighted = !weights.empty() && params_.min_weight > 0.0;
+  if (weighted || !(side > eps / kMaxReach && std::isfinite(side))) return Run(points, weights);
+  const int reach = static_cast<int>(std::floor(eps / side + 2.0 * kCellSlack)) + 1;
+  if (reach > kMaxReach) return Run(points, weights);
+  SetBlock(reach, side);
+  // Two points of one cell (widened by the slack) are closer than eps * (1 - 1e-9), as in
+  // InvFineSide.
+  whole_core_ = side * (1.0 + 2.0 * kCellSlack) * std::sqrt(2.0) < eps * (1.0 - 1e-9);
+  if (!GivenCells(points, cells)) return Run(points, weights);
+  return LabelOnFineGrid(points, weights);
+}
+
+std::span<const int> Dbscan::LabelOnFineGrid(std::span<const Position> points,
+                                             std::span<const double> weights) {
+  const int n = static_cast<int>(points.size());
+  // The fine grid: the core test of sparse cells, the components and the borders.
   core_.assign(n, 0);
   const bool use_weights = !weights.empty() && params_.min_weight > 0.0;
   if (use_weights)

@@ -199,3 +199,54 @@ TEST_CASE("CellWindow holds every cell a box touches", "[cosim][scoring]") {
   const OrientedBox nan_box{Position(std::nan(""), 0.0), 0.0, 1.0, 1.0};
   CHECK_FALSE(cosim::CellWindow::Around(nan_box, grid).Holds(0, 0));
 }
+
+TEST_CASE("DynamicParticles' cells group its particles by grid cell; clustering in them agrees",
+          "[cosim][scoring]") {
+  // The crossing car: every particle lies in its run's cell (as the grid's CellOf places it),
+  // the runs cover the particles in order, and the clusterer in these cells gives Run's clusters
+  // and labels bit for bit, with and without the ego box.
+  filter::DynamicGrid grid(Crossing::Params(), 5);
+  const scenario::EvaluationConfig config;
+  Crossing crossing;
+  int compared = 0;
+  for (int step = 0; step < 40; ++step) {
+    crossing.Step(grid, step);
+    if (step < 10) continue;
+    cosim::GridSnapshot s;
+    cosim::TakeSnapshot(grid, false, s);
+    cosim::ClassifySnapshot(config.dynamic_threshold, s);
+    for (const std::optional<OrientedBox>& box :
+         {std::optional<OrientedBox>(), std::optional<OrientedBox>(crossing.car)}) {
+      std::vector<eval::WeightedParticle> particles;
+      eval::PointCells cells;
+      cosim::DynamicParticles(grid, s.classes, box, &particles, &cells);
+      CHECK(cells.side == grid.resolution());
+      std::size_t covered = 0;
+      for (std::size_t r = 0; r < cells.runs.size(); ++r) {
+        const eval::CellRun& run = cells.runs[r];
+        CHECK(run.first == static_cast<int>(covered));
+        const std::size_t last =
+            r + 1 < cells.runs.size() ? cells.runs[r + 1].first : particles.size();
+        REQUIRE(last > covered);
+        for (std::size_t i = covered; i < last; ++i) {
+          const auto cell = grid.CellOf(particles[i].position);
+          REQUIRE(cell);
+          CHECK(cell->x == run.x);
+          CHECK(cell->y == run.y);
+          const Position corner = cells.origin + cells.side * Position(run.x, run.y);
+          CHECK(particles[i].position.x() >= corner.x() - 1e-4);
+          CHECK(particles[i].position.x() <= corner.x() + cells.side + 1e-4);
+        }
+        covered = last;
+      }
+      CHECK(covered == particles.size());
+      eval::ParticleClusterer in_cells(config.dbscan, config.min_cluster_mass),
+          plain(config.dbscan, config.min_cluster_mass);
+      CheckSameClusters(in_cells.Run(particles, cells), plain.Run(particles));
+      CHECK(std::vector<int>(in_cells.labels().begin(), in_cells.labels().end()) ==
+            std::vector<int>(plain.labels().begin(), plain.labels().end()));
+      compared += !particles.empty();
+    }
+  }
+  CHECK(compared >= 40);
+}

@@ -259,3 +259,109 @@ TEST_CASE("DBSCAN labels do not depend on the OpenMP thread count", "[dbscan]") 
   omp_set_num_threads(saved);
   CHECK(std::vector<int>(four.begin(), four.end()) == labels_one);
 }
+
+namespace {
+
+using dualgrid::eval::CellRun;
+using dualgrid::eval::PointCells;
+
+// `pts` reordered cell by cell (cells in row-major order, input order within a cell, as the
+// filter hands its particles over), with the cells of side `side` whose lower-left corner of cell
+// (0, 0) is `origin`: a point on an edge between cells goes to the lower one.
+PointCells GroupByCells(std::vector<Position>& pts, const Position& origin, double side) {
+  const auto cell = [&](const Position& p) {
+    const auto index = [&](double v) {
+      const double u = v / side;
+      const double f = std::floor(u);
+      return static_cast<std::int64_t>(f == u ? f - 1.0 : f);  // an edge: the lower cell
+    };
+    return std::pair(index(p.y() - origin.y()), index(p.x() - origin.x()));
+  };
+  std::stable_sort(pts.begin(), pts.end(),
+                   [&](const Position& a, const Position& b) { return cell(a) < cell(b); });
+  PointCells cells{origin, side, {}};
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto [y, x] = cell(pts[i]);
+    if (i == 0 || cell(pts[i - 1]) != std::pair(y, x))
+      cells.runs.push_back({x, y, static_cast<int>(i)});
+  }
+  return cells;
+}
+
+}  // namespace
+
+TEST_CASE("DBSCAN in given cells labels as Run does", "[dbscan]") {
+  const std::uint64_t seed = GENERATE(range(1, 11));
+  const bool snap = GENERATE(false, true);  // points on the 0.5 m lattice: on cell edges
+  // 0.5: the filter's cells (whole cells core, reach 3); 0.26 (reach 4); 0.8: above
+  // eps / sqrt(2), so no cell is core as a whole (reach 2).
+  const double side = GENERATE(0.5, 0.26, 0.8);
+  const int min_points = GENERATE(2, 4);
+  std::vector<Position> pts = RandomPoints(seed, 400, 20.0, snap);
+  for (Position& q : pts) q += Position(-10.0, -7.0);
+  const Position origin = snap ? Position(-3.0, 1.5) : Position(-3.1, 1.37);
+  const PointCells cells = GroupByCells(pts, origin, side);
+  const DbscanParams params{.eps = 1.0, .min_points = min_points};
+  Dbscan given(params), reference(params);
+  const auto labels = given.RunInCells(pts, {}, cells);
+  const std::vector<int> got(labels.begin(), labels.end());
+  const auto expected = reference.Run(pts);
+  CHECK(got == std::vector<int>(expected.begin(), expected.end()));
+  CHECK(given.num_clusters() == reference.num_clusters());
+  CHECK(reference.num_clusters() > 1);
+  // Run after RunInCells on the same object: its own fine grid again.
+  const auto again = given.Run(pts);
+  CHECK(std::vector<int>(again.begin(), again.end()) == got);
+}
+
+TEST_CASE("DBSCAN in given cells links points exactly eps apart three cells apart", "[dbscan]") {
+  // Cells of 0.5 m: (0.5, 0.1) on the right edge of cell 0 and (1.5, 0.1) on the left edge of
+  // cell 3 are exactly eps apart; and a pair slightly nearer each edge than the cells' slack.
+  std::vector<Position> pts = {{0.5, 0.1}, {1.5, 0.1}, {0.5, 3.1}, {1.5, 3.1}};
+  PointCells cells{Position::Zero(), 0.5, {{0, 0, 0}, {3, 0, 1}, {0, 6, 2}, {3, 6, 3}}};
+  Dbscan dbscan({.eps = 1.0, .min_points = 2});
+  const auto labels = dbscan.RunInCells(pts, {}, cells);
+  CHECK(std::vector<int>(labels.begin(), labels.end()) == std::vector<int>{0, 0, 1, 1});
+  // The same points over 0.5 m cells, one nudged past the slack of its cell: Run's result.
+  pts[1] = Position(1.5 - 0.01, 0.1);
+  const auto nudged = dbscan.RunInCells(pts, {}, cells);
+  CHECK(std::vector<int>(nudged.begin(), nudged.end()) == std::vector<int>{0, 0, 1, 1});
+  pts[1] = Position(1.5 + 0.01, 0.1);  // now beyond eps
+  const auto apart = dbscan.RunInCells(pts, {}, cells);
+  CHECK(std::vector<int>(apart.begin(), apart.end()) == std::vector<int>{kNoise, kNoise, 0, 0});
+
+  // Cells slightly wider than eps / 2, points just outside them (within the slack): cells 3
+  // apart hold points within eps (0.9995 m).
+  const double side = 0.5002;
+  const std::vector<Position> edge = {{1.0009 * side, 0.1}, {2.9991 * side, 0.1}};
+  const auto slack = dbscan.RunInCells(edge, {}, {Position::Zero(), side, {{0, 0, 0}, {3, 0, 1}}});
+  CHECK(std::vector<int>(slack.begin(), slack.end()) == std::vector<int>{0, 0});
+
+  // Cells of 0.8 m (diagonal 1.13 m): two points of one cell 1.10 m apart are not neighbours.
+  const std::vector<Position> wide = {{0.01, 0.01}, {0.79, 0.79}};
+  const auto apart_in_cell = dbscan.RunInCells(wide, {}, {Position::Zero(), 0.8, {{0, 0, 0}}});
+  CHECK(std::vector<int>(apart_in_cell.begin(), apart_in_cell.end()) ==
+        std::vector<int>{kNoise, kNoise});
+}
+
+TEST_CASE("DBSCAN in given cells rejects malformed runs", "[dbscan]") {
+  const std::vector<Position> pts = {{0.1, 0.1}, {0.2, 0.1}, {0.7, 0.1}};
+  Dbscan dbscan;
+  CHECK_THROWS_AS(dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {{0, 0, 1}, {1, 0, 2}}}),
+                  std::invalid_argument);  // not from 0
+  CHECK_THROWS_AS(dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {{0, 0, 0}, {1, 0, 0}}}),
+                  std::invalid_argument);  // not rising
+  CHECK_THROWS_AS(dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {{0, 0, 0}, {1, 0, 3}}}),
+                  std::invalid_argument);  // past the points
+  CHECK_THROWS_AS(dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {}}), std::invalid_argument);
+  // A cell in two runs, a point outside its cell: Run's labels.
+  const auto twice = dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {{0, 0, 0}, {0, 0, 2}}});
+  const std::vector<int> got(twice.begin(), twice.end());
+  Dbscan reference;
+  const auto expected = reference.Run(pts);
+  CHECK(got == std::vector<int>(expected.begin(), expected.end()));
+  const auto outside =
+      dbscan.RunInCells(pts, {}, {Position::Zero(), 0.5, {{0, 0, 0}, {0, 1, 2}}});  // 0.7 in x
+  CHECK(std::vector<int>(outside.begin(), outside.end()) ==
+        std::vector<int>(expected.begin(), expected.end()));
+}

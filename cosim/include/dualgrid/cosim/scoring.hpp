@@ -64,11 +64,13 @@ struct CellWindow {
 /// update, before resampling; weights normalised per cell to its dynamic mass) in the cells whose
 /// `classes` entry (eval::CellClass per cell, index y * cells_x + x) is dynamic, with a positive
 /// weight and outside `exclude` (the ego's box: nothing else can be there). Grid frame. Replaces
-/// `out`'s contents, in the particles' order. Throws std::invalid_argument when classes.size()
-/// is not the grid's cell count.
+/// `out`'s contents, in the particles' order. With `cells`, also replaces its contents with the
+/// grid cells of `out` (logical (x, y), the grid frame's origin and resolution: a grouping for
+/// eval::Dbscan::RunInCells). Throws std::invalid_argument when classes.size() is not the grid's
+/// cell count.
 void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint8_t> classes,
                       const std::optional<OrientedBox>& exclude,
-                      std::vector<eval::WeightedParticle>* out);
+                      std::vector<eval::WeightedParticle>* out, eval::PointCells* cells = nullptr);
 
 class ModeScorer {
  public:
@@ -100,6 +102,7 @@ class ModeScorer {
   eval::CellClassificationAccumulator cells_;
   std::optional<eval::PointClassificationAccumulator> points_;
   std::vector<eval::WeightedParticle> dynamic_particles_;
+  eval::PointCells dynamic_cells_;  // their grid cells
   std::vector<eval::Cluster> clusters_;
   eval::AssociationResult association_;
   std::vector<std::uint8_t> predicted_;

@@ -40,6 +40,8 @@ class ParticleClusterer {
 
   /// Throws std::invalid_argument for a negative or non-finite weight or a non-finite particle.
   std::vector<Cluster> Run(std::span<const WeightedParticle> particles);
+  /// The same clusters for particles grouped by `cells` (Dbscan::RunInCells; its throws too).
+  std::vector<Cluster> Run(std::span<const WeightedParticle> particles, const PointCells& cells);
 
   /// DBSCAN labels of the particles of the last Run (kNoise or index into its clusters).
   std::span<const int> labels() const { return labels_; }
@@ -48,6 +50,11 @@ class ParticleClusterer {
   // The plain (unweighted) means of cluster `label`'s particles (labels_ of this Run) into `c`,
   // whose size is set: the fallback of a cluster whose weights sum to zero.
   void PlainMeans(std::span<const WeightedParticle> particles, int label, Cluster& c) const;
+  // Both Runs: checked positions and weights into positions_, weights_; DBSCAN labels (of
+  // dbscan_.Run or RunInCells) into labels_; then the clusters.
+  void TakeParticles(std::span<const WeightedParticle> particles);
+  std::vector<Cluster> Clusters(std::span<const WeightedParticle> particles,
+                                std::span<const int> labels);
 
   Dbscan dbscan_;
   double min_cluster_weight_ = 0.0;

@@ -8,7 +8,9 @@
 // the first pair of their core points within eps, so dense clusters cost O(cells), not
 // O(points x density). With the weighted criterion (min_weight > 0), the core test sums the
 // weights over index cells of side eps in a fixed order instead (the 3 x 3 block, own cell
-// first). Speed: docs/performance.md (bench_models' clusterer, bench_scoring).
+// first). RunInCells takes the fine grid from the caller (points already grouped by the cells of
+// a lattice, e.g. the filter's grid cells), with a neighbour block as wide as its side needs.
+// Speed: docs/performance.md (bench_models' clusterer, bench_scoring).
 #pragma once
 
 #include <cstdint>
@@ -46,6 +48,20 @@ void to_json(nlohmann::json& j, const DbscanParams& p);
 /// Label of points that belong to no cluster.
 inline constexpr int kNoise = -1;
 
+/// One cell of a lattice of square cells and the points it holds (Dbscan::RunInCells).
+struct CellRun {
+  std::int64_t x = 0,
+               y = 0;  ///< the cell's lattice index: it spans origin + (x, y) side + [0, side]^2
+  int first = 0;       ///< its first point; it holds points [first, the next run's first or n)
+};
+
+/// Points grouped by the square cells of a lattice (for the scorer: the filter's grid cells).
+struct PointCells {
+  Position origin = Position::Zero();  ///< lower-left corner of cell (0, 0) [m]
+  double side = 0.0;                   ///< cell edge [m]
+  std::vector<CellRun> runs;           ///< in point order, one per non-empty cell
+};
+
 /// Reusable DBSCAN runner; keeps its buffers between calls so per-frame use does not allocate
 /// once warmed up.
 ///
@@ -63,6 +79,14 @@ class Dbscan {
   /// per point (cluster index or kNoise), valid until the next call.
   /// Throws std::invalid_argument on a size mismatch or a non-finite point.
   std::span<const int> Run(std::span<const Position> points, std::span<const double> weights = {});
+  /// The same labels as Run(points, weights), for points grouped by `cells` (each point within
+  /// its run's cell up to 1e-3 of the side): the cells serve as the fine grid, so no point is
+  /// located, and a cell of side < eps / sqrt(2) holding min_points points makes them all core.
+  /// Falls back to Run when the weighted criterion applies, the side is not in (eps / 4, inf), a
+  /// point lies outside its cell or a cell has two runs. Throws std::invalid_argument as Run
+  /// does, and for runs whose firsts do not rise strictly from 0 below points.size().
+  std::span<const int> RunInCells(std::span<const Position> points, std::span<const double> weights,
+                                  const PointCells& cells);
 
   int num_clusters() const { return num_clusters_; }
   const DbscanParams& params() const { return params_; }
@@ -81,11 +105,13 @@ class Dbscan {
   double inv_eps_ = 1.0;
   // Maps integer cell coordinates to cell ids numbered by first appearance. A dense array (with a
   // border of `pad` cells holding -1) when the keys' bounding rectangle is small (up to
-  // 8 n + 65,536 cells: a grid-sized scene), else a hash map.
+  // 8 n + 65,536 cells: a grid-sized scene), else a hash map. The dense array is kept between
+  // builds: a build resets only the entries the last one set (`used`), the rest hold -1 already.
   struct CellTable {
     bool dense = false;
     std::int64_t x0 = 0, y0 = 0, w = 0;
-    std::vector<int> cells;
+    std::vector<int> cells;  // every entry not listed in `used` is -1
+    std::vector<std::size_t> used;
     std::unordered_map<std::uint64_t, int> map;
     // Assigns ids to the cells of (ix[k], iy[k]) into id[k]; returns the number of cells.
     int Build(std::span<const std::int64_t> ix, std::span<const std::int64_t> iy, int pad,
@@ -96,11 +122,18 @@ class Dbscan {
 
   // 1 / h, the fine grid's inverse cell side [1/m] (h < eps / sqrt(2)).
   double InvFineSide() const;
-  // The fine grid of all points: fx_, fy_, fine_cell_ per point; cell c holds the points
-  // fine_sorted_[fine_start_[c] .. fine_start_[c + 1]) in input order.
+  // The fine grid of all points: fx_, fy_, fine_cell_ per point; cell c, at (cx_[c], cy_[c]),
+  // holds the points fine_sorted_[fine_start_[c] .. fine_start_[c + 1]) in input order.
   void FineCells(std::span<const Position> points);
+  // The fine grid given by `cells` (fine_sorted_ the identity); false (nothing usable built) when
+  // a point lies outside its cell or a cell has two runs.
+  bool GivenCells(std::span<const Position> points, const PointCells& cells);
+  // Core flags, components, borders and labels on the fine grid built (after FineCells or
+  // GivenCells).
+  std::span<const int> LabelOnFineGrid(std::span<const Position> points,
+                                       std::span<const double> weights);
   // Calls f(j) for every point j within eps of point i (itself included) of fine cell c, in the
-  // cells of the 5 x 5 block around c, until f returns false.
+  // cells of the block of `reach_` cells around c, until f returns false.
   template <typename F>
   void ForEachFineNeighbour(std::span<const Position> points, int c, int i, F&& f) const;
   // Core flags without the weighted criterion: count neighbours on the fine grid.
@@ -124,9 +157,26 @@ class Dbscan {
   // Fine grid of all points (FineCells); its core points per cell: core_sorted_[core_start_[c] ..
   // core_start_[c + 1]).
   CellTable fine_;
-  std::vector<std::int64_t> fx_, fy_;
+  // The fine grid's neighbour block: points within eps lie at most reach_ cells apart; whole_core_:
+  // a cell holding min_points points makes them all core (its diameter is below eps).
+  struct Offset {
+    int dx, dy;
+  };
+  // The offsets of cells up to `reach` apart that can hold points within eps: all of them when
+  // side is 0 (FineCells); for given cells of `side` [m], those whose gap (less the slack) is
+  // within eps. half_: those of the upper half plane (dy > 0, or dy == 0 and dx > 0), ring by ring
+  // (ring r: half_[ring_start_[r - 1] .. ring_start_[r])); block_: all, (0, 0) included.
+  void SetBlock(int reach, double side);
+  int reach_ = 0;
+  double block_side_ = -1.0;
+  std::vector<Offset> half_, block_;
+  std::vector<int> ring_start_;
+  bool whole_core_ = true;
+  std::vector<std::int64_t> fx_, fy_, cx_, cy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
   std::vector<int> core_start_, core_sorted_;
+  std::vector<int> core_cells_;             // the cells holding core points
+  std::vector<std::ptrdiff_t> half_delta_;  // half_ as steps in the dense table
   std::vector<int> component_;
   std::vector<int> labels_;
   std::vector<int> relabel_;
