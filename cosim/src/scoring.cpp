@@ -153,9 +153,13 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
           const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
           if (!(p.weight > 0.0f)) continue;
           if (test_ego && ego->Contains(p.position)) continue;
-          eval::WeightedParticle& d = dst[j++];  // field by field: no temporary on the stack
-          d.position = p.position;
-          d.velocity = p.velocity;
+          // Scalar double stores: Eigen's vector stores may alias anything, which would make
+          // the compiler reload the grid's arrays per particle.
+          eval::WeightedParticle& d = dst[j++];
+          d.position.x() = p.position.x();
+          d.position.y() = p.position.y();
+          d.velocity.x() = p.velocity.x();
+          d.velocity.y() = p.velocity.y();
           d.weight = p.weight;
         }
         if (cells && j > m) cells->runs.push_back({cx, cy, static_cast<int>(m)});
