@@ -125,7 +125,7 @@ TEST_CASE("The first bad particle is named; weights in [0, max] and finite veloc
     const std::string m = message(bad);
     CHECK(m.find("particle " + std::to_string(first) + " has weight") != std::string::npos);
   }
-  for (const Velocity v : {Velocity(kNaN, 0), Velocity(0, -kInf), Velocity(kInf, kInf)}) {
+  for (const Velocity& v : {Velocity(kNaN, 0), Velocity(0, -kInf), Velocity(kInf, kInf)}) {
     auto bad = good;
     bad[first].velocity = v;
     if (first + 1 < 7) bad[first + 1].weight = -1.0;
