@@ -142,23 +142,27 @@ void DynamicParticles(const filter::DynamicGrid& grid, std::span<const std::uint
   }
   std::size_t m = 0;  // particles written
   grid.ForEachWeightedCellWhere(
-      classes, [](std::uint8_t c) { return c == kDynamic; },
-      [&](std::size_t k, std::int64_t first, std::int64_t last) {
+      classes, filter::ByteIs{kDynamic}, [&](std::size_t k, std::int64_t first, std::int64_t last) {
         const auto count = static_cast<std::size_t>(last - first);
         if (m + count > out->size()) out->resize(m + count);  // past the last call's size only
         eval::WeightedParticle* const dst = out->data();
-        const bool test_ego = near_ego && near_ego->Holds(static_cast<int>(k % cells_x),
-                                                          static_cast<int>(k / cells_x));
+        const auto cx = static_cast<int>(k % cells_x), cy = static_cast<int>(k / cells_x);
+        const bool test_ego = near_ego && near_ego->Holds(cx, cy);
         std::size_t j = m;
         for (std::int64_t i = first; i < last; ++i) {
           const filter::ParticleView p = grid.WeightedParticle(static_cast<std::size_t>(i));
           if (!(p.weight > 0.0f)) continue;
           if (test_ego && ego->Contains(p.position)) continue;
-          dst[j++] = {p.position, p.velocity, p.weight};
+          // Scalar double stores: Eigen's vector stores may alias anything, which would make
+          // the compiler reload the grid's arrays per particle.
+          eval::WeightedParticle& d = dst[j++];
+          d.position.x() = p.position.x();
+          d.position.y() = p.position.y();
+          d.velocity.x() = p.velocity.x();
+          d.velocity.y() = p.velocity.y();
+          d.weight = p.weight;
         }
-        if (cells && j > m)
-          cells->runs.push_back({static_cast<std::int64_t>(k % cells_x),
-                                 static_cast<std::int64_t>(k / cells_x), static_cast<int>(m)});
+        if (cells && j > m) cells->runs.push_back({cx, cy, static_cast<int>(m)});
         m = j;
       });
   out->resize(m);

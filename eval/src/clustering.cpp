@@ -41,6 +41,18 @@ void ParticleClusterer::TakeParticles(std::span<const WeightedParticle> particle
   const int n = static_cast<int>(particles.size());
   positions_.resize(n);
   weights_.resize(n);
+  // Copy first, checking without a branch per particle (finite and >= 0 is [0, max], which NaN
+  // fails); only a bad set is walked again to name its first bad particle.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  bool ok = true;
+  for (int i = 0; i < n; ++i) {
+    const WeightedParticle& p = particles[i];
+    ok &= (p.weight >= 0.0) & (p.weight <= kMax) & (std::abs(p.velocity.x()) <= kMax) &
+          (std::abs(p.velocity.y()) <= kMax);
+    positions_[i] = p.position;
+    weights_[i] = p.weight;
+  }
+  if (ok) return;
   for (int i = 0; i < n; ++i) {
     const WeightedParticle& p = particles[i];
     if (!(std::isfinite(p.weight) && p.weight >= 0.0))
@@ -49,8 +61,6 @@ void ParticleClusterer::TakeParticles(std::span<const WeightedParticle> particle
     if (!p.velocity.allFinite())
       throw std::invalid_argument("ParticleClusterer: particle " + std::to_string(i) +
                                   " has a non-finite velocity");
-    positions_[i] = p.position;
-    weights_[i] = p.weight;
   }
 }
 

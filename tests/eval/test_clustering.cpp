@@ -1,4 +1,6 @@
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -87,6 +89,51 @@ TEST_CASE("Negative or non-finite weights are rejected", "[clustering]") {
   const double bad = GENERATE(-1.0, std::numeric_limits<double>::quiet_NaN());
   const std::vector<WeightedParticle> particles = {{{0.0, 0.0}, {0.0, 0.0}, bad}};
   CHECK_THROWS_AS(clusterer.Run(particles), std::invalid_argument);
+}
+
+TEST_CASE("The first bad particle is named; weights in [0, max] and finite velocities pass",
+          "[clustering]") {
+  // TakeParticles checks without a branch per particle and walks a bad set again for the
+  // message: the index must be the first bad one, a weight fault must win over a velocity fault
+  // of the same particle, and the boundary values must pass.
+  constexpr double kMax = std::numeric_limits<double>::max();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  std::vector<WeightedParticle> good;
+  for (int i = 0; i < 7; ++i) good.push_back({Position(0.3 * i, 0), Velocity(1, 0), 1.0});
+  good[1].weight = 0.0;
+  good[2].weight = -0.0;
+  good[3].weight = kMax;
+  good[4].velocity = Velocity(kMax, -kMax);
+  ParticleClusterer clusterer;
+  CHECK_NOTHROW(clusterer.Run(good));
+  const int first = GENERATE(0, 3, 6);
+  const auto message = [&](const std::vector<WeightedParticle>& particles) -> std::string {
+    try {
+      clusterer.Run(particles);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no throw";
+  };
+  for (const double w : {-1.0, -kMax, kInf, kNaN}) {
+    auto bad = good;
+    bad[first].weight = w;
+    bad[first].velocity = Velocity(kNaN, 0);  // the weight is reported first
+    if (first + 1 < 7) bad[first + 1].velocity = Velocity(0, kInf);
+    INFO("weight " << w << " at " << first);
+    const std::string m = message(bad);
+    CHECK(m.find("particle " + std::to_string(first) + " has weight") != std::string::npos);
+  }
+  for (const Velocity& v : {Velocity(kNaN, 0), Velocity(0, -kInf), Velocity(kInf, kInf)}) {
+    auto bad = good;
+    bad[first].velocity = v;
+    if (first + 1 < 7) bad[first + 1].weight = -1.0;
+    INFO("velocity " << v.transpose() << " at " << first);
+    const std::string m = message(bad);
+    CHECK(m.find("particle " + std::to_string(first) + " has a non-finite velocity") !=
+          std::string::npos);
+  }
 }
 
 TEST_CASE("ParticleClusterer drops clusters below the minimum mass", "[eval][clustering]") {

@@ -479,6 +479,74 @@ TEST_CASE("ForEachWeightedCellWhere gives the particles of the cells a layer kee
                   std::logic_error);
 }
 
+TEST_CASE("ForEachWeightedCellWhere with ByteIs makes the calls of the plain byte test",
+          "[filter][grid][property]") {
+  // ByteIs tests 8 bytes per word: the same calls in the same order as a callable v == value, on
+  // layers of no kept cell, all, sparse cells and runs of kept cells (across word boundaries and
+  // the storage wrap, which the ego's fractional moves shift), with the other bytes often differing
+  // from the value in one bit only (bit 7 or bit 0: a carry between bytes would show). 61.5 m at
+  // 0.3 m: 205 columns, so rows end in a partial word.
+  const std::uint64_t seed = GENERATE(range(1, 5));
+  FilterParams fp;
+  fp.resolution = 0.3;
+  fp.length_x = 61.5;
+  fp.width_y = 30.0;
+  fp.num_particles = 3000;
+  fp.num_birth = 300;
+  DynamicGrid g(fp, seed);
+  REQUIRE(g.cells_x() % 8 != 0);
+  const std::size_t cells = static_cast<std::size_t>(g.cells_x()) * g.cells_y();
+  using Call = std::array<std::int64_t, 3>;  // k, first, last
+  std::vector<Call> fast, plain;
+  const auto into = [](std::vector<Call>& calls) {
+    return [&calls](std::size_t k, std::int64_t first, std::int64_t last) {
+      calls.push_back({static_cast<std::int64_t>(k), first, last});
+    };
+  };
+  CounterRng rng(seed, RngPurpose::kTest, 2001, 0);
+  const auto byte = [&](int lo, int hi) { return static_cast<int>(rng.Uniform(lo, hi + 1.0)); };
+  Pose2 ego;
+  ego.position = {rng.Uniform(-500.0, 500.0), rng.Uniform(-500.0, 500.0)};
+  std::vector<std::uint8_t> layer(cells);
+  std::size_t kept_calls = 0;
+  for (int step = 0; step < 5; ++step) {
+    ego.position += Vector2(rng.Uniform(0.0, 1.7), rng.Uniform(-0.4, 0.4));
+    const auto cov = Sensors(ego);
+    g.Update({ego, {20, 0}}, RandomDetections(ego, seed, step, cov), cov, 0.05);
+    for (const int pattern : {0, 1, 2, 3}) {  // none, all, sparse, runs
+      const auto value = static_cast<std::uint8_t>(std::min(byte(0, 255), 255));
+      const std::uint8_t near[] = {static_cast<std::uint8_t>(value ^ 0x80),
+                                   static_cast<std::uint8_t>(value ^ 0x01)};
+      for (std::uint8_t& b : layer) {
+        const int r = byte(0, 3);
+        b = r < 2 ? near[r] : static_cast<std::uint8_t>(std::min(byte(0, 255), 255));
+        if (b == value) b = near[0];
+        if (pattern == 1 || (pattern == 2 && rng.Uniform(0.0, 1.0) < 0.05)) b = value;
+      }
+      if (pattern == 3) {
+        for (int run = 0; run < 200; ++run) {
+          const auto k0 = static_cast<std::size_t>(rng.Uniform(0.0, static_cast<double>(cells)));
+          const std::size_t len = static_cast<std::size_t>(byte(1, 20));
+          for (std::size_t k = k0; k < std::min(cells, k0 + len); ++k) layer[k] = value;
+        }
+      }
+      fast.clear();
+      plain.clear();
+      g.ForEachWeightedCellWhere(std::span<const std::uint8_t>(layer), ByteIs{value}, into(fast));
+      g.ForEachWeightedCellWhere(
+          std::span<const std::uint8_t>(layer), [value](std::uint8_t b) { return b == value; },
+          into(plain));
+      INFO("seed " << seed << " step " << step << " pattern " << pattern << " value "
+                   << static_cast<int>(value));
+      CHECK(fast == plain);
+      if (pattern == 0) CHECK(fast.empty());
+      if (pattern != 0) CHECK(!fast.empty());
+      kept_calls += fast.size();
+    }
+  }
+  CHECK(kept_calls > 0);
+}
+
 TEST_CASE("ExportMeanVelocities gives Cell's mean velocities of every cell, as float",
           "[filter][grid][property]") {
   // The ego moves by fractions of a cell each step, so the storage origin wraps in both axes and
