@@ -13,7 +13,7 @@ namespace dualgrid::outputs {
 namespace {
 constexpr double kBoundsMargin = 1e-6;  // [m]
 
-// `a` if `keep`, else +0.0, without a branch (which particles of a run count is unpredictable).
+// `a` if `keep`, else +0.0, without a branch (which particles move with the box is unpredictable).
 // Adding +0.0 leaves a sum's bits alone unless the sum is -0.0, and the sums below start at +0.0,
 // so never are: they equal the sums of the kept values alone.
 inline double KeepIf(double a, bool keep) {
@@ -60,14 +60,13 @@ BoxWeights ParticleRuns::Sum(const OrientedBox& box, const Velocity& velocity) c
       continue;
     for (std::size_t i = first, end = std::min(n, first + kRun); i < end; ++i) {
       const double x = p_.x[i], y = p_.y[i];
-      const bool in = !(x < lo.x()) & !(x > hi.x()) & !(y < lo.y()) & !(y > hi.y()) &
-                      inside.Contains(Position(x, y));
-      const bool good =
-          in & ((Velocity(p_.vx[i], p_.vy[i]) - v).norm() < WeightTrace::kGoodVelocity);
+      if (x < lo.x() || x > hi.x() || y < lo.y() || y > hi.y()) continue;
+      if (!inside.Contains(Position(x, y))) continue;
+      const bool good = (Velocity(p_.vx[i], p_.vy[i]) - v).norm() < WeightTrace::kGoodVelocity;
       const double pw = p_.w_position[i], vw = p_.w_velocity[i];
-      wp += KeepIf(pw, in);
-      wv += KeepIf(vw, in);
-      w += KeepIf(p_.weight[i], in);
+      wp += pw;
+      wv += vw;
+      w += p_.weight[i];
       wp_good += KeepIf(pw, good);
       wv_good += KeepIf(vw, good);
     }
