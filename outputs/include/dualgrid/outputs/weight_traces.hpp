@@ -42,9 +42,10 @@ class ParticleRuns {
  public:
   static constexpr std::size_t kRun = 16;  ///< particles per run
   explicit ParticleRuns(const filter::ParticleSet& particles);
-  /// The sums over the particles inside `box` (BoxTest::Contains, same frame as the particles),
-  /// added in increasing index order: the same bits as a scan of every particle. `velocity`
-  /// [m/s] is the box's, compared with each particle's for the "good" shares.
+  /// The sums over the particles inside `box` (within its axis-aligned bounds grown by 1e-6 m and
+  /// BoxTest::Contains; same frame as the particles), added in increasing index order: the same
+  /// bits as a scan of every particle. `velocity` [m/s] is the box's, compared with each
+  /// particle's for the "good" shares.
   BoxWeights Sum(const OrientedBox& box, const Velocity& velocity) const;
 
  private:
