@@ -7,7 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "dualgrid/core/types.hpp"
 #include "dualgrid/cosim/pipeline.hpp"
+#include "dualgrid/filter/particles.hpp"
 
 namespace dualgrid::outputs {
 
@@ -21,6 +23,34 @@ struct WeightTrace {
   std::vector<double> position_share, velocity_share;
   /// Share of the object's detections whose |compensated Doppler| is below half its speed.
   std::vector<double> tangential_share;
+};
+
+/// Weight sums of the particles inside one box (paper Fig. 4): all three weights, and the position
+/// and velocity weights of the particles whose velocity is within WeightTrace::kGoodVelocity of
+/// the box's.
+struct BoxWeights {
+  double w_position = 0.0, w_velocity = 0.0, weight = 0.0;
+  double w_position_good = 0.0, w_velocity_good = 0.0;
+};
+
+/// A particle set cut into runs of kRun consecutive indices with each run's axis-aligned bounds,
+/// so that a box's sums read only the runs that can hold a particle inside it. Building is one
+/// pass over the particles; Sum is O(runs + particles of the runs overlapping the box), cheap
+/// where the set is roughly sorted by position (the filter's particles are, by cell). Keeps a
+/// reference to `particles`, which must outlive it unchanged.
+class ParticleRuns {
+ public:
+  static constexpr std::size_t kRun = 16;  ///< particles per run
+  explicit ParticleRuns(const filter::ParticleSet& particles);
+  /// The sums over the particles inside `box` (within its axis-aligned bounds grown by 1e-6 m and
+  /// BoxTest::Contains; same frame as the particles), added in increasing index order: the same
+  /// bits as a scan of every particle. `velocity` [m/s] is the box's, compared with each
+  /// particle's for the "good" shares.
+  BoxWeights Sum(const OrientedBox& box, const Velocity& velocity) const;
+
+ private:
+  const filter::ParticleSet& p_;
+  std::vector<double> bounds_;  // per run: lowest x, highest x, lowest y, highest y [m]
 };
 
 /// Weight traces of every vehicle in the grid (paper Fig. 4), from one filter's particles.
