@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <omp.h>
+
 #include "scan_geometry.hpp"
 #include "sensor_scan.hpp"
 
@@ -25,6 +27,7 @@ struct StepScratch {
   std::vector<ScanScratch> sensors;
   std::vector<TargetGeometry> targets;
   RailWalkScratch rails;
+  std::vector<RailWalkScratch> rail_groups;  // Scan's groups of sensors, one per thread
 };
 
 StepScratch& Scratch() {
@@ -235,9 +238,16 @@ std::vector<Detection> RadarModel::Scan(const EgoMotion& ego, const Scene& scene
   for (int i = 0; i < n; ++i)
     scans[i].emplace(params_[due[i]], models_[due[i]], options_, ego, scene, scratch.targets,
                      scratch.sensors[i]);
-  std::vector<SensorScan*> walking;
-  for (std::optional<SensorScan>& scan : scans) walking.push_back(&*scan);
-  ScanRails(walking, scratch.rails);
+  // Called outside a parallel region with threads to spare (dualgrid sim, Python), the sensors'
+  // rails are walked in groups, one per thread; a sensor's samples do not depend on its group.
+  const int groups = omp_in_parallel() ? 1 : std::max(1, std::min(n, omp_get_max_threads()));
+  if (static_cast<int>(scratch.rail_groups.size()) < groups) scratch.rail_groups.resize(groups);
+#pragma omp parallel for schedule(static, 1) if (groups > 1)
+  for (int g = 0; g < groups; ++g) {
+    std::vector<SensorScan*> walking;
+    for (int i = g; i < n; i += groups) walking.push_back(&*scans[i]);
+    ScanRails(walking, scratch.rail_groups[g]);
+  }
 #pragma omp parallel for schedule(dynamic, 1)
   for (int i = 0; i < n; ++i) {
     scans[i]->AddGhosts();
