@@ -19,6 +19,7 @@
 #include "dualgrid/outputs/video.hpp"
 #include "dualgrid/outputs/viewer.hpp"
 #include "dualgrid/sim/sumo_simulation.hpp"
+#include "pictures.hpp"
 
 namespace dualgrid::outputs {
 
@@ -190,37 +191,67 @@ std::string WriteResults(const cosim::CoSimulation& cosim, const scenario::Scena
   return table.ToMarkdown();
 }
 
-// figures/weights.* and figures/tracked_share{,_v}.*: failures are warnings.
-void WriteRunFigures(const cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
-                     const RunFolderOptions& o, const std::vector<eval::ScenarioMetrics>& metrics,
-                     const WeightTraces& traces, std::size_t trace_mode,
-                     std::vector<std::string>* warnings) {
-  const std::vector<std::string>& modes = cosim.mode_names();
-  const std::string focus = traces.Focus();
-  if (!focus.empty()) {
-    TryFigures(
-        o.out / "figures" / "weights.png", o.figure_formats,
-        [&](const auto& p) {
-          RenderWeightTrace(traces.by_vehicle.at(focus), focus, modes[trace_mode],
-                            config.filter.velocity_likelihood, p, o.figure_captions);
-        },
-        warnings);
+// figures/weights.* and figures/tracked_share{,_v}.*, drawn by Draw on any one thread (the run's
+// output worker) from copies of what they show: the job outlives nothing it reads. A figure that
+// fails leaves its warning in `failures`, for the caller to publish in order.
+struct EndFigures {
+  EndFigures(const cosim::CoSimulation& cosim, const scenario::ScenarioConfig& config,
+             const RunFolderOptions& o, const std::vector<eval::ScenarioMetrics>& metrics,
+             const WeightTraces& traces, std::size_t trace_mode)
+      : dir(o.out / "figures"),
+        formats(o.figure_formats),
+        captions(o.figure_captions),
+        words(WordsFor(o.references)),
+        modes(cosim.mode_names()),
+        trace_mode_name(modes[trace_mode]),
+        focus(traces.Focus()),
+        likelihood(config.filter.velocity_likelihood),
+        title_start(config.sim.name + ": tracked share "),
+        title_end(" per object (seed " + std::to_string(config.sim.seed) + ")") {
+    if (!focus.empty()) trace = traces.by_vehicle.at(focus);
+    for (const bool v : {false, true})
+      shares.push_back(RunTrackedShares(metrics, cosim.pipeline().ids(), v));
   }
-  for (const bool v : {false, true}) {
-    const auto png = o.out / "figures" / (v ? "tracked_share_v.png" : "tracked_share.png");
-    const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
-    TryFigures(
-        png, o.figure_formats,
-        [&](const auto& p) {
-          RenderTrackedShares(modes, RunTrackedShares(metrics, cosim.pipeline().ids(), v),
-                              config.sim.name + ": tracked share " + what + " per object (seed " +
-                                  std::to_string(config.sim.seed) + ")",
-                              "tracked share " + what + " [%]", p, {}, o.figure_captions,
-                              WordsFor(o.references));
-        },
-        warnings);
+
+  // The files Draw writes, relative to the run folder (in the order drawn).
+  std::vector<std::string> Files() const {
+    std::vector<std::string> files;
+    for (const std::string stem : {"weights", "tracked_share", "tracked_share_v"})
+      if (stem != "weights" || !focus.empty())
+        for (const std::string& f : formats) files.push_back("figures/" + stem + "." + f);
+    return files;
   }
-}
+
+  void Draw() {
+    if (!focus.empty())
+      Keep(DrawFigures(dir / "weights.png", formats, [&](const auto& p) {
+        RenderWeightTrace(trace, focus, trace_mode_name, likelihood, p, captions);
+      }));
+    for (const bool v : {false, true}) {
+      const std::string what = v ? "D_v (tracked with the right velocity)" : "D";
+      Keep(DrawFigures(
+          dir / (v ? "tracked_share_v.png" : "tracked_share.png"), formats, [&](const auto& p) {
+            RenderTrackedShares(modes, shares[v], title_start + what + title_end,
+                                "tracked share " + what + " [%]", p, {}, captions, words);
+          }));
+    }
+  }
+  void Keep(const std::vector<std::string>& f) {
+    failures.insert(failures.end(), f.begin(), f.end());
+  }
+
+  std::filesystem::path dir;
+  std::vector<std::string> formats;
+  bool captions;
+  ReferenceWords words;
+  std::vector<std::string> modes;
+  std::string trace_mode_name, focus;
+  filter::VelocityLikelihood likelihood;
+  std::string title_start, title_end;
+  WeightTrace trace;
+  std::vector<TrackedShares> shares;  // D, then D_v
+  std::vector<std::string> failures;
+};
 
 // replay.html and replay.mp4 from the finished recording: failures are warnings.
 void WriteReplayFiles(const RunFolderOptions& o, const Callbacks& callbacks,
@@ -319,26 +350,34 @@ RunFolderResult WriteRunFolder(cosim::CoSimulation& cosim, const scenario::Scena
   const nlohmann::json metrics_json = MetricsJson(cosim, config, metrics);
   r.table_markdown = WriteResults(cosim, config, o.out, recorded, metrics, metrics_json, r.status,
                                   observers.files.traces());
+  // The end figures go to the output worker behind the step pictures (cairo numbers its
+  // surfaces process-wide: every figure is drawn on that one thread, in the same order as ever),
+  // and are drawn while this thread finishes the recording and digests the files before them.
+  std::shared_ptr<EndFigures> figures;
+  std::future<void> figures_done;
+  if (o.figures && !r.stop) {
+    figures = std::make_shared<EndFigures>(cosim, config, o, metrics, observers.files.traces(),
+                                           observers.trace_mode);
+    figures_done = observers.worker.Post([figures] { figures->Draw(); });
+  }
   // The step pictures' warnings, then the recording's (as they came when drawn in line).
   observers.pictures.Finish();
-  // After the results, before the figures: a failure here costs only the replay.
+  // After the results: a failure here costs only the replay.
   const bool recording = observers.recording &&
                          observers.recording->Finish(metrics_json["modes"], cosim.pipeline().ids(),
                                                      r.complete, r.status);
-  // Every file written so far is final: the output worker digests them while this thread draws
-  // the figures (cairo stays on one thread, in the same order as ever).
-  const auto early = std::make_shared<FileDigests>();
-  std::future<void> early_done =
-      observers.worker.Post([early, &o] { *early = FolderDigests(o.out); });
-  if (o.figures && !r.stop)
-    WriteRunFigures(cosim, config, o, metrics, observers.files.traces(), observers.trace_mode,
-                    &r.warnings);
+  // Every file but the end figures is final now: digested while the worker draws those.
+  const FileDigests early =
+      FolderDigests(o.out, figures ? figures->Files() : std::vector<std::string>{});
+  if (figures) {
+    figures_done.get();  // Draw keeps its failures: it does not throw
+    for (const std::string& failure : figures->failures) PublishWarning(failure, &r.warnings);
+  }
   if (recording && !r.stop && (o.video || o.viewer)) WriteReplayFiles(o, callbacks, &r.warnings);
-  early_done.get();
 
   // Written last: a run folder without summary.json did not finish.
   AddSummary(cosim, config, r, observers, recorded, &summary);
-  summary["digests"] = OutputDigests(o.out, *early);
+  summary["digests"] = OutputDigests(o.out, early);
   SealOutputFolder(o.out);
   WriteTextFile(o.out / "summary.json", summary.dump(2) + "\n");
   return r;

@@ -55,11 +55,13 @@ FileDigest DigestFile(const std::filesystem::path& f, std::vector<char>& buf) {
 
 }  // namespace
 
-FileDigests FolderDigests(const std::filesystem::path& dir) {
+FileDigests FolderDigests(const std::filesystem::path& dir, const std::vector<std::string>& skip) {
   FileDigests digests;
   std::vector<char> buf(1 << 16);
-  for (const auto& f : DigestedFiles(dir))
-    digests[std::filesystem::relative(f, dir).string()] = DigestFile(f, buf);
+  for (const auto& f : DigestedFiles(dir)) {
+    const std::string name = std::filesystem::relative(f, dir).string();
+    if (std::find(skip.begin(), skip.end(), name) == skip.end()) digests[name] = DigestFile(f, buf);
+  }
   return digests;
 }
 

@@ -84,3 +84,19 @@ TEST_CASE("an early digest is used only while its file's size and time are uncha
   fs::last_write_time(dir / "a.csv", early.at("a.csv").modified + std::chrono::seconds(5));
   CHECK(OutputDigests(dir, early).at("a.csv") == Fnv("9,9\n"));
 }
+
+TEST_CASE("early digests leave out the files being written, which the end digests read",
+          "[digests]") {
+  const fs::path dir = Folder("skip");
+  Write(dir / "table.md", "| a |\n");
+  Write(dir / "figures" / "weights.png", "half");  // the output worker is still writing it
+  const FileDigests early = FolderDigests(dir, {"figures/weights.png", "figures/absent.svg"});
+  CHECK(early.size() == 1);
+  CHECK(early.count("table.md") == 1);
+  CHECK(early.count("figures/weights.png") == 0);
+  // Finished with the same size and (coarse clocks) possibly the same time: still read again.
+  Write(dir / "figures" / "weights.png", "done");
+  const nlohmann::json d = OutputDigests(dir, early);
+  CHECK(d.at("figures/weights.png") == Fnv("done"));
+  CHECK(d == OutputDigests(dir));
+}

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -39,8 +40,11 @@ bool FaultInjected(const std::string& what);
 nlohmann::json OutputDigests(const std::filesystem::path& dir, const FileDigests& earlier = {});
 
 /// The digests OutputDigests would give for the files under `dir` now, each with the size and
-/// modification time it had when read (relative path -> digest). Throws as OutputDigests.
-FileDigests FolderDigests(const std::filesystem::path& dir);
+/// modification time it had when read (relative path -> digest), leaving out the files named in
+/// `skip` (paths relative to `dir`, e.g. files another thread is writing). Throws as
+/// OutputDigests.
+FileDigests FolderDigests(const std::filesystem::path& dir,
+                          const std::vector<std::string>& skip = {});
 
 /// After Start(), when `ego: {from_routes: auto}` chose the ego: prints to stderr the vehicle it
 /// chose and why (unless `quiet`), and a warning when no vehicle ever had another in its grid
