@@ -64,16 +64,18 @@ bool CoSimulation::Step() {
 // The modes run concurrently, one thread each, in one parallel region per step instead of ~40 (the
 // filters' regions and barriers, three times): robust when another process shares the cores
 // (docs/performance.md). With one mode (or one thread) the filter's own loops are parallel
-// instead. Which thread filters which mode is fixed (ModeSchedule), not left to a task queue: a
+// instead. Which thread filters which mode is planned (ModeSchedule), not left to a task queue: a
 // filter's state (~2-3 MB) then stays in the cache of the core that updated it last step, and its
-// snapshot is taken there at once. With tasks, a mode moved between cores from step to step and
-// every pass over its cells paid for the move (+28 % CPU time on the recorded loop,
-// docs/performance.md). The rest of the step (StepRegion's tasks: the truth, the scoring, the
-// next step's reading and measurement grid, the observers' Prepare parts, the next cycle's noise)
-// is taken by whichever thread is
-// free first (TaskBoard), so that a thread slowed down (by another process, or the output thread)
-// does not leave the other idle at the region's end. Results do not depend on either: every value
-// is computed by one thread from the same inputs.
+// snapshot is taken there at once. With free tasks, a mode moved between cores from step to step
+// and every pass over its cells paid for the move (+28 % CPU time on the recorded loop,
+// docs/performance.md). Only a filter whose thread has not started it when another thread has
+// nothing else left to do moves (StepRegion: its owner was preempted, e.g. by the output thread,
+// or the region got fewer threads than planned). The rest of the step (StepRegion's tasks: the
+// truth, the scoring, the next step's reading and measurement grid, the observers' Prepare
+// parts, the next cycle's noise) is taken by whichever thread is free first (TaskBoard), so that
+// a thread slowed down (by another process, or the output thread) does not leave the other idle
+// at the region's end. Results do not depend on either: every value is computed by one thread
+// from the same inputs.
 std::vector<std::exception_ptr> CoSimulation::FilterAndScore(const StepView& view) {
   const int modes = static_cast<int>(mode_names_.size());
   objects_.clear();
@@ -99,10 +101,8 @@ std::vector<std::exception_ptr> CoSimulation::FilterAndScore(const StepView& vie
   // Reading ahead only when a thread filters fewer modes than another (3 modes on 2 threads):
   // otherwise there is no time to spare in the region, and Advance does it all between regions.
   StepRegion region(*this, view, read_ahead_ && team > 1 && modes % team != 0);
-  const auto run_thread = [&](int t) {
-    for (int m : schedule.filters(t)) region.Filter(m);
-    region.Work(schedule.filters(t));
-  };
+  // Thread t filters its modes first; another takes one only when the owner is late (StepRegion).
+  const auto run_thread = [&](int t) { region.Work(schedule.filters(t)); };
   if (team == 1) {
     // No enclosing region: an inactive one (if (false)) still counts as a nesting level, and
     // libgomp then started new threads for the filter's own regions in every step (measured:

@@ -15,7 +15,7 @@ StepRegion::StepRegion(CoSimulation& cs, const StepView& view, bool read_ahead)
       errors_(modes_),
       observer_errors_(cs.observers_.size() * static_cast<std::size_t>(1 + 2 * modes_)),
       filtered_(std::make_unique<std::atomic<int>[]>(modes_)),
-      board_(NoiseTask() + 1) {
+      board_(FilterTask(modes_)) {
   // Labelled recorded points, scored per mode at their cells.
   Pipeline& p = cs_.pipeline_;
   cs_.point_positions_.clear();
@@ -40,11 +40,11 @@ void StepRegion::Filter(int m) {
   filtered_[m].store(errors_[m] ? kFilterFailed : kFilterOk, std::memory_order_release);
   if (!errors_[m]) filters_ok_.fetch_add(1, std::memory_order_acq_rel);
   filters_done_.fetch_add(1, std::memory_order_acq_rel);
-  board_.Wake();
 }
 
 void StepRegion::Work(std::span<const int> own) {
   std::vector<int> preferred;
+  for (int m : own) preferred.push_back(FilterTask(m));
   for (int m : own) preferred.push_back(FilteredTask(m));
   for (int m : own) preferred.push_back(ScoredTask(m));
   board_.Work([this](int task) { return Ready(task); }, [this](int task) { Run(task); }, preferred);
@@ -62,7 +62,7 @@ bool StepRegion::Ready(int task) const {
     default:
       break;
   }
-  if (task == NoiseTask()) return true;
+  if (task >= NoiseTask()) return true;  // the noise and the filters: inputs complete
   if (task == ObserveStepTask()) return board_.done(kTruth) && board_.done(kReadAhead);
   if (task >= ScoredTask(0)) {
     const int m = task - ScoredTask(0);
@@ -102,7 +102,9 @@ void StepRegion::Run(int task) {
       break;
   }
   using Part = StepObserver::Part;
-  if (task == NoiseTask()) {
+  if (task >= FilterTask(0)) {
+    Filter(task - FilterTask(0));
+  } else if (task == NoiseTask()) {
     Guarded(noise_error_, [&] { p.DrawNoise(true); });  // the other slot: no race
   } else if (task == ObserveStepTask()) {
     Observe(Part::kStep, -1, 0);

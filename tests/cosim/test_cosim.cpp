@@ -6,7 +6,11 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -206,6 +210,63 @@ TEST_CASE("CoSimulation: observers' Prepare parts run after their inputs, before
     CHECK(c.parts.load() == cs.steps() * (1 + 2 * 3));
     CHECK(r.steps.size() == static_cast<std::size_t>(cs.steps()));
   }
+}
+
+// Called inside the caller's own active parallel region, the step's region gets one thread
+// (nested regions stay off) although the schedule plans two: the filters planned for the missing
+// thread are taken by the one there (StepRegion: a filter whose owner has not started it), as a
+// late or preempted owner's are. Before, they were never run and the step waited for them for
+// ever: the other thread of this team stops the test then instead of letting it hang.
+TEST_CASE("CoSimulation: inside the caller's parallel region one thread filters every mode",
+          "[cosim][sumo]") {
+  auto config = Highway(2.0);
+  Recorder two;
+  const auto m2 = [&] {
+    cosim::CoSimulation cs(config, {.threads = 2});
+    cs.Start(sim::DefaultNetworkDir(), WorkDir("nested_ref"));
+    cs.AddObserver(&two);
+    while (cs.Step()) {
+    }
+    return cs.Metrics();
+  }();
+  Recorder nested;
+  PartChecker c(3, static_cast<std::size_t>(config.filter.CellsX() * config.filter.CellsY()),
+                config.sim.StepCount());
+  std::vector<eval::ScenarioMetrics> m1;
+  int steps = 0;
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool done = false;
+#pragma omp parallel num_threads(2)
+  {
+    if (omp_get_thread_num() == 0) {
+      cosim::CoSimulation cs(config, {.threads = 2});
+      cs.Start(sim::DefaultNetworkDir(), WorkDir("nested"));
+      cs.AddObserver(&c);
+      cs.AddObserver(&nested);
+      while (cs.Step()) {
+      }
+      steps = cs.steps();
+      m1 = cs.Metrics();
+      const std::lock_guard<std::mutex> lock(mutex);
+      done = true;
+      cv.notify_all();
+    } else {
+      std::unique_lock<std::mutex> lock(mutex);
+      if (!cv.wait_for(lock, std::chrono::seconds(300), [&] { return done; })) {
+        std::fprintf(stderr, "test_cosim: the step inside a parallel region hangs\n");
+        std::abort();
+      }
+    }
+  }
+  REQUIRE(steps == config.sim.StepCount());
+  for (const auto& f : c.failures) UNSCOPED_INFO(f);
+  CHECK(c.bad.load() == 0);
+  CHECK(c.parts.load() == steps * (1 + 2 * 3));
+  CHECK(nested.digests == two.digests);
+  REQUIRE(m1.size() == 3u);
+  REQUIRE(m2.size() == 3u);
+  for (std::size_t m = 0; m < 3; ++m) CHECK(nlohmann::json(m1[m]) == nlohmann::json(m2[m]));
 }
 
 struct PrepareThrower : cosim::StepObserver {

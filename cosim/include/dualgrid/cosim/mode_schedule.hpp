@@ -19,7 +19,8 @@ class ModeSchedule {
   /// modes; more keep m % threads; ties and anything not strictly better than m % threads keep
   /// m % threads). Only the filters are placed: the rest of a step (the truth, the scoring, the
   /// reading ahead) goes to whichever thread is free (StepRegion, TaskBoard). A thread filters
-  /// its modes in increasing m.
+  /// its modes in increasing m; another thread takes one only when that thread has not started
+  /// it and the other has nothing else left to do (StepRegion).
   /// Throws std::invalid_argument outside these ranges, for a cost count other than `modes` or a
   /// negative or non-finite cost.
   ModeSchedule(int modes, int threads, std::span<const double> costs = {});
