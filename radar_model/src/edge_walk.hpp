@@ -2,15 +2,20 @@
 // (scan_geometry.hpp) emits, bit for bit, with the edges on SIMD lanes.
 #pragma once
 
+#include <limits>
+
 #include "dualgrid/core/types.hpp"
 
 namespace dualgrid::radar::detail {
 
 /// An edge a -> b [m] (world frame), walked for the sensor cones[cone] (the multi-cone
-/// WalkEdges; the one-cone overload ignores `cone`).
+/// WalkEdges; the one-cone overload ignores `cone`). The walk stops at the first sample that
+/// starts at or beyond `stop` [m along the edge] (the caller's proof that no later sample can be
+/// kept: its samples are those of the whole walk up to there); infinity walks the whole edge.
 struct Edge {
   Position a, b;
   int cone = 0;
+  double stop = std::numeric_limits<double>::infinity();
 };
 
 /// What the scan's first tests need of a sensor (RadarModel::VisibleScatterers' `consider`): a

@@ -32,6 +32,15 @@ constexpr double kEgoBodySkin = 1e-3;
 // its far corner, hidden behind the near one (docs/radar.md step 2).
 constexpr double kMinGrazingSin = 0.0087;  // sin(0.5 deg)
 
+/// Margins of the proofs that cut a rail piece's walk (SensorScan::CutRailWalks), far above the
+/// rounding of the walk's samples (~1e-12 m) and of the scan's tests: an angle [rad] added to the
+/// half field of view, a distance [m] to a half-plane or line, a share of an occluder's length
+/// kept from its ends, the least sine of the angle a line of sight meets an occluder at.
+constexpr double kFovCutAngle = 1e-4;
+constexpr double kCutDistance = 1e-3;
+constexpr double kCutShare = 1e-3;
+constexpr double kCutSine = 1e-2;
+
 /// Margin on the cosine of a half field of view [-]: far above the rounding of a cosine, a norm
 /// and atan2 (~1e-15), far below any geometry that matters (1e-9 in cosine is >= 1e-9 rad).
 constexpr double kFovCosMargin = 1e-9;

@@ -83,6 +83,7 @@ SensorScan::SensorScan(const SensorParams& p, const SensorModel& model, const Mo
   CullTargets();
   CullRails();
   FillBins();
+  CutRailWalks();
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
   scratch.scatterers.clear();
   AddBoxes();
@@ -169,6 +170,73 @@ void SensorScan::FillBins() {
       for (int bi = std::max(first, 0); bi <= std::min(last, kAzimuthBins - 1); ++bi)
         bins[bi].push_back(static_cast<int>(k));
     }
+  }
+}
+
+// Where a rail piece's walk may stop: every sample beyond lies outside the field of view widened
+// by kFovCutAngle, by at least kCutDistance, so OutsideFov (whose margin is 1e-9 in cosine, and
+// whose rounding is ~1e-15 of the range) rejects it. The wedge |azimuth| <= h' is the
+// intersection of two half-planes when h' < pi / 2: along the piece, local(t) = la + t ld, each
+// half-plane's signed distance is linear in t, g(t) = c + t k; once g < -kCutDistance with k < 0
+// it stays so. Infinity when the field of view is too wide or narrow for this.
+double SensorScan::FovWalkEnd(const RailPiece& piece) const {
+  const double h = half_fov_ + kFovCutAngle;
+  if (!(half_fov_ >= 1e-3 && h <= 0.5 * kPi - 1e-3)) return std::numeric_limits<double>::infinity();
+  const double len = (piece.b - piece.a).norm();
+  if (!(len > 0.0)) return std::numeric_limits<double>::infinity();
+  const Vector2 la = LocalOf(piece.a), ld = to_local_ * ((piece.b - piece.a) / len);
+  const double sin_h = std::sin(h), cos_h = std::cos(h);
+  double end = std::numeric_limits<double>::infinity();
+  for (const double side : {-1.0, 1.0}) {  // g = x sin h' -+ y cos h' (inside: g >= 0)
+    const double c = la.x() * sin_h + side * la.y() * cos_h;
+    const double k = ld.x() * sin_h + side * ld.y() * cos_h;
+    if (k < 0.0) end = std::min(end, std::max(0.0, (c + 2.0 * kCutDistance) / -k));
+  }
+  return end;
+}
+
+// Does rail occluder `o` hide every point of the segment p0 -> p1 in BehindOthers (o.owner is not
+// the points' owner)? Sufficient, with margins far above rounding: s and the segment lie on
+// opposite sides of o's line, the segment more than the occlusion shrink plus kCutDistance beyond
+// it, so each shrunk line of sight crosses the line strictly inside (0 < t < 1); the lines of
+// sight to p0 and p1 meet o at a parameter u inside [kCutShare, 1 - kCutShare] at an angle whose
+// sine is at least kCutSine, and so do those to every point between (the direction turns
+// monotonically along the segment, by less than a half turn). Such a point's direction lies
+// inside o's angular interval (the dot test and the azimuth bins, which have a bin of slack, list
+// o), its range exceeds o.min_distance, and SegmentsIntersect finds the crossing.
+bool SensorScan::HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const {
+  const Vector2 sv = o.b - o.a;
+  const double len = sv.norm();
+  if (o.is_box || !(len >= 1e-2)) return false;
+  const double side_s = Cross(sv, s_ - o.a) / len;
+  if (!(std::abs(side_s) >= kCutDistance)) return false;
+  for (const Position& p : {p0, p1}) {
+    if (!(Cross(sv, p - o.a) / len * (side_s > 0.0 ? -1.0 : 1.0) >=
+          kOcclusionShrink + kCutDistance))
+      return false;
+    const Vector2 r = p - s_;
+    const double denom = Cross(sv, r);
+    if (!(std::abs(denom) >= kCutSine * len * r.norm())) return false;
+    const double u = Cross(s_ - o.a, r) / denom;
+    if (!(u >= kCutShare && u <= 1.0 - kCutShare)) return false;
+  }
+  return true;
+}
+
+// Each rail piece's walk_end: the end of the field of view along it, or 0 when another rail
+// piece hides all of it that lies in view (the median barrier hides the far carriageway's rail).
+void SensorScan::CutRailWalks() {
+  for (RailPiece& piece : scratch_.rail_pieces) {
+    piece.walk_end = FovWalkEnd(piece);
+    if (!options_.occlusion) continue;
+    const double len = (piece.b - piece.a).norm();
+    const Position end =
+        piece.walk_end < len ? piece.a + piece.walk_end * ((piece.b - piece.a) / len) : piece.b;
+    for (const Occluder& o : scratch_.occluders)
+      if (o.owner != -1 - piece.segment && HidesWhole(o, piece.a, end)) {
+        piece.walk_end = 0.0;
+        break;
+      }
   }
 }
 
@@ -271,7 +339,7 @@ void SensorScan::AddGhosts() {
   AddGhostScatterers(view, options_.multipath, scene_, occluded, &scratch_.scatterers);
 }
 
-void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch) {
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, bool cut) {
   std::vector<Edge>& edges = scratch.edges;
   std::vector<SensorCone>& cones = scratch.cones;
   std::vector<std::pair<int, int>>& owner_of = scratch.owner_of;
@@ -282,7 +350,9 @@ void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch) {
     cones.push_back(scans[j]->cone());
     const std::vector<RailPiece>& pieces = scans[j]->rail_pieces();
     for (std::size_t k = 0; k < pieces.size(); ++k) {
-      edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
+      if (cut && pieces[k].walk_end == 0.0) continue;
+      edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j),
+                       cut ? pieces[k].walk_end : std::numeric_limits<double>::infinity()});
       owner_of.emplace_back(static_cast<int>(j), static_cast<int>(k));
     }
   }

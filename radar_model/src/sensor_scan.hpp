@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -23,6 +24,9 @@ struct RailPiece {
   Position a, b;     ///< [m] world
   int segment;       ///< the segment's index over all polylines
   double rcs_per_m;  ///< [m^2 / m]
+  /// [m along a -> b] no sample whose walk starts here or beyond passes the scan's tests (Edge::
+  /// stop); infinity: none known; 0: the whole piece is hidden (not walked).
+  double walk_end = std::numeric_limits<double>::infinity();
 };
 
 /// What the scan needs of a target whatever the sensor, computed once per step (the same values
@@ -78,6 +82,9 @@ class SensorScan {
   void CullTargets();
   void CullRails();
   void FillBins();
+  void CutRailWalks();
+  double FovWalkEnd(const RailPiece& piece) const;
+  bool HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const;
   void AddBoxes();
   Position LocalOf(const Position& q) const { return to_local_ * (q - s_); }
   bool InFov(const Interval& iv) const;
@@ -114,7 +121,9 @@ struct RailWalkScratch {
 };
 
 /// Step 3 of every scan of `scans`: their rail pieces walked together (WalkEdges with one cone
-/// per scan), each kept sample handed to its scan, then FinishRails.
-void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch);
+/// per scan), each kept sample handed to its scan, then FinishRails. Each piece is walked up to
+/// its walk_end (a hidden piece not at all); with `cut` false every piece is walked whole (the
+/// same scatterers: the reference of the tests).
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, bool cut = true);
 
 }  // namespace dualgrid::radar::detail
