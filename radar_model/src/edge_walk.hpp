@@ -9,13 +9,15 @@
 namespace dualgrid::radar::detail {
 
 /// An edge a -> b [m] (world frame), walked for the sensor cones[cone] (the multi-cone
-/// WalkEdges; the one-cone overload ignores `cone`). The walk stops at the first sample that
-/// starts at or beyond `stop` [m along the edge] (the caller's proof that no later sample can be
-/// kept: its samples are those of the whole walk up to there); infinity walks the whole edge.
+/// WalkEdges; the one-cone overload ignores `cone`). Parameters along the edge [m], from the
+/// caller's proof that the scan rejects the samples they leave out: samples whose midpoint lies
+/// before `begin` are walked but not handed on; the walk stops at the first sample that starts at
+/// or beyond `stop`. The samples handed on are those of the whole walk, bit for bit.
 struct Edge {
   Position a, b;
   int cone = 0;
   double stop = std::numeric_limits<double>::infinity();
+  double begin = 0.0;
 };
 
 /// What the scan's first tests need of a sensor (RadarModel::VisibleScatterers' `consider`): a

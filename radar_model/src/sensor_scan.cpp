@@ -173,28 +173,6 @@ void SensorScan::FillBins() {
   }
 }
 
-// Where a rail piece's walk may stop: every sample beyond lies outside the field of view widened
-// by kFovCutAngle, by at least kCutDistance, so OutsideFov (whose margin is 1e-9 in cosine, and
-// whose rounding is ~1e-15 of the range) rejects it. The wedge |azimuth| <= h' is the
-// intersection of two half-planes when h' < pi / 2: along the piece, local(t) = la + t ld, each
-// half-plane's signed distance is linear in t, g(t) = c + t k; once g < -kCutDistance with k < 0
-// it stays so. Infinity when the field of view is too wide or narrow for this.
-double SensorScan::FovWalkEnd(const RailPiece& piece) const {
-  const double h = half_fov_ + kFovCutAngle;
-  if (!(half_fov_ >= 1e-3 && h <= 0.5 * kPi - 1e-3)) return std::numeric_limits<double>::infinity();
-  const double len = (piece.b - piece.a).norm();
-  if (!(len > 0.0)) return std::numeric_limits<double>::infinity();
-  const Vector2 la = LocalOf(piece.a), ld = to_local_ * ((piece.b - piece.a) / len);
-  const double sin_h = std::sin(h), cos_h = std::cos(h);
-  double end = std::numeric_limits<double>::infinity();
-  for (const double side : {-1.0, 1.0}) {  // g = x sin h' -+ y cos h' (inside: g >= 0)
-    const double c = la.x() * sin_h + side * la.y() * cos_h;
-    const double k = ld.x() * sin_h + side * ld.y() * cos_h;
-    if (k < 0.0) end = std::min(end, std::max(0.0, (c + 2.0 * kCutDistance) / -k));
-  }
-  return end;
-}
-
 // Does rail occluder `o` hide every point of the segment p0 -> p1 in BehindOthers (o.owner is not
 // the points' owner)? Sufficient, with margins far above rounding: s and the segment lie on
 // opposite sides of o's line, the segment more than the occlusion shrink plus kCutDistance beyond
@@ -223,21 +201,99 @@ bool SensorScan::HidesWhole(const Occluder& o, const Position& p0, const Positio
   return true;
 }
 
-// Each rail piece's walk_end: the end of the field of view along it, or 0 when another rail
-// piece hides all of it that lies in view (the median barrier hides the far carriageway's rail).
-void SensorScan::CutRailWalks() {
-  for (RailPiece& piece : scratch_.rail_pieces) {
-    piece.walk_end = FovWalkEnd(piece);
-    if (!options_.occlusion) continue;
-    const double len = (piece.b - piece.a).norm();
-    const Position end =
-        piece.walk_end < len ? piece.a + piece.walk_end * ((piece.b - piece.a) / len) : piece.b;
-    for (const Occluder& o : scratch_.occluders)
-      if (o.owner != -1 - piece.segment && HidesWhole(o, piece.a, end)) {
-        piece.walk_end = 0.0;
-        break;
-      }
+// The regions of rejected points. The field of view: the wedge |azimuth| <= h' (h' = half_fov
+// + kFovCutAngle < pi / 2) is the intersection of two half-planes; a point more than
+// kCutDistance outside either lies outside it, so OutsideFov (margin 1e-9 in cosine, rounding
+// ~1e-15 of the range) rejects it. The body: for each face of the ego's box the sensor sits on
+// (or beyond), two gates inside the box parallel to the face (kBodyGateInset and kBodyGateInset +
+// kBodyGateGap deep, the face's length less kCutDistance); a point beyond the second gate whose
+// line of sight passes between both gates' ends crosses both inside the box, so its line of
+// sight runs at least kBodyGateGap > kEgoBodyMargin inside the body and BehindBody rejects it.
+// Those points form the intersection of five half-planes: beyond the second gate, and between
+// the lines from s through each gate's ends.
+void SensorScan::SetUpCuts() {
+  const double h = half_fov_ + kFovCutAngle;
+  fov_cuts_ = 0;
+  if (half_fov_ >= 1e-3 && h <= 0.5 * kPi - 1e-3) {
+    const Vector2 boresight = to_local_.row(0).transpose(), left = to_local_.row(1).transpose();
+    const double sin_h = std::sin(h), cos_h = std::cos(h);
+    for (const double side : {-1.0, 1.0}) {  // inside the wedge: (q - s) . n >= 0
+      const Vector2 n = sin_h * boresight + side * cos_h * left;
+      fov_outside_[fov_cuts_++] = {-n, -n.dot(s_)};
+    }
   }
+  body_regions_ = 0;
+  if (!has_body_) return;
+  const Vector2 axis = body_.axis, lateral(-axis.y(), axis.x());
+  const struct {
+    Vector2 n;  // outward normal
+    double h;   // half extent along n [m]
+    Vector2 along;
+    double e;  // half extent along `along` [m]
+  } faces[4] = {{axis, body_.half_length, lateral, body_.half_width},
+                {-axis, body_.half_length, lateral, body_.half_width},
+                {lateral, body_.half_width, axis, body_.half_length},
+                {-lateral, body_.half_width, axis, body_.half_length}};
+  for (const auto& f : faces) {
+    const double g1 = f.h - kBodyGateInset, g2 = g1 - kBodyGateGap, e = f.e - kCutDistance;
+    if (!(f.n.dot(s_ - body_.a) >= g1 + kCutDistance && g2 >= -f.h && e > 0.0)) continue;
+    std::array<HalfPlane, 5>& region = body_region_[body_regions_++];
+    region[0] = {-f.n, -f.n.dot(body_.a) - g2};  // beyond the second gate: n . (q - c) <= g2
+    int k = 1;
+    for (const double g : {g1, g2}) {
+      const Position mid = body_.a + g * f.n;
+      const Vector2 u0 = (mid + e * f.along - s_).normalized();
+      const Vector2 u1 = (mid - e * f.along - s_).normalized();
+      const double turn = Cross(u0, u1) > 0.0 ? 1.0 : -1.0;
+      region[k++] = LeftOf(s_, turn * u0);  // between the lines through the gate's ends
+      region[k++] = LeftOf(s_, -turn * u1);
+    }
+  }
+}
+
+// A piece's walk_begin and walk_end: the stretches at its ends covered by the regions of
+// rejected points (kCutDistance deep; the spans are computed twice as deep, so rounding of the
+// spans and of the samples' positions, ~1e-12 m, stays inside). Then a piece that another rail
+// hides in all of what is left is not walked (the median barrier hides the far rail).
+void SensorScan::CutRailWalk(RailPiece& piece) const {
+  const double len = (piece.b - piece.a).norm();
+  if (!(len > 0.0)) return;
+  const Vector2 d = (piece.b - piece.a) / len;
+  std::array<Span, 6> dead;
+  int n = 0;
+  for (int i = 0; i < fov_cuts_; ++i)
+    KeepInside(fov_outside_[i], piece.a, d, 2.0 * kCutDistance, &dead[n++]);
+  for (int r = 0; r < body_regions_; ++r) {
+    for (const HalfPlane& h : body_region_[r])
+      KeepInside(h, piece.a, d, 2.0 * kCutDistance, &dead[n]);
+    ++n;
+  }
+  double begin = 0.0, end = len;
+  for (bool grew = true; grew;) {  // the stretches reachable from each end through the spans
+    grew = false;
+    for (int i = 0; i < n; ++i) {
+      if (dead[i].lo <= begin && dead[i].hi > begin) begin = dead[i].hi, grew = true;
+      if (dead[i].hi >= end && dead[i].lo < end) end = dead[i].lo, grew = true;
+    }
+  }
+  piece.walk_begin = begin;
+  piece.walk_end = end < len ? end : std::numeric_limits<double>::infinity();
+  if (!(begin < end)) {
+    piece.walk_end = 0.0;
+    return;
+  }
+  if (!options_.occlusion) return;
+  const Position first = piece.a + begin * d, last = end < len ? piece.a + end * d : piece.b;
+  for (const Occluder& o : scratch_.occluders)
+    if (o.owner != -1 - piece.segment && HidesWhole(o, first, last)) {
+      piece.walk_end = 0.0;
+      return;
+    }
+}
+
+void SensorScan::CutRailWalks() {
+  SetUpCuts();
+  for (RailPiece& piece : scratch_.rail_pieces) CutRailWalk(piece);
 }
 
 void SensorScan::AddBoxes() {
@@ -351,8 +407,11 @@ void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, boo
     const std::vector<RailPiece>& pieces = scans[j]->rail_pieces();
     for (std::size_t k = 0; k < pieces.size(); ++k) {
       if (cut && pieces[k].walk_end == 0.0) continue;
-      edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j),
-                       cut ? pieces[k].walk_end : std::numeric_limits<double>::infinity()});
+      if (cut)
+        edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j), pieces[k].walk_end,
+                         pieces[k].walk_begin});
+      else
+        edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
       owner_of.emplace_back(static_cast<int>(j), static_cast<int>(k));
     }
   }

@@ -24,8 +24,10 @@ struct RailPiece {
   Position a, b;     ///< [m] world
   int segment;       ///< the segment's index over all polylines
   double rcs_per_m;  ///< [m^2 / m]
-  /// [m along a -> b] no sample whose walk starts here or beyond passes the scan's tests (Edge::
-  /// stop); infinity: none known; 0: the whole piece is hidden (not walked).
+  /// [m along a -> b] the scan rejects every sample whose midpoint lies before walk_begin (Edge::
+  /// begin) and every sample that starts at or beyond walk_end (Edge::stop); walk_end 0: the
+  /// whole piece is rejected (not walked).
+  double walk_begin = 0.0;
   double walk_end = std::numeric_limits<double>::infinity();
 };
 
@@ -82,8 +84,9 @@ class SensorScan {
   void CullTargets();
   void CullRails();
   void FillBins();
+  void SetUpCuts();
   void CutRailWalks();
-  double FovWalkEnd(const RailPiece& piece) const;
+  void CutRailWalk(RailPiece& piece) const;
   bool HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const;
   void AddBoxes();
   Position LocalOf(const Position& q) const { return to_local_ * (q - s_); }
@@ -111,6 +114,13 @@ class SensorScan {
   bool has_body_;
   SensorCone cone_;
   std::size_t rail_begin_ = 0;  // the first rail scatterer in scratch.scatterers
+  // Regions whose every point the scan rejects (CutRailWalks): beyond the field of view widened by
+  // kFovCutAngle (either half-plane; none when the view is too wide or narrow for two), and
+  // behind the ego's body (each region the intersection of its five half-planes).
+  int fov_cuts_ = 0;
+  std::array<HalfPlane, 2> fov_outside_;
+  int body_regions_ = 0;
+  std::array<std::array<HalfPlane, 5>, 4> body_region_;
 };
 
 /// ScanRails' working memory.
