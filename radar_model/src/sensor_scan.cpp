@@ -201,54 +201,55 @@ bool SensorScan::HidesWhole(const Occluder& o, const Position& p0, const Positio
   return true;
 }
 
-// The regions of rejected points. The field of view: the wedge |azimuth| <= h' (h' = half_fov
-// + kFovCutAngle < pi / 2) is the intersection of two half-planes; a point more than
-// kCutDistance outside either lies outside it, so OutsideFov (margin 1e-9 in cosine, rounding
-// ~1e-15 of the range) rejects it. The body: for each face of the ego's box the sensor sits on
-// (or beyond), two gates inside the box parallel to the face (kBodyGateInset and kBodyGateInset +
-// kBodyGateGap deep, the face's length less kCutDistance); a point beyond the second gate whose
-// line of sight passes between both gates' ends crosses both inside the box, so its line of
-// sight runs at least kBodyGateGap > kEgoBodyMargin inside the body and BehindBody rejects it.
-// Those points form the intersection of five half-planes: beyond the second gate, and between
-// the lines from s through each gate's ends.
-void SensorScan::SetUpCuts() {
-  const double h = half_fov_ + kFovCutAngle;
-  fov_cuts_ = 0;
-  if (half_fov_ >= 1e-3 && h <= 0.5 * kPi - 1e-3) {
-    const Vector2 boresight = to_local_.row(0).transpose(), left = to_local_.row(1).transpose();
+// The field of view: the wedge |azimuth| <= h' (h' = half_fov + kFovCutAngle < pi / 2) is the
+// intersection of two half-planes; a point more than kCutDistance outside either lies outside it,
+// so OutsideFov (margin 1e-9 in cosine, rounding ~1e-15 of the range) rejects it. The body: for
+// each face of the ego's box the sensor sits on (or beyond), two gates inside the box parallel to
+// the face (kBodyGateInset and kBodyGateInset + kBodyGateGap deep, the face's length less
+// kCutDistance); a point beyond the second gate whose line of sight passes between both gates'
+// ends crosses both inside the box, so its line of sight runs at least kBodyGateGap >
+// kEgoBodyMargin inside the body and BehindBody rejects it. Those points form the intersection
+// of five half-planes: beyond the second gate, and between the lines from s through each gate's
+// ends.
+RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, double half_fov,
+                                    const Occluder* body) {
+  RejectedRegions out;
+  const double h = half_fov + kFovCutAngle;
+  if (half_fov >= 1e-3 && h <= 0.5 * kPi - 1e-3) {
+    const Vector2 boresight = to_local.row(0).transpose(), left = to_local.row(1).transpose();
     const double sin_h = std::sin(h), cos_h = std::cos(h);
     for (const double side : {-1.0, 1.0}) {  // inside the wedge: (q - s) . n >= 0
       const Vector2 n = sin_h * boresight + side * cos_h * left;
-      fov_outside_[fov_cuts_++] = {-n, -n.dot(s_)};
+      out.fov_outside[out.fov++] = {-n, -n.dot(s)};
     }
   }
-  body_regions_ = 0;
-  if (!has_body_) return;
-  const Vector2 axis = body_.axis, lateral(-axis.y(), axis.x());
+  if (!body) return out;
+  const Vector2 axis = body->axis, lateral(-axis.y(), axis.x());
   const struct {
     Vector2 n;  // outward normal
     double h;   // half extent along n [m]
     Vector2 along;
     double e;  // half extent along `along` [m]
-  } faces[4] = {{axis, body_.half_length, lateral, body_.half_width},
-                {-axis, body_.half_length, lateral, body_.half_width},
-                {lateral, body_.half_width, axis, body_.half_length},
-                {-lateral, body_.half_width, axis, body_.half_length}};
+  } faces[4] = {{axis, body->half_length, lateral, body->half_width},
+                {-axis, body->half_length, lateral, body->half_width},
+                {lateral, body->half_width, axis, body->half_length},
+                {-lateral, body->half_width, axis, body->half_length}};
   for (const auto& f : faces) {
     const double g1 = f.h - kBodyGateInset, g2 = g1 - kBodyGateGap, e = f.e - kCutDistance;
-    if (!(f.n.dot(s_ - body_.a) >= g1 + kCutDistance && g2 >= -f.h && e > 0.0)) continue;
-    std::array<HalfPlane, 5>& region = body_region_[body_regions_++];
-    region[0] = {-f.n, -f.n.dot(body_.a) - g2};  // beyond the second gate: n . (q - c) <= g2
+    if (!(f.n.dot(s - body->a) >= g1 + kCutDistance && g2 >= -f.h && e > 0.0)) continue;
+    std::array<HalfPlane, 5>& region = out.behind_body[out.body++];
+    region[0] = {-f.n, -f.n.dot(body->a) - g2};  // beyond the second gate: n . (q - c) <= g2
     int k = 1;
     for (const double g : {g1, g2}) {
-      const Position mid = body_.a + g * f.n;
-      const Vector2 u0 = (mid + e * f.along - s_).normalized();
-      const Vector2 u1 = (mid - e * f.along - s_).normalized();
+      const Position mid = body->a + g * f.n;
+      const Vector2 u0 = (mid + e * f.along - s).normalized();
+      const Vector2 u1 = (mid - e * f.along - s).normalized();
       const double turn = Cross(u0, u1) > 0.0 ? 1.0 : -1.0;
-      region[k++] = LeftOf(s_, turn * u0);  // between the lines through the gate's ends
-      region[k++] = LeftOf(s_, -turn * u1);
+      region[k++] = LeftOf(s, turn * u0);  // between the lines through the gate's ends
+      region[k++] = LeftOf(s, -turn * u1);
     }
   }
+  return out;
 }
 
 // A piece's walk_begin and walk_end: the stretches at its ends covered by the regions of
@@ -261,10 +262,10 @@ void SensorScan::CutRailWalk(RailPiece& piece) const {
   const Vector2 d = (piece.b - piece.a) / len;
   std::array<Span, 6> dead;
   int n = 0;
-  for (int i = 0; i < fov_cuts_; ++i)
-    KeepInside(fov_outside_[i], piece.a, d, 2.0 * kCutDistance, &dead[n++]);
-  for (int r = 0; r < body_regions_; ++r) {
-    for (const HalfPlane& h : body_region_[r])
+  for (int i = 0; i < rejected_.fov; ++i)
+    KeepInside(rejected_.fov_outside[i], piece.a, d, 2.0 * kCutDistance, &dead[n++]);
+  for (int r = 0; r < rejected_.body; ++r) {
+    for (const HalfPlane& h : rejected_.behind_body[r])
       KeepInside(h, piece.a, d, 2.0 * kCutDistance, &dead[n]);
     ++n;
   }
@@ -292,7 +293,7 @@ void SensorScan::CutRailWalk(RailPiece& piece) const {
 }
 
 void SensorScan::CutRailWalks() {
-  SetUpCuts();
+  rejected_ = MakeRejectedRegions(s_, to_local_, half_fov_, has_body_ ? &body_ : nullptr);
   for (RailPiece& piece : scratch_.rail_pieces) CutRailWalk(piece);
 }
 

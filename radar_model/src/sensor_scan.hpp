@@ -45,6 +45,22 @@ struct TargetGeometry {
 /// The TargetGeometry of every target of `scene`, in its order (`out` reused).
 void ComputeTargetGeometry(const Scene& scene, std::vector<TargetGeometry>* out);
 
+/// Regions of the plane whose every point a sensor's scan rejects, each the intersection of its
+/// half-planes (a point kCutDistance inside all of them is rejected): beyond the field of view
+/// widened by kFovCutAngle (one half-plane each; none when the view is too wide or narrow for
+/// the wedge to be the intersection of two), and behind the ego's body (five half-planes each).
+struct RejectedRegions {
+  int fov = 0;
+  std::array<HalfPlane, 2> fov_outside;
+  int body = 0;
+  std::array<std::array<HalfPlane, 5>, 4> behind_body;
+};
+
+/// The regions of a sensor at s [m] with half field of view half_fov [rad] and world -> sensor
+/// rotation to_local; the body's when `body` (the shrunk ego box BehindBody tests) is given.
+RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, double half_fov,
+                                    const Occluder* body);
+
 /// One sensor's working memory, kept between steps so that a scan allocates nothing once warmed
 /// up. Each scan in flight has its own; every user clears what it takes.
 struct ScanScratch {
@@ -84,7 +100,6 @@ class SensorScan {
   void CullTargets();
   void CullRails();
   void FillBins();
-  void SetUpCuts();
   void CutRailWalks();
   void CutRailWalk(RailPiece& piece) const;
   bool HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const;
@@ -114,13 +129,7 @@ class SensorScan {
   bool has_body_;
   SensorCone cone_;
   std::size_t rail_begin_ = 0;  // the first rail scatterer in scratch.scatterers
-  // Regions whose every point the scan rejects (CutRailWalks): beyond the field of view widened by
-  // kFovCutAngle (either half-plane; none when the view is too wide or narrow for two), and
-  // behind the ego's body (each region the intersection of its five half-planes).
-  int fov_cuts_ = 0;
-  std::array<HalfPlane, 2> fov_outside_;
-  int body_regions_ = 0;
-  std::array<std::array<HalfPlane, 5>, 4> body_region_;
+  RejectedRegions rejected_;    // CutRailWalks
 };
 
 /// ScanRails' working memory.

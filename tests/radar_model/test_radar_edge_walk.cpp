@@ -380,3 +380,75 @@ TEST_CASE("the cut rail walks give the scatterers of the whole walks", "[radar][
   CHECK(hidden > pieces / 10);
   CHECK(stopped > pieces / 5);
 }
+
+// The regions the cuts rest on (MakeRejectedRegions): every point kCutDistance inside a body
+// region must be hidden by the ego's body as BehindBody tests it (its line of sight more than
+// kEgoBodyMargin inside the shrunk box), every point kCutDistance outside a field-of-view
+// half-plane rejected by OutsideFov; and the regions must cover most of what they stand for
+// (the body's: all lines of sight into the body but those within a few degrees of the sensor's
+// face, so > 80 % of the hidden points 5-100 m away; fails if a region is turned or empty).
+TEST_CASE("the rejected regions lie behind the body and outside the field of view",
+          "[radar][edge_walk]") {
+  std::size_t in_body = 0, hidden = 0, hidden_covered = 0, outside = 0, in_fov_region = 0;
+  for (std::uint32_t scene = 0; scene < 200; ++scene) {
+    CounterRng rng(43, RngPurpose::kTest, scene, 0);
+    const double length = rng.Uniform(3.5, 6.0), width = rng.Uniform(1.6, 2.6);
+    const Pose2 ego{Position(rng.Uniform(-500.0, 500.0), rng.Uniform(-50.0, 50.0)),
+                    rng.Uniform(-kPi, kPi)};
+    Occluder body;
+    body.a = ego.position;
+    body.axis = UnitVector(ego.yaw);
+    body.half_length = 0.5 * length - kEgoBodySkin;
+    body.half_width = 0.5 * width - kEgoBodySkin;
+    // A sensor on a face, at a corner, or a little off the box.
+    Pose2 mount;
+    const int kind = static_cast<int>(scene % 4);
+    const double side = rng.Uniform() < 0.5 ? -1.0 : 1.0;
+    if (kind == 0) mount = {Position(rng.Uniform(-0.5, 0.5) * length, side * 0.5 * width), 0.0};
+    if (kind == 1) mount = {Position(side * 0.5 * length, rng.Uniform(-0.5, 0.5) * width), 0.0};
+    if (kind == 2) mount = {Position(0.5 * length, side * 0.5 * width), 0.0};
+    if (kind == 3)
+      mount = {Position(0.5 * length + 0.2, side * rng.Uniform(0.0, 0.6) * width), 0.0};
+    mount.yaw = rng.Uniform(-kPi, kPi);
+    const Pose2 pose = ego.Compose(mount);
+    const Matrix2 to_local = Rotation(pose.yaw).transpose();
+    const double half_fov = rng.Uniform(0.05, 1.5);
+    const RejectedRegions regions = MakeRejectedRegions(pose.position, to_local, half_fov, &body);
+    const auto inside = [](const HalfPlane& h, const Position& q) {
+      return h.n.dot(q) - h.offset >= kCutDistance;
+    };
+    for (int i = 0; i < 400; ++i) {
+      const Position q =
+          pose.position + rng.Uniform(0.0, 100.0) * UnitVector(rng.Uniform(-kPi, kPi));
+      const double chord = LengthInsideBox(body, pose.position, q);
+      bool covered = false;
+      for (int r = 0; r < regions.body; ++r) {
+        const auto& region = regions.behind_body[r];
+        if (std::all_of(region.begin(), region.end(),
+                        [&](const HalfPlane& h) { return inside(h, q); })) {
+          covered = true;
+          ++in_body;
+          CHECK(chord > kEgoBodyMargin);
+        }
+      }
+      if (chord > kEgoBodyMargin && (q - pose.position).norm() > 5.0) {
+        ++hidden;
+        hidden_covered += covered;
+      }
+      const Position local = to_local * (q - pose.position);
+      bool beyond_view = false;
+      for (int k = 0; k < regions.fov; ++k) beyond_view |= inside(regions.fov_outside[k], q);
+      if (beyond_view) {
+        ++in_fov_region;
+        CHECK(OutsideFov(local, local.norm(), FovCosBound(half_fov)));
+      }
+      outside += std::abs(std::atan2(local.y(), local.x())) > half_fov + 1e-3 && half_fov < 1.5;
+    }
+  }
+  INFO(in_body << " points in body regions; " << hidden_covered << " of " << hidden
+               << " hidden points covered; " << in_fov_region << " of " << outside
+               << " points outside the view in its regions");
+  CHECK(in_body > 10000);
+  CHECK(hidden_covered > 0.8 * static_cast<double>(hidden));
+  CHECK(in_fov_region > 0.9 * static_cast<double>(outside));
+}
