@@ -33,7 +33,8 @@ struct Lanes {
   alignas(16) double min_range[kGroup] = {}, max_range[kGroup] = {}, cos_bound[kGroup] = {};
   alignas(16) double range_res[kGroup] = {}, azimuth_res[kGroup] = {};
   alignas(16) double stop[kGroup] = {}, begin[kGroup] = {};  // Edge::stop, Edge::begin
-  int edge[kGroup] = {};                                     // the walked edge's index
+  alignas(16) double skip_lo[kGroup] = {}, skip_hi[kGroup] = {};
+  int edge[kGroup] = {};  // the walked edge's index
 };
 
 // Lane l of `lanes` set to edge e (index `index`) of cone c; as WalkEdge, nothing for an empty
@@ -50,6 +51,8 @@ void SetLane(Lanes& lanes, int l, const Edge& e, int index, const SensorCone& c)
   lanes.len[l] = len;
   lanes.stop[l] = e.stop;
   lanes.begin[l] = e.begin;
+  lanes.skip_lo[l] = e.skip_lo;
+  lanes.skip_hi[l] = e.skip_hi;
   lanes.sx[l] = c.position.x();
   lanes.sy[l] = c.position.y();
   lanes.m00[l] = c.to_local(0, 0);
@@ -128,8 +131,11 @@ void WalkGroup(const Lanes& lanes, int used, SampleSink sink, void* context) {
                             hn::Load(d, lanes.azimuth_res + o));
       const VD t = hn::Add(pos[k], hn::Mul(half, ds));
       const VD x = hn::Add(ax, hn::Mul(t, dx)), y = hn::Add(ay, hn::Mul(t, dy));
-      const auto kept = hn::And(hn::And(active, hn::Ge(t, hn::Load(d, lanes.begin + o))),
-                                Keep(d, lanes, o, x, y, lx + o, ly + o, range + o));
+      const auto skipped = hn::And(hn::Ge(t, hn::Load(d, lanes.skip_lo + o)),
+                                   hn::Le(t, hn::Load(d, lanes.skip_hi + o)));
+      const auto handed = hn::AndNot(skipped, hn::Ge(t, hn::Load(d, lanes.begin + o)));
+      const auto kept =
+          hn::And(hn::And(active, handed), Keep(d, lanes, o, x, y, lx + o, ly + o, range + o));
       hn::Store(hn::IfThenElseZero(kept, hn::Set(d, 1.0)), d, keep + o);
       hn::Store(x, d, qx + o);
       hn::Store(y, d, qy + o);

@@ -45,6 +45,9 @@ constexpr double kCutSine = 1e-2;
 /// beyond the first. A line of sight through both runs at least kBodyGateGap inside the body.
 constexpr double kBodyGateInset = 0.01;
 constexpr double kBodyGateGap = kEgoBodyMargin + 0.01;
+/// A box's shadow (BoxShadow) is drawn from its corners moved this share of the way to its
+/// centre, so lines of sight into the shadow cross the box's inside, not its corners.
+constexpr double kShadowInset = 0.05;
 
 /// A half-plane {q : n . q >= offset} [m], n a unit normal.
 struct HalfPlane {

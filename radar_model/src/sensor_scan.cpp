@@ -252,33 +252,80 @@ RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, 
   return out;
 }
 
-// A piece's walk_begin and walk_end: the stretches at its ends covered by the regions of
-// rejected points (kCutDistance deep; the spans are computed twice as deep, so rounding of the
-// spans and of the samples' positions, ~1e-12 m, stays inside). Then a piece that another rail
-// hides in all of what is left is not walked (the median barrier hides the far rail).
-void SensorScan::CutRailWalk(RailPiece& piece) const {
+std::optional<std::array<HalfPlane, 3>> BoxShadow(const Position& s,
+                                                  const std::array<Position, 4>& corners) {
+  const Position centre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+  std::array<Position, 4> c;
+  for (int k = 0; k < 4; ++k) c[k] = corners[k] + kShadowInset * (centre - corners[k]);
+  // The outermost corners: all others lie counter-clockwise of `right`, clockwise of `left`.
+  int right = -1, left = -1;
+  for (int i = 0; i < 4; ++i) {
+    bool is_right = true, is_left = true;
+    for (int j = 0; j < 4; ++j) {
+      const double turn = Cross(c[i] - s, c[j] - s);
+      is_right = is_right && turn >= 0.0;
+      is_left = is_left && turn <= 0.0;
+    }
+    if (is_right && right < 0) right = i;
+    if (is_left && left < 0) left = i;
+  }
+  if (right < 0 || left < 0 || !(Cross(c[right] - s, c[left] - s) > 0.0)) return std::nullopt;
+  if (!(Cross(c[left] - c[right], s - c[right]) > kCutDistance * (c[left] - c[right]).norm()))
+    return std::nullopt;  // s must lie clear of the two corners' segment, on its left
+  // Beyond the segment (on its right) by the occlusion shrink as well: the shrunk line of sight
+  // still crosses it.
+  HalfPlane beyond = LeftOf(c[right], -(c[left] - c[right]).normalized());
+  beyond.offset += kOcclusionShrink;
+  return std::array<HalfPlane, 3>{LeftOf(s, (c[right] - s).normalized()),
+                                  LeftOf(s, -(c[left] - s).normalized()), beyond};
+}
+
+// A piece's walk_begin, walk_end and skip: the spans of samples that lie in a rejected region
+// (kCutDistance deep; the spans are computed twice as deep, so rounding of the spans and of the
+// samples' positions, ~1e-12 m, stays inside): outside the view, behind the body, in the shadow
+// of a candidate box (BehindOthers lists it: its interval holds the shadow's directions, its
+// min_distance is nearer, SegmentHitsBox finds the crossing). Their union's stretches at the ends
+// are not walked or not handed on, its longest stretch between is skipped. Then a piece that
+// another rail hides in all of the rest is not walked (the median barrier hides the far rail).
+void SensorScan::CutRailWalk(RailPiece& piece) {
   const double len = (piece.b - piece.a).norm();
   if (!(len > 0.0)) return;
   const Vector2 d = (piece.b - piece.a) / len;
-  std::array<Span, 6> dead;
-  int n = 0;
-  for (int i = 0; i < rejected_.fov; ++i)
-    KeepInside(rejected_.fov_outside[i], piece.a, d, 2.0 * kCutDistance, &dead[n++]);
-  for (int r = 0; r < rejected_.body; ++r) {
-    for (const HalfPlane& h : rejected_.behind_body[r])
-      KeepInside(h, piece.a, d, 2.0 * kCutDistance, &dead[n]);
-    ++n;
+  const double depth = 2.0 * kCutDistance;
+  std::vector<Span>& spans = scratch_.spans;
+  spans.clear();
+  for (int i = 0; i < rejected_.fov; ++i) {
+    spans.emplace_back();
+    KeepInside(rejected_.fov_outside[i], piece.a, d, depth, &spans.back());
   }
+  for (int r = 0; r < rejected_.body; ++r) {
+    spans.emplace_back();
+    for (const HalfPlane& h : rejected_.behind_body[r])
+      KeepInside(h, piece.a, d, depth, &spans.back());
+  }
+  for (const std::array<HalfPlane, 3>& shadow : scratch_.shadows) {
+    spans.emplace_back();
+    for (const HalfPlane& h : shadow) KeepInside(h, piece.a, d, depth, &spans.back());
+  }
+  std::erase_if(spans,
+                [&](const Span& sp) { return !(sp.lo <= sp.hi && sp.hi >= 0.0 && sp.lo <= len); });
+  std::sort(spans.begin(), spans.end(), [](const Span& x, const Span& y) { return x.lo < y.lo; });
   double begin = 0.0, end = len;
-  for (bool grew = true; grew;) {  // the stretches reachable from each end through the spans
-    grew = false;
-    for (int i = 0; i < n; ++i) {
-      if (dead[i].lo <= begin && dead[i].hi > begin) begin = dead[i].hi, grew = true;
-      if (dead[i].hi >= end && dead[i].lo < end) end = dead[i].lo, grew = true;
+  Span skip = piece.skip;
+  for (std::size_t i = 0; i < spans.size();) {  // the union's stretches, in order
+    Span u = spans[i];
+    for (++i; i < spans.size() && spans[i].lo <= u.hi; ++i) u.hi = std::max(u.hi, spans[i].hi);
+    if (u.lo <= 0.0) {
+      begin = std::max(begin, u.hi);
+    } else if (u.hi >= len) {
+      end = std::min(end, u.lo);
+    } else if (!(skip.hi - skip.lo >= u.hi - u.lo)) {
+      skip = u;
     }
   }
   piece.walk_begin = begin;
   piece.walk_end = end < len ? end : std::numeric_limits<double>::infinity();
+  piece.skip = skip;
   if (!(begin < end)) {
     piece.walk_end = 0.0;
     return;
@@ -294,6 +341,12 @@ void SensorScan::CutRailWalk(RailPiece& piece) const {
 
 void SensorScan::CutRailWalks() {
   rejected_ = MakeRejectedRegions(s_, to_local_, half_fov_, has_body_ ? &body_ : nullptr);
+  scratch_.shadows.clear();
+  if (options_.occlusion)
+    for (const Occluder& o : scratch_.occluders)
+      if (o.is_box)
+        if (const auto shadow = BoxShadow(s_, targets_[o.owner].corners))
+          scratch_.shadows.push_back(*shadow);
   for (RailPiece& piece : scratch_.rail_pieces) CutRailWalk(piece);
 }
 
@@ -410,7 +463,7 @@ void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, boo
       if (cut && pieces[k].walk_end == 0.0) continue;
       if (cut)
         edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j), pieces[k].walk_end,
-                         pieces[k].walk_begin});
+                         pieces[k].walk_begin, pieces[k].skip.lo, pieces[k].skip.hi});
       else
         edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
       owner_of.emplace_back(static_cast<int>(j), static_cast<int>(k));

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -29,6 +30,9 @@ struct RailPiece {
   /// whole piece is rejected (not walked).
   double walk_begin = 0.0;
   double walk_end = std::numeric_limits<double>::infinity();
+  /// [m along a -> b] the scan rejects every sample whose midpoint lies in [skip.lo, skip.hi]
+  /// (Edge::skip; a box's shadow across the piece).
+  Span skip{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
 };
 
 /// What the scan needs of a target whatever the sensor, computed once per step (the same values
@@ -56,6 +60,14 @@ struct RejectedRegions {
   std::array<std::array<HalfPlane, 5>, 4> behind_body;
 };
 
+/// The shadow of a box (corners) seen from s [m], an intersection of three half-planes: beyond
+/// the segment between its outermost corners moved kShadowInset of the way to the centre (by
+/// kOcclusionShrink more), between the lines from s through them. A line of sight to a point
+/// kCutDistance inside all three, shrunk by kOcclusionShrink, crosses the box's inside.
+/// std::nullopt when s is not clear of that segment.
+std::optional<std::array<HalfPlane, 3>> BoxShadow(const Position& s,
+                                                  const std::array<Position, 4>& corners);
+
 /// The regions of a sensor at s [m] with half field of view half_fov [rad] and world -> sensor
 /// rotation to_local; the body's when `body` (the shrunk ego box BehindBody tests) is given.
 RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, double half_fov,
@@ -72,8 +84,10 @@ struct ScanScratch {
   std::vector<Scatterer> rail_buffer;  // GroupByPiece's copy
   std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
   std::vector<FaceSample> samples;
-  std::vector<Scatterer> scatterers;                           // the scan's result
-  std::vector<Detection> detections;                           // RadarModel::Scan's, per sensor
+  std::vector<Span> spans;                        // CutRailWalks' spans of rejected samples
+  std::vector<std::array<HalfPlane, 3>> shadows;  // CutRailWalks' box shadows
+  std::vector<Scatterer> scatterers;              // the scan's result
+  std::vector<Detection> detections;              // RadarModel::Scan's, per sensor
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
 };
 
@@ -101,7 +115,7 @@ class SensorScan {
   void CullRails();
   void FillBins();
   void CutRailWalks();
-  void CutRailWalk(RailPiece& piece) const;
+  void CutRailWalk(RailPiece& piece);
   bool HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const;
   void AddBoxes();
   Position LocalOf(const Position& q) const { return to_local_ * (q - s_); }

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "../../radar_model/src/edge_walk.hpp"
@@ -451,4 +452,56 @@ TEST_CASE("the rejected regions lie behind the body and outside the field of vie
   CHECK(in_body > 10000);
   CHECK(hidden_covered > 0.8 * static_cast<double>(hidden));
   CHECK(in_fov_region > 0.9 * static_cast<double>(outside));
+}
+
+// A box's shadow (BoxShadow): every point kCutDistance inside it must be hidden by the box as
+// BehindOthers tests it (the line of sight shrunk by kOcclusionShrink hits the box, the point is
+// farther than the occluder's min_distance, its direction passes the dot test);
+// and the shadow must hold most points hidden by the box 0.5 m or more beyond it (fails if it is
+// turned, empty or reaches past the box's outline).
+TEST_CASE("a box's shadow lies behind the box", "[radar][edge_walk]") {
+  std::size_t in_shadow = 0, behind = 0, behind_covered = 0;
+  for (std::uint32_t scene = 0; scene < 300; ++scene) {
+    CounterRng rng(47, RngPurpose::kTest, scene, 0);
+    const OrientedBox box{Position(rng.Uniform(-30.0, 30.0), rng.Uniform(-30.0, 30.0)),
+                          rng.Uniform(-kPi, kPi), rng.Uniform(0.5, 15.0), rng.Uniform(0.5, 3.0)};
+    const Position s(rng.Uniform(-10.0, 10.0), rng.Uniform(-10.0, 10.0));
+    const auto shadow = BoxShadow(s, box.Corners());
+    if (box.Contains(s)) CHECK(!shadow);
+    if (!shadow) continue;
+    Occluder o;
+    o.a = box.center;
+    o.axis = UnitVector(box.yaw);
+    o.half_length = 0.5 * box.length;
+    o.half_width = 0.5 * box.width;
+    Position relative[4];  // the box's angular interval as CullTargets computes it (frame of s)
+    for (int k = 0; k < 4; ++k) relative[k] = box.Corners()[k] - s;
+    const Interval interval = IntervalOf(relative, 4);
+    // The occluder's min_distance as SensorScan::CullTargets sets it.
+    const double nearest =
+        std::max(0.0, (box.center - s).norm() - 0.5 * std::hypot(box.length, box.width));
+    for (int i = 0; i < 300; ++i) {
+      const Position q = s + rng.Uniform(0.0, 80.0) * UnitVector(rng.Uniform(-kPi, kPi));
+      const double range = (q - s).norm();
+      const Position end = q - kOcclusionShrink * (q - s) / range;
+      const bool inside = std::all_of(shadow->begin(), shadow->end(), [&](const HalfPlane& h) {
+        return h.n.dot(q) - h.offset >= kCutDistance;
+      });
+      if (inside) {
+        ++in_shadow;
+        CHECK(SegmentHitsBox(o, s, end));
+        CHECK(range > nearest);
+        CHECK((q - s).dot(UnitVector(interval.center)) / range >=
+              std::cos(interval.half_width) - 1e-12);  // BehindOthers' dot test lists the box
+      }
+      // Hidden 0.5 m or more beyond the box: the line of sight still hits it 0.5 m short of q.
+      if (SegmentHitsBox(o, s, q - 0.5 * (q - s) / range) && !box.Contains(q)) {
+        ++behind;
+        behind_covered += inside;
+      }
+    }
+  }
+  INFO(in_shadow << " points in shadows; " << behind_covered << " of " << behind << " covered");
+  CHECK(in_shadow > 2000);
+  CHECK(behind_covered > 0.8 * static_cast<double>(behind));
 }
