@@ -31,7 +31,7 @@ struct RailPiece {
   double walk_begin = 0.0;
   double walk_end = std::numeric_limits<double>::infinity();
   /// [m along a -> b] the scan rejects every sample whose midpoint lies in [skip.lo, skip.hi]
-  /// (Edge::skip; a box's shadow across the piece).
+  /// (Edge::skip_lo, skip_hi; a box's shadow across the piece).
   Span skip{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
 };
 
@@ -155,7 +155,8 @@ struct RailWalkScratch {
 
 /// Step 3 of every scan of `scans`: their rail pieces walked together (WalkEdges with one cone
 /// per scan), each kept sample handed to its scan, then FinishRails. Each piece is walked up to
-/// its walk_end (a hidden piece not at all); with `cut` false every piece is walked whole (the
+/// its walk_end (a hidden piece not at all), its samples before walk_begin and in its skip not
+/// handed on; with `cut` false every piece is walked whole and every kept sample handed on (the
 /// same scatterers: the reference of the tests).
 void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, bool cut = true);
 
