@@ -32,6 +32,8 @@ struct Lanes {
   alignas(16) double m00[kGroup] = {}, m01[kGroup] = {}, m10[kGroup] = {}, m11[kGroup] = {};
   alignas(16) double min_range[kGroup] = {}, max_range[kGroup] = {}, cos_bound[kGroup] = {};
   alignas(16) double range_res[kGroup] = {}, azimuth_res[kGroup] = {};
+  alignas(16) double stop[kGroup] = {}, begin[kGroup] = {};  // Edge::stop, Edge::begin
+  alignas(16) double skip_lo[kGroup] = {}, skip_hi[kGroup] = {};
   int edge[kGroup] = {};  // the walked edge's index
 };
 
@@ -47,6 +49,10 @@ void SetLane(Lanes& lanes, int l, const Edge& e, int index, const SensorCone& c)
   lanes.dx[l] = dir.x();
   lanes.dy[l] = dir.y();
   lanes.len[l] = len;
+  lanes.stop[l] = e.stop;
+  lanes.begin[l] = e.begin;
+  lanes.skip_lo[l] = e.skip_lo;
+  lanes.skip_hi[l] = e.skip_hi;
   lanes.sx[l] = c.position.x();
   lanes.sy[l] = c.position.y();
   lanes.m00[l] = c.to_local(0, 0);
@@ -114,7 +120,7 @@ void WalkGroup(const Lanes& lanes, int used, SampleSink sink, void* context) {
       const VD ax = hn::Load(d, lanes.ax + o), ay = hn::Load(d, lanes.ay + o);
       const VD dx = hn::Load(d, lanes.dx + o), dy = hn::Load(d, lanes.dy + o);
       const VD len = hn::Load(d, lanes.len + o);
-      const auto active = hn::Lt(pos[k], len);
+      const auto active = hn::And(hn::Lt(pos[k], len), hn::Lt(pos[k], hn::Load(d, lanes.stop + o)));
       if (hn::AllFalse(d, active)) {
         hn::Store(hn::Zero(d), d, keep + o);
         continue;
@@ -125,7 +131,11 @@ void WalkGroup(const Lanes& lanes, int used, SampleSink sink, void* context) {
                             hn::Load(d, lanes.azimuth_res + o));
       const VD t = hn::Add(pos[k], hn::Mul(half, ds));
       const VD x = hn::Add(ax, hn::Mul(t, dx)), y = hn::Add(ay, hn::Mul(t, dy));
-      const auto kept = hn::And(active, Keep(d, lanes, o, x, y, lx + o, ly + o, range + o));
+      const auto skipped = hn::And(hn::Ge(t, hn::Load(d, lanes.skip_lo + o)),
+                                   hn::Le(t, hn::Load(d, lanes.skip_hi + o)));
+      const auto handed = hn::AndNot(skipped, hn::Ge(t, hn::Load(d, lanes.begin + o)));
+      const auto kept =
+          hn::And(hn::And(active, handed), Keep(d, lanes, o, x, y, lx + o, ly + o, range + o));
       hn::Store(hn::IfThenElseZero(kept, hn::Set(d, 1.0)), d, keep + o);
       hn::Store(x, d, qx + o);
       hn::Store(y, d, qy + o);
@@ -140,21 +150,24 @@ void WalkGroup(const Lanes& lanes, int used, SampleSink sink, void* context) {
   }
 }
 
-// Squared length of an edge [m^2].
-double Length2(const Edge& e) { return (e.b - e.a).squaredNorm(); }
+// Length of an edge's walk [m]: to its end or its stop.
+double WalkLength(const Edge& e) { return std::min((e.b - e.a).norm(), e.stop); }
 
 }  // namespace
 
 void WalkEdges(const Edge* edges, int n, const SensorCone* cones, SampleSink sink, void* context) {
-  // Longest edges first, so that a group's lanes end at about the same sample (ties by index:
+  // Longest walks first, so that a group's lanes end at about the same sample (ties by index:
   // the order is the same on every run; the samples do not depend on it).
   thread_local std::vector<int> order;
+  thread_local std::vector<double> length;
   order.resize(n);
-  for (int i = 0; i < n; ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](int i, int j) {
-    const double li = Length2(edges[i]), lj = Length2(edges[j]);
-    return li != lj ? li > lj : i < j;
-  });
+  length.resize(n);
+  for (int i = 0; i < n; ++i) {
+    order[i] = i;
+    length[i] = WalkLength(edges[i]);
+  }
+  std::sort(order.begin(), order.end(),
+            [&](int i, int j) { return length[i] != length[j] ? length[i] > length[j] : i < j; });
   for (int first = 0; first < n; first += kGroup) {
     const int used = std::min(kGroup, n - first);
     Lanes lanes;

@@ -2,15 +2,25 @@
 // (scan_geometry.hpp) emits, bit for bit, with the edges on SIMD lanes.
 #pragma once
 
+#include <limits>
+
 #include "dualgrid/core/types.hpp"
 
 namespace dualgrid::radar::detail {
 
 /// An edge a -> b [m] (world frame), walked for the sensor cones[cone] (the multi-cone
-/// WalkEdges; the one-cone overload ignores `cone`).
+/// WalkEdges; the one-cone overload ignores `cone`). Parameters along the edge [m], from the
+/// caller's proof that the scan rejects the samples they leave out: samples whose midpoint lies
+/// before `begin` or in [skip_lo, skip_hi] are walked but not handed on; the walk stops at the
+/// first sample that starts at or beyond `stop`. The samples handed on are those of the whole
+/// walk, bit for bit.
 struct Edge {
   Position a, b;
   int cone = 0;
+  double stop = std::numeric_limits<double>::infinity();
+  double begin = 0.0;
+  double skip_lo = std::numeric_limits<double>::infinity();
+  double skip_hi = -std::numeric_limits<double>::infinity();
 };
 
 /// What the scan's first tests need of a sensor (RadarModel::VisibleScatterers' `consider`): a

@@ -32,6 +32,55 @@ constexpr double kEgoBodySkin = 1e-3;
 // its far corner, hidden behind the near one (docs/radar.md step 2).
 constexpr double kMinGrazingSin = 0.0087;  // sin(0.5 deg)
 
+/// Margins of the proofs that cut a rail piece's walk (SensorScan::CutRailWalks), far above the
+/// rounding of the walk's samples (~1e-12 m) and of the scan's tests: an angle [rad] added to the
+/// half field of view, a distance [m] to a half-plane or line, a share of an occluder's length
+/// kept from its ends, the least sine of the angle a line of sight meets an occluder at.
+constexpr double kFovCutAngle = 1e-4;
+constexpr double kCutDistance = 1e-3;
+constexpr double kCutShare = 1e-3;
+constexpr double kCutSine = 1e-2;
+/// The ego body's gates (SensorScan's body regions): two segments inside the body parallel to a
+/// face the sensor sits on, the first kBodyGateInset [m] inside it, the second kBodyGateGap [m]
+/// beyond the first. A line of sight through both runs at least kBodyGateGap inside the body.
+constexpr double kBodyGateInset = 0.01;
+constexpr double kBodyGateGap = kEgoBodyMargin + 0.01;
+/// A box's shadow (BoxShadow) is drawn from its corners moved this share of the way to its
+/// centre, so lines of sight into the shadow cross the box's inside, not its corners.
+constexpr double kShadowInset = 0.05;
+
+/// A half-plane {q : n . q >= offset} [m], n a unit normal.
+struct HalfPlane {
+  Vector2 n = Vector2::UnitX();
+  double offset = 0.0;
+};
+
+/// The half-plane left of the line through p along the unit direction u: Cross(u, q - p) >= 0.
+inline HalfPlane LeftOf(const Position& p, const Vector2& u) {
+  const Vector2 n(-u.y(), u.x());
+  return {n, n.dot(p)};
+}
+
+/// A closed interval [lo, hi] of a line's parameter [m]; empty when lo > hi.
+struct Span {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+};
+
+/// Narrows `span` to the parameters t at which a + t d (d a unit direction) lies at least `depth`
+/// [m] inside h.
+inline void KeepInside(const HalfPlane& h, const Position& a, const Vector2& d, double depth,
+                       Span* span) {
+  const double c = h.n.dot(a) - h.offset - depth, k = h.n.dot(d);  // inside: c + k t >= 0
+  if (k > 0.0) {
+    span->lo = std::max(span->lo, -c / k);
+  } else if (k < 0.0) {
+    span->hi = std::min(span->hi, c / -k);
+  } else if (c < 0.0) {
+    span->hi = -std::numeric_limits<double>::infinity();
+  }
+}
+
 /// Margin on the cosine of a half field of view [-]: far above the rounding of a cosine, a norm
 /// and atan2 (~1e-15), far below any geometry that matters (1e-9 in cosine is >= 1e-9 rad).
 constexpr double kFovCosMargin = 1e-9;

@@ -83,6 +83,7 @@ SensorScan::SensorScan(const SensorParams& p, const SensorModel& model, const Mo
   CullTargets();
   CullRails();
   FillBins();
+  CutRailWalks();
   // 2. Boxes: samples on the faces facing the sensor plus their corners, sharing the RCS.
   scratch.scatterers.clear();
   AddBoxes();
@@ -170,6 +171,183 @@ void SensorScan::FillBins() {
         bins[bi].push_back(static_cast<int>(k));
     }
   }
+}
+
+// Does rail occluder `o` hide every point of the segment p0 -> p1 in BehindOthers (o.owner is not
+// the points' owner)? Sufficient, with margins far above rounding: s and the segment lie on
+// opposite sides of o's line, the segment more than the occlusion shrink plus kCutDistance beyond
+// it, so each shrunk line of sight crosses the line strictly inside (0 < t < 1); the lines of
+// sight to p0 and p1 meet o at a parameter u inside [kCutShare, 1 - kCutShare] at an angle whose
+// sine is at least kCutSine, and so do those to every point between (the direction turns
+// monotonically along the segment, by less than a half turn). Such a point's direction lies
+// inside o's angular interval (the dot test and the azimuth bins, which have a bin of slack, list
+// o), its range exceeds o.min_distance, and SegmentsIntersect finds the crossing.
+bool SensorScan::HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const {
+  const Vector2 sv = o.b - o.a;
+  const double len = sv.norm();
+  if (o.is_box || !(len >= 1e-2)) return false;
+  const double side_s = Cross(sv, s_ - o.a) / len;
+  if (!(std::abs(side_s) >= kCutDistance)) return false;
+  for (const Position& p : {p0, p1}) {
+    if (!(Cross(sv, p - o.a) / len * (side_s > 0.0 ? -1.0 : 1.0) >=
+          kOcclusionShrink + kCutDistance))
+      return false;
+    const Vector2 r = p - s_;
+    const double denom = Cross(sv, r);
+    if (!(std::abs(denom) >= kCutSine * len * r.norm())) return false;
+    const double u = Cross(s_ - o.a, r) / denom;
+    if (!(u >= kCutShare && u <= 1.0 - kCutShare)) return false;
+  }
+  return true;
+}
+
+// The field of view: the wedge |azimuth| <= h' (h' = half_fov + kFovCutAngle < pi / 2) is the
+// intersection of two half-planes; a point more than kCutDistance outside either lies outside it,
+// so OutsideFov (margin 1e-9 in cosine, rounding ~1e-15 of the range) rejects it. The body: for
+// each face of the ego's box the sensor sits on (or beyond), two gates inside the box parallel to
+// the face (kBodyGateInset and kBodyGateInset + kBodyGateGap deep, the face's length less
+// kCutDistance); a point beyond the second gate whose line of sight passes between both gates'
+// ends crosses both inside the box, so its line of sight runs at least kBodyGateGap >
+// kEgoBodyMargin inside the body and BehindBody rejects it. Those points form the intersection
+// of five half-planes: beyond the second gate, and between the lines from s through each gate's
+// ends.
+RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, double half_fov,
+                                    const Occluder* body) {
+  RejectedRegions out;
+  const double h = half_fov + kFovCutAngle;
+  if (half_fov >= 1e-3 && h <= 0.5 * kPi - 1e-3) {
+    const Vector2 boresight = to_local.row(0).transpose(), left = to_local.row(1).transpose();
+    const double sin_h = std::sin(h), cos_h = std::cos(h);
+    for (const double side : {-1.0, 1.0}) {  // inside the wedge: (q - s) . n >= 0
+      const Vector2 n = sin_h * boresight + side * cos_h * left;
+      out.fov_outside[out.fov++] = {-n, -n.dot(s)};
+    }
+  }
+  if (!body) return out;
+  const Vector2 axis = body->axis, lateral(-axis.y(), axis.x());
+  const struct {
+    Vector2 n;  // outward normal
+    double h;   // half extent along n [m]
+    Vector2 along;
+    double e;  // half extent along `along` [m]
+  } faces[4] = {{axis, body->half_length, lateral, body->half_width},
+                {-axis, body->half_length, lateral, body->half_width},
+                {lateral, body->half_width, axis, body->half_length},
+                {-lateral, body->half_width, axis, body->half_length}};
+  for (const auto& f : faces) {
+    const double g1 = f.h - kBodyGateInset, g2 = g1 - kBodyGateGap, e = f.e - kCutDistance;
+    if (!(f.n.dot(s - body->a) >= g1 + kCutDistance && g2 >= -f.h && e > 0.0)) continue;
+    std::array<HalfPlane, 5>& region = out.behind_body[out.body++];
+    region[0] = {-f.n, -f.n.dot(body->a) - g2};  // beyond the second gate: n . (q - c) <= g2
+    int k = 1;
+    for (const double g : {g1, g2}) {
+      const Position mid = body->a + g * f.n;
+      const Vector2 u0 = (mid + e * f.along - s).normalized();
+      const Vector2 u1 = (mid - e * f.along - s).normalized();
+      const double turn = Cross(u0, u1) > 0.0 ? 1.0 : -1.0;
+      region[k++] = LeftOf(s, turn * u0);  // between the lines through the gate's ends
+      region[k++] = LeftOf(s, -turn * u1);
+    }
+  }
+  return out;
+}
+
+std::optional<std::array<HalfPlane, 3>> BoxShadow(const Position& s,
+                                                  const std::array<Position, 4>& corners) {
+  const Position centre = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+  std::array<Position, 4> c;
+  for (int k = 0; k < 4; ++k) c[k] = corners[k] + kShadowInset * (centre - corners[k]);
+  // The outermost corners: all others lie counter-clockwise of `right`, clockwise of `left`.
+  int right = -1, left = -1;
+  for (int i = 0; i < 4; ++i) {
+    bool is_right = true, is_left = true;
+    for (int j = 0; j < 4; ++j) {
+      const double turn = Cross(c[i] - s, c[j] - s);
+      is_right = is_right && turn >= 0.0;
+      is_left = is_left && turn <= 0.0;
+    }
+    if (is_right && right < 0) right = i;
+    if (is_left && left < 0) left = i;
+  }
+  if (right < 0 || left < 0 || !(Cross(c[right] - s, c[left] - s) > 0.0)) return std::nullopt;
+  if (!(Cross(c[left] - c[right], s - c[right]) > kCutDistance * (c[left] - c[right]).norm()))
+    return std::nullopt;  // s must lie clear of the two corners' segment, on its left
+  // Beyond the segment (on its right) by the occlusion shrink as well: the shrunk line of sight
+  // still crosses it.
+  HalfPlane beyond = LeftOf(c[right], -(c[left] - c[right]).normalized());
+  beyond.offset += kOcclusionShrink;
+  return std::array<HalfPlane, 3>{LeftOf(s, (c[right] - s).normalized()),
+                                  LeftOf(s, -(c[left] - s).normalized()), beyond};
+}
+
+// A piece's walk_begin, walk_end and skip: the spans of samples that lie in a rejected region
+// (kCutDistance deep; the spans are computed twice as deep, so rounding of the spans and of the
+// samples' positions, ~1e-12 m, stays inside): outside the view, behind the body, in the shadow
+// of a candidate box (BehindOthers lists it: its interval holds the shadow's directions, its
+// min_distance is nearer, SegmentHitsBox finds the crossing). Their union's stretches at the ends
+// are not walked or not handed on, its longest stretch between is skipped. Then a piece that
+// another rail hides in all of the rest is not walked (the median barrier hides the far rail).
+void SensorScan::CutRailWalk(RailPiece& piece) {
+  const double len = (piece.b - piece.a).norm();
+  if (!(len > 0.0)) return;
+  const Vector2 d = (piece.b - piece.a) / len;
+  const double depth = 2.0 * kCutDistance;
+  std::vector<Span>& spans = scratch_.spans;
+  spans.clear();
+  for (int i = 0; i < rejected_.fov; ++i) {
+    spans.emplace_back();
+    KeepInside(rejected_.fov_outside[i], piece.a, d, depth, &spans.back());
+  }
+  for (int r = 0; r < rejected_.body; ++r) {
+    spans.emplace_back();
+    for (const HalfPlane& h : rejected_.behind_body[r])
+      KeepInside(h, piece.a, d, depth, &spans.back());
+  }
+  for (const std::array<HalfPlane, 3>& shadow : scratch_.shadows) {
+    spans.emplace_back();
+    for (const HalfPlane& h : shadow) KeepInside(h, piece.a, d, depth, &spans.back());
+  }
+  std::erase_if(spans,
+                [&](const Span& sp) { return !(sp.lo <= sp.hi && sp.hi >= 0.0 && sp.lo <= len); });
+  std::sort(spans.begin(), spans.end(), [](const Span& x, const Span& y) { return x.lo < y.lo; });
+  double begin = 0.0, end = len;
+  Span skip = piece.skip;
+  for (std::size_t i = 0; i < spans.size();) {  // the union's stretches, in order
+    Span u = spans[i];
+    for (++i; i < spans.size() && spans[i].lo <= u.hi; ++i) u.hi = std::max(u.hi, spans[i].hi);
+    if (u.lo <= 0.0) {
+      begin = std::max(begin, u.hi);
+    } else if (u.hi >= len) {
+      end = std::min(end, u.lo);
+    } else if (!(skip.hi - skip.lo >= u.hi - u.lo)) {
+      skip = u;
+    }
+  }
+  piece.walk_begin = begin;
+  piece.walk_end = end < len ? end : std::numeric_limits<double>::infinity();
+  piece.skip = skip;
+  if (!(begin < end)) {
+    piece.walk_end = 0.0;
+    return;
+  }
+  if (!options_.occlusion) return;
+  const Position first = piece.a + begin * d, last = end < len ? piece.a + end * d : piece.b;
+  for (const Occluder& o : scratch_.occluders)
+    if (o.owner != -1 - piece.segment && HidesWhole(o, first, last)) {
+      piece.walk_end = 0.0;
+      return;
+    }
+}
+
+void SensorScan::CutRailWalks() {
+  rejected_ = MakeRejectedRegions(s_, to_local_, half_fov_, has_body_ ? &body_ : nullptr);
+  scratch_.shadows.clear();
+  if (options_.occlusion)
+    for (const Occluder& o : scratch_.occluders)
+      if (o.is_box)
+        if (const auto shadow = BoxShadow(s_, targets_[o.owner].corners))
+          scratch_.shadows.push_back(*shadow);
+  for (RailPiece& piece : scratch_.rail_pieces) CutRailWalk(piece);
 }
 
 void SensorScan::AddBoxes() {
@@ -271,7 +449,7 @@ void SensorScan::AddGhosts() {
   AddGhostScatterers(view, options_.multipath, scene_, occluded, &scratch_.scatterers);
 }
 
-void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch) {
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, bool cut) {
   std::vector<Edge>& edges = scratch.edges;
   std::vector<SensorCone>& cones = scratch.cones;
   std::vector<std::pair<int, int>>& owner_of = scratch.owner_of;
@@ -282,7 +460,12 @@ void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch) {
     cones.push_back(scans[j]->cone());
     const std::vector<RailPiece>& pieces = scans[j]->rail_pieces();
     for (std::size_t k = 0; k < pieces.size(); ++k) {
-      edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
+      if (cut && pieces[k].walk_end == 0.0) continue;
+      if (cut)
+        edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j), pieces[k].walk_end,
+                         pieces[k].walk_begin, pieces[k].skip.lo, pieces[k].skip.hi});
+      else
+        edges.push_back({pieces[k].a, pieces[k].b, static_cast<int>(j)});
       owner_of.emplace_back(static_cast<int>(j), static_cast<int>(k));
     }
   }

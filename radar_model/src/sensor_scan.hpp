@@ -7,6 +7,8 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
@@ -23,6 +25,14 @@ struct RailPiece {
   Position a, b;     ///< [m] world
   int segment;       ///< the segment's index over all polylines
   double rcs_per_m;  ///< [m^2 / m]
+  /// [m along a -> b] the scan rejects every sample whose midpoint lies before walk_begin (Edge::
+  /// begin) and every sample that starts at or beyond walk_end (Edge::stop); walk_end 0: the
+  /// whole piece is rejected (not walked).
+  double walk_begin = 0.0;
+  double walk_end = std::numeric_limits<double>::infinity();
+  /// [m along a -> b] the scan rejects every sample whose midpoint lies in [skip.lo, skip.hi]
+  /// (Edge::skip_lo, skip_hi; a box's shadow across the piece).
+  Span skip{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
 };
 
 /// What the scan needs of a target whatever the sensor, computed once per step (the same values
@@ -39,6 +49,30 @@ struct TargetGeometry {
 /// The TargetGeometry of every target of `scene`, in its order (`out` reused).
 void ComputeTargetGeometry(const Scene& scene, std::vector<TargetGeometry>* out);
 
+/// Regions of the plane whose every point a sensor's scan rejects, each the intersection of its
+/// half-planes (a point kCutDistance inside all of them is rejected): beyond the field of view
+/// widened by kFovCutAngle (one half-plane each; none when the view is too wide or narrow for
+/// the wedge to be the intersection of two), and behind the ego's body (five half-planes each).
+struct RejectedRegions {
+  int fov = 0;
+  std::array<HalfPlane, 2> fov_outside;
+  int body = 0;
+  std::array<std::array<HalfPlane, 5>, 4> behind_body;
+};
+
+/// The shadow of a box (corners) seen from s [m], an intersection of three half-planes: beyond
+/// the segment between its outermost corners moved kShadowInset of the way to the centre (by
+/// kOcclusionShrink more), between the lines from s through them. A line of sight to a point
+/// kCutDistance inside all three, shrunk by kOcclusionShrink, crosses the box's inside.
+/// std::nullopt when s is not clear of that segment.
+std::optional<std::array<HalfPlane, 3>> BoxShadow(const Position& s,
+                                                  const std::array<Position, 4>& corners);
+
+/// The regions of a sensor at s [m] with half field of view half_fov [rad] and world -> sensor
+/// rotation to_local; the body's when `body` (the shrunk ego box BehindBody tests) is given.
+RejectedRegions MakeRejectedRegions(const Position& s, const Matrix2& to_local, double half_fov,
+                                    const Occluder* body);
+
 /// One sensor's working memory, kept between steps so that a scan allocates nothing once warmed
 /// up. Each scan in flight has its own; every user clears what it takes.
 struct ScanScratch {
@@ -50,8 +84,10 @@ struct ScanScratch {
   std::vector<Scatterer> rail_buffer;  // GroupByPiece's copy
   std::vector<std::vector<int>> bins;  // kAzimuthBins lists when occlusion is on
   std::vector<FaceSample> samples;
-  std::vector<Scatterer> scatterers;                           // the scan's result
-  std::vector<Detection> detections;                           // RadarModel::Scan's, per sensor
+  std::vector<Span> spans;                        // CutRailWalks' spans of rejected samples
+  std::vector<std::array<HalfPlane, 3>> shadows;  // CutRailWalks' box shadows
+  std::vector<Scatterer> scatterers;              // the scan's result
+  std::vector<Detection> detections;              // RadarModel::Scan's, per sensor
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;  // (resolution cell, scatterer)
 };
 
@@ -78,6 +114,9 @@ class SensorScan {
   void CullTargets();
   void CullRails();
   void FillBins();
+  void CutRailWalks();
+  void CutRailWalk(RailPiece& piece);
+  bool HidesWhole(const Occluder& o, const Position& p0, const Position& p1) const;
   void AddBoxes();
   Position LocalOf(const Position& q) const { return to_local_ * (q - s_); }
   bool InFov(const Interval& iv) const;
@@ -104,6 +143,7 @@ class SensorScan {
   bool has_body_;
   SensorCone cone_;
   std::size_t rail_begin_ = 0;  // the first rail scatterer in scratch.scatterers
+  RejectedRegions rejected_;    // CutRailWalks
 };
 
 /// ScanRails' working memory.
@@ -114,7 +154,10 @@ struct RailWalkScratch {
 };
 
 /// Step 3 of every scan of `scans`: their rail pieces walked together (WalkEdges with one cone
-/// per scan), each kept sample handed to its scan, then FinishRails.
-void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch);
+/// per scan), each kept sample handed to its scan, then FinishRails. Each piece is walked up to
+/// its walk_end (a hidden piece not at all), its samples before walk_begin and in its skip not
+/// handed on; with `cut` false every piece is walked whole and every kept sample handed on (the
+/// same scatterers: the reference of the tests).
+void ScanRails(std::span<SensorScan* const> scans, RailWalkScratch& scratch, bool cut = true);
 
 }  // namespace dualgrid::radar::detail

@@ -5,11 +5,14 @@
 // and heading.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "../../radar_model/src/edge_walk.hpp"
 #include "../../radar_model/src/scan_geometry.hpp"
+#include "../../radar_model/src/sensor_scan.hpp"
 #include "dualgrid/core/random.hpp"
 #include "dualgrid/radar_model/radar_model.hpp"
 
@@ -291,4 +294,214 @@ TEST_CASE("Scan with the sensors' rails walked together equals ScanSensor per se
   }
   CHECK(detections > 2000);
   CHECK(rail_detections > 500);
+}
+
+namespace {
+
+bool SameScatterer(const radar::Scatterer& a, const radar::Scatterer& b) {
+  return SameBits(a.position.x(), b.position.x()) && SameBits(a.position.y(), b.position.y()) &&
+         SameBits(a.rcs_m2, b.rcs_m2) && SameBits(a.truth.range, b.truth.range) &&
+         SameBits(a.truth.azimuth, b.truth.azimuth) &&
+         SameBits(a.truth.range_rate, b.truth.range_rate) && a.source_id == b.source_id;
+}
+
+// A motorway as the scenarios draw it: a median barrier, a rail beyond it (hidden by it) and a
+// rail on the near side, each a few long segments, with cars around a turned ego.
+radar::Scene MotorwayScene(CounterRng& rng) {
+  radar::Scene scene;
+  const double ys[3] = {rng.Uniform(2.0, 6.0), rng.Uniform(15.0, 22.0), -rng.Uniform(8.0, 16.0)};
+  for (int i = 0; i < 3; ++i) {
+    radar::Polyline line;
+    line.id = 1000 + i;
+    for (double x = -400.0; x < 400.0; x += rng.Uniform(40.0, 500.0))
+      line.points.push_back(Position(x, ys[i] + rng.Uniform(-0.3, 0.3)));
+    line.points.push_back(Position(400.0, ys[i]));
+    if (i == 1 && rng.Uniform() < 0.5) std::reverse(line.points.begin(), line.points.end());
+    scene.polylines.push_back(line);
+  }
+  for (int i = 0; i < 6; ++i) {
+    radar::Target t;
+    t.id = i;
+    t.box = OrientedBox{Position(rng.Uniform(-60.0, 60.0), rng.Uniform(-7.0, 1.0)),
+                        rng.Uniform(-0.1, 0.1), 4.5, 1.8};
+    t.velocity = Velocity(rng.Uniform(20.0, 35.0), 0.0);
+    scene.targets.push_back(t);
+  }
+  return scene;
+}
+
+}  // namespace
+
+// The rail walks are cut (SensorScan::CutRailWalks): a piece stops where the field of view
+// ends along it, and a piece that another rail hides whole (the far rail behind the median) is
+// not walked. The cuts rest on proofs with margins; the scatterers must be those of the whole
+// walks bit for bit and in order, for every sensor of the rig, on scenes where both cuts occur
+// (fails if a cut drops a sample the scan keeps).
+TEST_CASE("the cut rail walks give the scatterers of the whole walks", "[radar][edge_walk]") {
+  const radar::RadarModel model(radar::DefaultRig(4.5, 1.8), radar::ModelOptions{}, 1);
+  const radar::ModelOptions& options = model.options();
+  std::size_t scatterers = 0, hidden = 0, stopped = 0, pieces = 0;
+  for (std::uint32_t scene_index = 0; scene_index < 60; ++scene_index) {
+    CounterRng rng(41, RngPurpose::kTest, scene_index, 0);
+    const radar::Scene scene = MotorwayScene(rng);
+    radar::EgoMotion ego;
+    ego.pose = Pose2{Position(rng.Uniform(-20.0, 20.0), rng.Uniform(-6.0, 0.0)),
+                     rng.Uniform(-0.4, 0.4) + (scene_index % 4 == 3 ? kPi : 0.0)};
+    ego.velocity = Velocity(rng.Uniform(0.0, 35.0), 0.0);
+    ego.length = 4.5;
+    ego.width = 1.8;
+    std::vector<TargetGeometry> targets;
+    ComputeTargetGeometry(scene, &targets);
+    for (int sensor = 0; sensor < static_cast<int>(model.sensors().size()); ++sensor) {
+      ScanScratch cut_scratch, whole_scratch;
+      RailWalkScratch walk_scratch;
+      SensorScan cut(model.sensors()[sensor], model.sensor_models()[sensor], options, ego, scene,
+                     targets, cut_scratch);
+      SensorScan whole(model.sensors()[sensor], model.sensor_models()[sensor], options, ego, scene,
+                       targets, whole_scratch);
+      SensorScan* const cut_scans[1] = {&cut};
+      SensorScan* const whole_scans[1] = {&whole};
+      ScanRails(cut_scans, walk_scratch, true);
+      ScanRails(whole_scans, walk_scratch, false);
+      for (const RailPiece& piece : cut.rail_pieces()) {
+        ++pieces;
+        hidden += piece.walk_end == 0.0;
+        stopped += piece.walk_end > 0.0 && piece.walk_end < (piece.b - piece.a).norm();
+      }
+      INFO("scene " << scene_index << ", sensor " << sensor);
+      REQUIRE(cut_scratch.scatterers.size() == whole_scratch.scatterers.size());
+      for (std::size_t k = 0; k < whole_scratch.scatterers.size(); ++k)
+        if (!SameScatterer(cut_scratch.scatterers[k], whole_scratch.scatterers[k]))
+          FAIL_CHECK("scatterer " << k << " differs");
+      scatterers += whole_scratch.scatterers.size();
+    }
+  }
+  INFO(pieces << " pieces: " << hidden << " hidden, " << stopped << " stopped early");
+  CHECK(scatterers > 20000);
+  CHECK(hidden > pieces / 10);
+  CHECK(stopped > pieces / 5);
+}
+
+// The regions the cuts rest on (MakeRejectedRegions): every point kCutDistance inside a body
+// region must be hidden by the ego's body as BehindBody tests it (its line of sight more than
+// kEgoBodyMargin inside the shrunk box), every point kCutDistance outside a field-of-view
+// half-plane rejected by OutsideFov; and the regions must cover most of what they stand for
+// (the body's: all lines of sight into the body but those within a few degrees of the sensor's
+// face, so > 80 % of the hidden points 5-100 m away; fails if a region is turned or empty).
+TEST_CASE("the rejected regions lie behind the body and outside the field of view",
+          "[radar][edge_walk]") {
+  std::size_t in_body = 0, hidden = 0, hidden_covered = 0, outside = 0, in_fov_region = 0;
+  for (std::uint32_t scene = 0; scene < 200; ++scene) {
+    CounterRng rng(43, RngPurpose::kTest, scene, 0);
+    const double length = rng.Uniform(3.5, 6.0), width = rng.Uniform(1.6, 2.6);
+    const Pose2 ego{Position(rng.Uniform(-500.0, 500.0), rng.Uniform(-50.0, 50.0)),
+                    rng.Uniform(-kPi, kPi)};
+    Occluder body;
+    body.a = ego.position;
+    body.axis = UnitVector(ego.yaw);
+    body.half_length = 0.5 * length - kEgoBodySkin;
+    body.half_width = 0.5 * width - kEgoBodySkin;
+    // A sensor on a face, at a corner, or a little off the box.
+    Pose2 mount;
+    const int kind = static_cast<int>(scene % 4);
+    const double side = rng.Uniform() < 0.5 ? -1.0 : 1.0;
+    if (kind == 0) mount = {Position(rng.Uniform(-0.5, 0.5) * length, side * 0.5 * width), 0.0};
+    if (kind == 1) mount = {Position(side * 0.5 * length, rng.Uniform(-0.5, 0.5) * width), 0.0};
+    if (kind == 2) mount = {Position(0.5 * length, side * 0.5 * width), 0.0};
+    if (kind == 3)
+      mount = {Position(0.5 * length + 0.2, side * rng.Uniform(0.0, 0.6) * width), 0.0};
+    mount.yaw = rng.Uniform(-kPi, kPi);
+    const Pose2 pose = ego.Compose(mount);
+    const Matrix2 to_local = Rotation(pose.yaw).transpose();
+    const double half_fov = rng.Uniform(0.05, 1.5);
+    const RejectedRegions regions = MakeRejectedRegions(pose.position, to_local, half_fov, &body);
+    const auto inside = [](const HalfPlane& h, const Position& q) {
+      return h.n.dot(q) - h.offset >= kCutDistance;
+    };
+    for (int i = 0; i < 400; ++i) {
+      const Position q =
+          pose.position + rng.Uniform(0.0, 100.0) * UnitVector(rng.Uniform(-kPi, kPi));
+      const double chord = LengthInsideBox(body, pose.position, q);
+      bool covered = false;
+      for (int r = 0; r < regions.body; ++r) {
+        const auto& region = regions.behind_body[r];
+        if (std::all_of(region.begin(), region.end(),
+                        [&](const HalfPlane& h) { return inside(h, q); })) {
+          covered = true;
+          ++in_body;
+          CHECK(chord > kEgoBodyMargin);
+        }
+      }
+      if (chord > kEgoBodyMargin && (q - pose.position).norm() > 5.0) {
+        ++hidden;
+        hidden_covered += covered;
+      }
+      const Position local = to_local * (q - pose.position);
+      bool beyond_view = false;
+      for (int k = 0; k < regions.fov; ++k) beyond_view |= inside(regions.fov_outside[k], q);
+      if (beyond_view) {
+        ++in_fov_region;
+        CHECK(OutsideFov(local, local.norm(), FovCosBound(half_fov)));
+      }
+      outside += std::abs(std::atan2(local.y(), local.x())) > half_fov + 1e-3 && half_fov < 1.5;
+    }
+  }
+  INFO(in_body << " points in body regions; " << hidden_covered << " of " << hidden
+               << " hidden points covered; " << in_fov_region << " of " << outside
+               << " points outside the view in its regions");
+  CHECK(in_body > 10000);
+  CHECK(hidden_covered > 0.8 * static_cast<double>(hidden));
+  CHECK(in_fov_region > 0.9 * static_cast<double>(outside));
+}
+
+// A box's shadow (BoxShadow): every point kCutDistance inside it must be hidden by the box as
+// BehindOthers tests it (the line of sight shrunk by kOcclusionShrink hits the box, the point is
+// farther than the occluder's min_distance, its direction passes the dot test);
+// and the shadow must hold most points hidden by the box 0.5 m or more beyond it (fails if it is
+// turned, empty or reaches past the box's outline).
+TEST_CASE("a box's shadow lies behind the box", "[radar][edge_walk]") {
+  std::size_t in_shadow = 0, behind = 0, behind_covered = 0;
+  for (std::uint32_t scene = 0; scene < 300; ++scene) {
+    CounterRng rng(47, RngPurpose::kTest, scene, 0);
+    const OrientedBox box{Position(rng.Uniform(-30.0, 30.0), rng.Uniform(-30.0, 30.0)),
+                          rng.Uniform(-kPi, kPi), rng.Uniform(0.5, 15.0), rng.Uniform(0.5, 3.0)};
+    const Position s(rng.Uniform(-10.0, 10.0), rng.Uniform(-10.0, 10.0));
+    const auto shadow = BoxShadow(s, box.Corners());
+    if (box.Contains(s)) CHECK(!shadow);
+    if (!shadow) continue;
+    Occluder o;
+    o.a = box.center;
+    o.axis = UnitVector(box.yaw);
+    o.half_length = 0.5 * box.length;
+    o.half_width = 0.5 * box.width;
+    Position relative[4];  // the box's angular interval as CullTargets computes it (frame of s)
+    for (int k = 0; k < 4; ++k) relative[k] = box.Corners()[k] - s;
+    const Interval interval = IntervalOf(relative, 4);
+    // The occluder's min_distance as SensorScan::CullTargets sets it.
+    const double nearest =
+        std::max(0.0, (box.center - s).norm() - 0.5 * std::hypot(box.length, box.width));
+    for (int i = 0; i < 300; ++i) {
+      const Position q = s + rng.Uniform(0.0, 80.0) * UnitVector(rng.Uniform(-kPi, kPi));
+      const double range = (q - s).norm();
+      const Position end = q - kOcclusionShrink * (q - s) / range;
+      const bool inside = std::all_of(shadow->begin(), shadow->end(), [&](const HalfPlane& h) {
+        return h.n.dot(q) - h.offset >= kCutDistance;
+      });
+      if (inside) {
+        ++in_shadow;
+        CHECK(SegmentHitsBox(o, s, end));
+        CHECK(range > nearest);
+        CHECK((q - s).dot(UnitVector(interval.center)) / range >=
+              std::cos(interval.half_width) - 1e-12);  // BehindOthers' dot test lists the box
+      }
+      // Hidden 0.5 m or more beyond the box: the line of sight still hits it 0.5 m short of q.
+      if (SegmentHitsBox(o, s, q - 0.5 * (q - s) / range) && !box.Contains(q)) {
+        ++behind;
+        behind_covered += inside;
+      }
+    }
+  }
+  INFO(in_shadow << " points in shadows; " << behind_covered << " of " << behind << " covered");
+  CHECK(in_shadow > 2000);
+  CHECK(behind_covered > 0.8 * static_cast<double>(behind));
 }
