@@ -32,6 +32,10 @@ std::int64_t FloorToInt(double v) {
 // dx > 0): of two cells at one of these distances, exactly one sees the other at such an offset.
 constexpr int kMaxReach = 4;  // the widest neighbour block: 9 x 9 cells
 
+// Ring-1 components beyond which OuterRingCells tries every core cell (its pairs of rectangles
+// grow with the square of their count).
+constexpr std::size_t kMaxRing1Boxes = 64;
+
 // Relative margin of a point outside its given cell (RunInCells), in cell sides: far above the
 // rounding of a position stored as a float offset (micrometres on a 0.5 m cell).
 constexpr double kCellSlack = 1e-3;
@@ -240,7 +244,6 @@ bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& give
 
 int Dbscan::CoreComponents(std::span<const Position> points) {
   // Cells up to reach_ apart can hold neighbours (FineCells: h < eps < 2 h, so a 5 x 5 block).
-  const double eps2 = params_.eps * params_.eps;
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   // Each cell's core points, in input order (a stable filter of fine_sorted_).
   core_start_.resize(cells + 1);
@@ -258,25 +261,48 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   core_sorted_.resize(num_core);
   parent_.resize(cells);
   for (int c = 0; c < cells; ++c) parent_[c] = c;
-  auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
-    for (int s = core_start_[a]; s < core_start_[a + 1]; ++s)
-      for (int t = core_start_[b]; t < core_start_[b + 1]; ++t)
-        if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
-    return false;
-  };
-  // Adjacent cells first (they almost always link), then the rings further away, which are then
-  // mostly joined already and skipped without a pair search. Each unordered pair of cells once:
-  // from the cell that sees the other at an offset of the upper half plane (half_). Cells
-  // without core points take no part (they stay their own roots and get no component).
-  // In a dense table, a cell's neighbours are at fixed distances from its entry.
+  // Cells without core points take no part (they stay their own roots and get no component).
   core_cells_.clear();
   for (int c = 0; c < cells; ++c)
     if (core_start_[c] < core_start_[c + 1]) core_cells_.push_back(c);
   half_delta_.resize(half_.size());
   for (std::size_t k = 0; k < half_.size(); ++k)
     half_delta_[k] = half_[k].dy * fine_.w + half_[k].dx;
-  for (int r = 1; r <= reach_; ++r) {
-    for (const int a : core_cells_) {
+  // Adjacent cells first (they almost always link); the outer rings then only from the cells
+  // that lie within reach of another ring-1 component (OuterRingCells): every other pair of cells
+  // in the outer rings is joined already, and the components (a partition) do not depend on the
+  // order or the number of the links tried.
+  JoinRings(points, 1, 1, core_cells_);
+  if (reach_ > 1) JoinRings(points, 2, reach_, OuterRingCells());
+  // Compact component ids in cell order; each cell's core points take its component.
+  int num_components = 0;
+  std::vector<int>& id_of_root = root_component_;
+  id_of_root.assign(cells, -1);
+  for (int c = 0; c < cells; ++c) {
+    if (core_start_[c] == core_start_[c + 1]) continue;
+    const int r = FindRoot(c);
+    if (id_of_root[r] < 0) id_of_root[r] = num_components++;
+    const int component = id_of_root[r];
+    for (int s = core_start_[c]; s < core_start_[c + 1]; ++s)
+      component_[core_sorted_[s]] = component;
+  }
+  return num_components;
+}
+
+void Dbscan::JoinRings(std::span<const Position> points, int first_ring, int last_ring,
+                       std::span<const int> from) {
+  const double eps2 = params_.eps * params_.eps;
+  auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
+    for (int s = core_start_[a]; s < core_start_[a + 1]; ++s)
+      for (int t = core_start_[b]; t < core_start_[b + 1]; ++t)
+        if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
+    return false;
+  };
+  // Each unordered pair of cells once: from the cell that sees the other at an offset of the
+  // upper half plane (half_). In a dense table, a cell's neighbours are at fixed distances from
+  // its entry.
+  for (int r = first_ring; r <= last_ring; ++r) {
+    for (const int a : from) {
       int ra = FindRoot(a);
       const auto join = [&](int b) {
         if (b < 0 || core_start_[b] == core_start_[b + 1]) return;
@@ -295,19 +321,57 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
       }
     }
   }
-  // Compact component ids in cell order; each cell's core points take its component.
-  int num_components = 0;
-  std::vector<int>& id_of_root = root_component_;
-  id_of_root.assign(cells, -1);
-  for (int c = 0; c < cells; ++c) {
-    if (core_start_[c] == core_start_[c + 1]) continue;
-    const int r = FindRoot(c);
-    if (id_of_root[r] < 0) id_of_root[r] = num_components++;
-    const int component = id_of_root[r];
-    for (int s = core_start_[c]; s < core_start_[c + 1]; ++s)
-      component_[core_sorted_[s]] = component;
+}
+
+std::span<const int> Dbscan::OuterRingCells() {
+  // The ring-1 components and their bounding rectangles in cells. A pair of cells of two
+  // components lies within reach_ cells along both axes, so each of its cells lies within reach_
+  // of the other's rectangle; cells within reach_ of no other rectangle need no outer ring.
+  ring1_of_.resize(core_cells_.size());
+  ring1_boxes_.clear();
+  root_component_.assign(parent_.size(), -1);
+  for (std::size_t k = 0; k < core_cells_.size(); ++k) {
+    const int a = core_cells_[k];
+    int& id = root_component_[FindRoot(a)];
+    if (id < 0) {
+      id = static_cast<int>(ring1_boxes_.size());
+      ring1_boxes_.push_back({cx_[a], cx_[a], cy_[a], cy_[a]});
+    }
+    CellBox& b = ring1_boxes_[id];
+    b.x0 = std::min(b.x0, cx_[a]);
+    b.x1 = std::max(b.x1, cx_[a]);
+    b.y0 = std::min(b.y0, cy_[a]);
+    b.y1 = std::max(b.y1, cy_[a]);
+    ring1_of_[k] = id;
   }
-  return num_components;
+  const std::size_t boxes = ring1_boxes_.size();
+  if (boxes > kMaxRing1Boxes) return core_cells_;  // the pairs of rectangles would cost more
+  // Per component, the others whose rectangles come within reach_ of its own (CSR lists).
+  const std::int64_t reach = reach_;
+  const auto near = [reach](const CellBox& b, std::int64_t x0, std::int64_t x1, std::int64_t y0,
+                            std::int64_t y1) {
+    return x0 <= b.x1 + reach && x1 >= b.x0 - reach && y0 <= b.y1 + reach && y1 >= b.y0 - reach;
+  };
+  near_start_.assign(boxes + 1, 0);
+  near_boxes_.clear();
+  for (std::size_t i = 0; i < boxes; ++i) {
+    const CellBox& bi = ring1_boxes_[i];
+    for (std::size_t j = 0; j < boxes; ++j)
+      if (j != i && near(ring1_boxes_[j], bi.x0, bi.x1, bi.y0, bi.y1))
+        near_boxes_.push_back(static_cast<int>(j));
+    near_start_[i + 1] = static_cast<int>(near_boxes_.size());
+  }
+  outer_cells_.clear();
+  for (std::size_t k = 0; k < core_cells_.size(); ++k) {
+    const int a = core_cells_[k], id = ring1_of_[k];
+    for (int m = near_start_[id]; m < near_start_[id + 1]; ++m) {
+      if (near(ring1_boxes_[near_boxes_[m]], cx_[a], cx_[a], cy_[a], cy_[a])) {
+        outer_cells_.push_back(a);
+        break;
+      }
+    }
+  }
+  return outer_cells_;
 }
 
 template <typename F>
