@@ -170,6 +170,7 @@ void Dbscan::FineCells(std::span<const Position> points) {
   }
   SetBlock(2, 0.0);
   whole_core_ = true;
+  sorted_is_identity_ = false;
   const int cells = fine_.Build(fx_, fy_, reach_, fine_cell_);
   fine_start_.assign(cells + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++fine_start_[fine_cell_[i] + 1];
@@ -239,6 +240,7 @@ bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& give
   if (fine_.Build(cx_, cy_, reach_, fine_cell_) != cells) return false;
   fine_sorted_.resize(n);
   for (int i = 0; i < n; ++i) fine_sorted_[i] = i;
+  sorted_is_identity_ = true;
   return true;
 }
 
@@ -246,14 +248,23 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   // Cells up to reach_ apart can hold neighbours (FineCells: h < eps < 2 h, so a 5 x 5 block).
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   // Each cell's core points, in input order (a stable filter of fine_sorted_).
+  // A cell that CountCore made core as a whole is copied without its flags.
   core_start_.resize(cells + 1);
   core_sorted_.resize(fine_sorted_.size());
+  const int* const sorted = fine_sorted_.data();
+  int* const core_sorted = core_sorted_.data();
   int num_core = 0;
   for (int c = 0; c < cells; ++c) {
     core_start_[c] = num_core;
-    for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
-      const int i = fine_sorted_[k];
-      core_sorted_[num_core] = i;
+    const int first = fine_start_[c], last = fine_start_[c + 1];
+    if (whole_cells_core_ && last - first >= params_.min_points) {
+      std::copy(sorted + first, sorted + last, core_sorted + num_core);
+      num_core += last - first;
+      continue;
+    }
+    for (int k = first; k < last; ++k) {
+      const int i = sorted[k];
+      core_sorted[num_core] = i;
       num_core += core_[i];
     }
   }
@@ -274,17 +285,23 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   // order or the number of the links tried.
   JoinRings(points, 1, 1, core_cells_);
   if (reach_ > 1) JoinRings(points, 2, reach_, OuterRingCells());
-  // Compact component ids in cell order; each cell's core points take its component.
+  // Compact component ids in cell order; each cell's core points take its component (a fill
+  // where they are consecutive input indices: all of a given cell's points).
   int num_components = 0;
   std::vector<int>& id_of_root = root_component_;
   id_of_root.assign(cells, -1);
+  int* const component_of = component_.data();
   for (int c = 0; c < cells; ++c) {
-    if (core_start_[c] == core_start_[c + 1]) continue;
+    const int first = core_start_[c], last = core_start_[c + 1];
+    if (first == last) continue;
     const int r = FindRoot(c);
     if (id_of_root[r] < 0) id_of_root[r] = num_components++;
     const int component = id_of_root[r];
-    for (int s = core_start_[c]; s < core_start_[c + 1]; ++s)
-      component_[core_sorted_[s]] = component;
+    if (sorted_is_identity_ && last - first == fine_start_[c + 1] - fine_start_[c]) {
+      std::fill(component_of + fine_start_[c], component_of + fine_start_[c + 1], component);
+      continue;
+    }
+    for (int s = first; s < last; ++s) component_of[core_sorted[s]] = component;
   }
   return num_components;
 }
@@ -524,6 +541,7 @@ std::span<const int> Dbscan::LabelOnFineGrid(std::span<const Position> points,
     WeightedCore(points, weights);
   else
     CountCore(points);
+  whole_cells_core_ = whole_core_ && !use_weights;
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);

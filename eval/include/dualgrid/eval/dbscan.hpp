@@ -180,6 +180,9 @@ class Dbscan {
   std::vector<Offset> half_, block_;
   std::vector<int> ring_start_;
   bool whole_core_ = true;
+  // CountCore made every point of a cell holding min_points points core (whole_core_ without the
+  // weighted criterion); fine_sorted_ is the identity (GivenCells: points in cell order).
+  bool whole_cells_core_ = false, sorted_is_identity_ = false;
   std::vector<std::int64_t> fx_, fy_, cx_, cy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
   std::vector<int> core_start_, core_sorted_;
