@@ -226,13 +226,21 @@ bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& give
     cy_[c] = run.y;
     fine_start_[c] = run.first;
     const int last = c + 1 < cells ? given.runs[c + 1].first : n;
-    const double x = static_cast<double>(run.x), y = static_cast<double>(run.y);
-    for (int i = run.first; i < last; ++i) {  // the position in cell sides, relative to the cell
-      const double u = (points[i].x() - given.origin.x()) * inv_side - x;
-      const double v = (points[i].y() - given.origin.y()) * inv_side - y;
-      inside &=
-          u >= -kCellSlack && u <= 1.0 + kCellSlack && v >= -kCellSlack && v <= 1.0 + kCellSlack;
+    // The position in cell sides, relative to the cell, is a non-decreasing function of the
+    // coordinate (a subtraction, a product by a positive factor, a subtraction: each rounded
+    // monotonically), so the run's extreme coordinates (finite: CheckInput) give its extremes.
+    double lo_x = points[run.first].x(), hi_x = lo_x, lo_y = points[run.first].y(), hi_y = lo_y;
+    for (int i = run.first + 1; i < last; ++i) {
+      lo_x = std::min(lo_x, points[i].x());
+      hi_x = std::max(hi_x, points[i].x());
+      lo_y = std::min(lo_y, points[i].y());
+      hi_y = std::max(hi_y, points[i].y());
     }
+    const double x = static_cast<double>(run.x), y = static_cast<double>(run.y);
+    const auto u = [&](double v) { return (v - given.origin.x()) * inv_side - x; };
+    const auto w = [&](double v) { return (v - given.origin.y()) * inv_side - y; };
+    inside &= (u(lo_x) >= -kCellSlack) & (u(hi_x) <= 1.0 + kCellSlack) & (w(lo_y) >= -kCellSlack) &
+              (w(hi_y) <= 1.0 + kCellSlack);
   }
   fine_start_[cells] = n;
   if (!inside) return false;
@@ -411,21 +419,26 @@ void Dbscan::CountCore(std::span<const Position> points) {
   // they are within eps of each other (Gunawan's rule). The points of the other cells count their
   // neighbours until min_points.
   const int cells = static_cast<int>(fine_start_.size()) - 1;
+  // Through local pointers: the flags' byte stores could alias the members, which the compiler
+  // would then reload per point.
+  const int* const start = fine_start_.data();
+  const int* const sorted = fine_sorted_.data();
+  std::uint8_t* const core = core_.data();
   ParallelFor(
       cells, Schedule::kDynamic,
       [&](std::int64_t c64) {
         const int c = static_cast<int>(c64);
-        const bool dense = whole_core_ && fine_start_[c + 1] - fine_start_[c] >= params_.min_points;
-        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
-          const int i = fine_sorted_[k];
-          if (dense) {
-            core_[i] = 1;
-            continue;
-          }
+        const int first = start[c], last = start[c + 1];
+        if (whole_core_ && last - first >= params_.min_points) {
+          for (int k = first; k < last; ++k) core[sorted[k]] = 1;
+          return;
+        }
+        for (int k = first; k < last; ++k) {
+          const int i = sorted[k];
           int count = 0;
           ForEachFineNeighbour(points, c, i, [&](int) {
             if (++count < params_.min_points) return true;
-            core_[i] = 1;
+            core[i] = 1;
             return false;
           });
         }

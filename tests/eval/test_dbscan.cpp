@@ -360,6 +360,36 @@ TEST_CASE("DBSCAN in given cells joins components through the outer rings as bru
   CHECK(dbscan.num_clusters() > 1);
 }
 
+TEST_CASE("DBSCAN in given cells notices a run's point outside its cell on each side", "[dbscan]") {
+  // The lattice points grouped by 0.5 m cells; in a run of several points one point is moved
+  // 2.5 m along one axis (the others stay inside), so that only the run's lowest or highest
+  // coordinate leaves the cell: RunInCells must notice it and give Run's labels, which trusting
+  // the cell (the moved point taken as core in its crowded cell, or unseen where it now lies)
+  // would change.
+  const std::uint64_t seed = GENERATE(range(1, 6));
+  std::vector<Position> base = RandomPoints(seed, 400, 12.0, false);
+  const PointCells cells = GroupByCells(base, Position::Zero(), 0.5);
+  const Position moves[] = {{2.5, 0.0}, {-2.5, 0.0}, {0.0, 2.5}, {0.0, -2.5}};
+  const int n = static_cast<int>(base.size());
+  int tried = 0;
+  for (std::size_t r = 0; r < cells.runs.size(); ++r) {
+    const int first = cells.runs[r].first;
+    const int last = r + 1 < cells.runs.size() ? cells.runs[r + 1].first : n;
+    if (last - first < 3) continue;
+    for (const Position& move : moves) {
+      std::vector<Position> pts = base;
+      pts[first + 1] += move;  // neither the run's first nor its last point
+      Dbscan given({.eps = 1.0, .min_points = 3}), reference({.eps = 1.0, .min_points = 3});
+      const auto got = given.RunInCells(pts, {}, cells);
+      const auto expected = reference.Run(pts);
+      CHECK(std::vector<int>(got.begin(), got.end()) ==
+            std::vector<int>(expected.begin(), expected.end()));
+      ++tried;
+    }
+  }
+  CHECK(tried >= 40);
+}
+
 TEST_CASE("DBSCAN in given cells links points exactly eps apart three cells apart", "[dbscan]") {
   // Cells of 0.5 m: (0.5, 0.1) on the right edge of cell 0 and (1.5, 0.1) on the left edge of
   // cell 3 are exactly eps apart; and a pair slightly nearer each edge than the cells' slack.
