@@ -32,6 +32,10 @@ std::int64_t FloorToInt(double v) {
 // dx > 0): of two cells at one of these distances, exactly one sees the other at such an offset.
 constexpr int kMaxReach = 4;  // the widest neighbour block: 9 x 9 cells
 
+// Ring-1 components beyond which OuterRingCells tries every core cell (its pairs of rectangles
+// grow with the square of their count).
+constexpr std::size_t kMaxRing1Boxes = 64;
+
 // Relative margin of a point outside its given cell (RunInCells), in cell sides: far above the
 // rounding of a position stored as a float offset (micrometres on a 0.5 m cell).
 constexpr double kCellSlack = 1e-3;
@@ -166,6 +170,7 @@ void Dbscan::FineCells(std::span<const Position> points) {
   }
   SetBlock(2, 0.0);
   whole_core_ = true;
+  sorted_is_identity_ = false;
   const int cells = fine_.Build(fx_, fy_, reach_, fine_cell_);
   fine_start_.assign(cells + 1, 0);
   for (std::size_t i = 0; i < n; ++i) ++fine_start_[fine_cell_[i] + 1];
@@ -221,13 +226,21 @@ bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& give
     cy_[c] = run.y;
     fine_start_[c] = run.first;
     const int last = c + 1 < cells ? given.runs[c + 1].first : n;
-    const double x = static_cast<double>(run.x), y = static_cast<double>(run.y);
-    for (int i = run.first; i < last; ++i) {  // the position in cell sides, relative to the cell
-      const double u = (points[i].x() - given.origin.x()) * inv_side - x;
-      const double v = (points[i].y() - given.origin.y()) * inv_side - y;
-      inside &=
-          u >= -kCellSlack && u <= 1.0 + kCellSlack && v >= -kCellSlack && v <= 1.0 + kCellSlack;
+    // The position in cell sides, relative to the cell, is a non-decreasing function of the
+    // coordinate (a subtraction, a product by a positive factor, a subtraction: each rounded
+    // monotonically), so the run's extreme coordinates (finite: CheckInput) give its extremes.
+    double lo_x = points[run.first].x(), hi_x = lo_x, lo_y = points[run.first].y(), hi_y = lo_y;
+    for (int i = run.first + 1; i < last; ++i) {
+      lo_x = std::min(lo_x, points[i].x());
+      hi_x = std::max(hi_x, points[i].x());
+      lo_y = std::min(lo_y, points[i].y());
+      hi_y = std::max(hi_y, points[i].y());
     }
+    const double x = static_cast<double>(run.x), y = static_cast<double>(run.y);
+    const auto u = [&](double v) { return (v - given.origin.x()) * inv_side - x; };
+    const auto w = [&](double v) { return (v - given.origin.y()) * inv_side - y; };
+    inside &= (u(lo_x) >= -kCellSlack) & (u(hi_x) <= 1.0 + kCellSlack) & (w(lo_y) >= -kCellSlack) &
+              (w(hi_y) <= 1.0 + kCellSlack);
   }
   fine_start_[cells] = n;
   if (!inside) return false;
@@ -235,22 +248,31 @@ bool Dbscan::GivenCells(std::span<const Position> points, const PointCells& give
   if (fine_.Build(cx_, cy_, reach_, fine_cell_) != cells) return false;
   fine_sorted_.resize(n);
   for (int i = 0; i < n; ++i) fine_sorted_[i] = i;
+  sorted_is_identity_ = true;
   return true;
 }
 
 int Dbscan::CoreComponents(std::span<const Position> points) {
   // Cells up to reach_ apart can hold neighbours (FineCells: h < eps < 2 h, so a 5 x 5 block).
-  const double eps2 = params_.eps * params_.eps;
   const int cells = static_cast<int>(fine_start_.size()) - 1;
   // Each cell's core points, in input order (a stable filter of fine_sorted_).
+  // A cell that CountCore made core as a whole is copied without its flags.
   core_start_.resize(cells + 1);
   core_sorted_.resize(fine_sorted_.size());
+  const int* const sorted = fine_sorted_.data();
+  int* const core_sorted = core_sorted_.data();
   int num_core = 0;
   for (int c = 0; c < cells; ++c) {
     core_start_[c] = num_core;
-    for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
-      const int i = fine_sorted_[k];
-      core_sorted_[num_core] = i;
+    const int first = fine_start_[c], last = fine_start_[c + 1];
+    if (whole_cells_core_ && last - first >= params_.min_points) {
+      std::copy(sorted + first, sorted + last, core_sorted + num_core);
+      num_core += last - first;
+      continue;
+    }
+    for (int k = first; k < last; ++k) {
+      const int i = sorted[k];
+      core_sorted[num_core] = i;
       num_core += core_[i];
     }
   }
@@ -258,25 +280,54 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
   core_sorted_.resize(num_core);
   parent_.resize(cells);
   for (int c = 0; c < cells; ++c) parent_[c] = c;
-  auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
-    for (int s = core_start_[a]; s < core_start_[a + 1]; ++s)
-      for (int t = core_start_[b]; t < core_start_[b + 1]; ++t)
-        if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
-    return false;
-  };
-  // Adjacent cells first (they almost always link), then the rings further away, which are then
-  // mostly joined already and skipped without a pair search. Each unordered pair of cells once:
-  // from the cell that sees the other at an offset of the upper half plane (half_). Cells
-  // without core points take no part (they stay their own roots and get no component).
-  // In a dense table, a cell's neighbours are at fixed distances from its entry.
+  // Cells without core points take no part (they stay their own roots and get no component).
   core_cells_.clear();
   for (int c = 0; c < cells; ++c)
     if (core_start_[c] < core_start_[c + 1]) core_cells_.push_back(c);
   half_delta_.resize(half_.size());
   for (std::size_t k = 0; k < half_.size(); ++k)
     half_delta_[k] = half_[k].dy * fine_.w + half_[k].dx;
-  for (int r = 1; r <= reach_; ++r) {
-    for (const int a : core_cells_) {
+  // Adjacent cells first (they almost always link); the outer rings then only from the cells
+  // that lie within reach of another ring-1 component (OuterRingCells): every other pair of cells
+  // in the outer rings is joined already, and the components (a partition) do not depend on the
+  // order or the number of the links tried.
+  JoinRings(points, 1, 1, core_cells_);
+  if (reach_ > 1) JoinRings(points, 2, reach_, OuterRingCells());
+  // Compact component ids in cell order; each cell's core points take its component (a fill
+  // where they are consecutive input indices: all of a given cell's points).
+  int num_components = 0;
+  std::vector<int>& id_of_root = root_component_;
+  id_of_root.assign(cells, -1);
+  int* const component_of = component_.data();
+  for (int c = 0; c < cells; ++c) {
+    const int first = core_start_[c], last = core_start_[c + 1];
+    if (first == last) continue;
+    const int r = FindRoot(c);
+    if (id_of_root[r] < 0) id_of_root[r] = num_components++;
+    const int component = id_of_root[r];
+    if (sorted_is_identity_ && last - first == fine_start_[c + 1] - fine_start_[c]) {
+      std::fill(component_of + fine_start_[c], component_of + fine_start_[c + 1], component);
+      continue;
+    }
+    for (int s = first; s < last; ++s) component_of[core_sorted[s]] = component;
+  }
+  return num_components;
+}
+
+void Dbscan::JoinRings(std::span<const Position> points, int first_ring, int last_ring,
+                       std::span<const int> from) {
+  const double eps2 = params_.eps * params_.eps;
+  auto linked = [&](int a, int b) {  // some core pair of cells a and b within eps
+    for (int s = core_start_[a]; s < core_start_[a + 1]; ++s)
+      for (int t = core_start_[b]; t < core_start_[b + 1]; ++t)
+        if ((points[core_sorted_[s]] - points[core_sorted_[t]]).squaredNorm() <= eps2) return true;
+    return false;
+  };
+  // Each unordered pair of cells once: from the cell that sees the other at an offset of the
+  // upper half plane (half_). In a dense table, a cell's neighbours are at fixed distances from
+  // its entry.
+  for (int r = first_ring; r <= last_ring; ++r) {
+    for (const int a : from) {
       int ra = FindRoot(a);
       const auto join = [&](int b) {
         if (b < 0 || core_start_[b] == core_start_[b + 1]) return;
@@ -295,19 +346,57 @@ int Dbscan::CoreComponents(std::span<const Position> points) {
       }
     }
   }
-  // Compact component ids in cell order; each cell's core points take its component.
-  int num_components = 0;
-  std::vector<int>& id_of_root = root_component_;
-  id_of_root.assign(cells, -1);
-  for (int c = 0; c < cells; ++c) {
-    if (core_start_[c] == core_start_[c + 1]) continue;
-    const int r = FindRoot(c);
-    if (id_of_root[r] < 0) id_of_root[r] = num_components++;
-    const int component = id_of_root[r];
-    for (int s = core_start_[c]; s < core_start_[c + 1]; ++s)
-      component_[core_sorted_[s]] = component;
+}
+
+std::span<const int> Dbscan::OuterRingCells() {
+  // The ring-1 components and their bounding rectangles in cells. A pair of cells of two
+  // components lies within reach_ cells along both axes, so each of its cells lies within reach_
+  // of the other's rectangle; cells within reach_ of no other rectangle need no outer ring.
+  ring1_of_.resize(core_cells_.size());
+  ring1_boxes_.clear();
+  root_component_.assign(parent_.size(), -1);
+  for (std::size_t k = 0; k < core_cells_.size(); ++k) {
+    const int a = core_cells_[k];
+    int& id = root_component_[FindRoot(a)];
+    if (id < 0) {
+      id = static_cast<int>(ring1_boxes_.size());
+      ring1_boxes_.push_back({cx_[a], cx_[a], cy_[a], cy_[a]});
+    }
+    CellBox& b = ring1_boxes_[id];
+    b.x0 = std::min(b.x0, cx_[a]);
+    b.x1 = std::max(b.x1, cx_[a]);
+    b.y0 = std::min(b.y0, cy_[a]);
+    b.y1 = std::max(b.y1, cy_[a]);
+    ring1_of_[k] = id;
   }
-  return num_components;
+  const std::size_t boxes = ring1_boxes_.size();
+  if (boxes > kMaxRing1Boxes) return core_cells_;  // the pairs of rectangles would cost more
+  // Per component, the others whose rectangles come within reach_ of its own (CSR lists).
+  const std::int64_t reach = reach_;
+  const auto near = [reach](const CellBox& b, std::int64_t x0, std::int64_t x1, std::int64_t y0,
+                            std::int64_t y1) {
+    return x0 <= b.x1 + reach && x1 >= b.x0 - reach && y0 <= b.y1 + reach && y1 >= b.y0 - reach;
+  };
+  near_start_.assign(boxes + 1, 0);
+  near_boxes_.clear();
+  for (std::size_t i = 0; i < boxes; ++i) {
+    const CellBox& bi = ring1_boxes_[i];
+    for (std::size_t j = 0; j < boxes; ++j)
+      if (j != i && near(ring1_boxes_[j], bi.x0, bi.x1, bi.y0, bi.y1))
+        near_boxes_.push_back(static_cast<int>(j));
+    near_start_[i + 1] = static_cast<int>(near_boxes_.size());
+  }
+  outer_cells_.clear();
+  for (std::size_t k = 0; k < core_cells_.size(); ++k) {
+    const int a = core_cells_[k], id = ring1_of_[k];
+    for (int m = near_start_[id]; m < near_start_[id + 1]; ++m) {
+      if (near(ring1_boxes_[near_boxes_[m]], cx_[a], cx_[a], cy_[a], cy_[a])) {
+        outer_cells_.push_back(a);
+        break;
+      }
+    }
+  }
+  return outer_cells_;
 }
 
 template <typename F>
@@ -330,21 +419,26 @@ void Dbscan::CountCore(std::span<const Position> points) {
   // they are within eps of each other (Gunawan's rule). The points of the other cells count their
   // neighbours until min_points.
   const int cells = static_cast<int>(fine_start_.size()) - 1;
+  // Through local pointers: the flags' byte stores could alias the members, which the compiler
+  // would then reload per point.
+  const int* const start = fine_start_.data();
+  const int* const sorted = fine_sorted_.data();
+  std::uint8_t* const core = core_.data();
   ParallelFor(
       cells, Schedule::kDynamic,
       [&](std::int64_t c64) {
         const int c = static_cast<int>(c64);
-        const bool dense = whole_core_ && fine_start_[c + 1] - fine_start_[c] >= params_.min_points;
-        for (int k = fine_start_[c]; k < fine_start_[c + 1]; ++k) {
-          const int i = fine_sorted_[k];
-          if (dense) {
-            core_[i] = 1;
-            continue;
-          }
+        const int first = start[c], last = start[c + 1];
+        if (whole_core_ && last - first >= params_.min_points) {
+          for (int k = first; k < last; ++k) core[sorted[k]] = 1;
+          return;
+        }
+        for (int k = first; k < last; ++k) {
+          const int i = sorted[k];
           int count = 0;
           ForEachFineNeighbour(points, c, i, [&](int) {
             if (++count < params_.min_points) return true;
-            core_[i] = 1;
+            core[i] = 1;
             return false;
           });
         }
@@ -460,6 +554,7 @@ std::span<const int> Dbscan::LabelOnFineGrid(std::span<const Position> points,
     WeightedCore(points, weights);
   else
     CountCore(points);
+  whole_cells_core_ = whole_core_ && !use_weights;
 
   // Clusters are the connected components of the core graph (order independent).
   component_.assign(n, kNoise);

@@ -56,6 +56,53 @@ bool LexLess(const Position& a, const Position& b) {
   return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
 }
 
+// Brute-force reference, O(n^2): core flags, core components, border -> nearest core (ties to
+// the lexicographically smaller core point). Components numbered by their first core point;
+// *weight_misses counts the points with min_points neighbours that the weights made non-core.
+std::vector<int> ReferenceLabels(const std::vector<Position>& pts,
+                                 const std::vector<double>& weights, const DbscanParams& params,
+                                 int* weight_misses) {
+  const int n = static_cast<int>(pts.size());
+  std::vector<std::vector<int>> nb(n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      if ((pts[i] - pts[j]).norm() <= params.eps) nb[i].push_back(j);
+  std::vector<bool> core(n);
+  for (int i = 0; i < n; ++i) {
+    double w = 0.0;
+    for (const int j : nb[i]) w += weights.empty() ? 1.0 : weights[j];
+    core[i] = static_cast<int>(nb[i].size()) >= params.min_points && w >= params.min_weight;
+    *weight_misses += static_cast<int>(nb[i].size()) >= params.min_points && !core[i];
+  }
+  std::vector<int> comp(n, -1);
+  int nc = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!core[i] || comp[i] >= 0) continue;
+    std::vector<int> stack = {i};
+    comp[i] = nc;
+    while (!stack.empty()) {
+      const int a = stack.back();
+      stack.pop_back();
+      for (const int b : nb[a])
+        if (core[b] && comp[b] < 0) comp[b] = nc, stack.push_back(b);
+    }
+    ++nc;
+  }
+  for (int i = 0; i < n; ++i) {  // border: nearest core, ties to the lexicographically smaller
+    if (core[i]) continue;
+    int best = -1;
+    for (const int j : nb[i]) {
+      if (!core[j]) continue;
+      const double d = (pts[j] - pts[i]).squaredNorm();
+      if (best < 0 || d < (pts[best] - pts[i]).squaredNorm() ||
+          (d == (pts[best] - pts[i]).squaredNorm() && LexLess(pts[j], pts[best])))
+        best = j;
+    }
+    if (best >= 0) comp[i] = comp[best];
+  }
+  return comp;
+}
+
 }  // namespace
 
 TEST_CASE("DBSCAN params validation names the field", "[dbscan]") {
@@ -184,46 +231,10 @@ TEST_CASE("DBSCAN matches a brute-force reference and is permutation invariant",
   const auto labels_span = dbscan.Run(pts, weights);
   const std::vector<int> labels(labels_span.begin(), labels_span.end());
 
-  // Brute-force reference, O(n^2): core flags, core components, border -> nearest core.
-  std::vector<std::vector<int>> nb(n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      if ((pts[i] - pts[j]).norm() <= params.eps) nb[i].push_back(j);
-  std::vector<bool> core(n);
   int weight_misses = 0;
-  for (int i = 0; i < n; ++i) {
-    double w = 0.0;
-    for (const int j : nb[i]) w += weights[j];
-    core[i] = static_cast<int>(nb[i].size()) >= params.min_points && w >= params.min_weight;
-    weight_misses += static_cast<int>(nb[i].size()) >= params.min_points && !core[i];
-  }
+  const std::vector<int> comp = ReferenceLabels(pts, weights, params, &weight_misses);
   if (weighted) CHECK(weight_misses > 0);  // the weighted criterion decided some points
-  std::vector<int> comp(n, -1);
-  int nc = 0;
-  for (int i = 0; i < n; ++i) {
-    if (!core[i] || comp[i] >= 0) continue;
-    std::vector<int> stack = {i};
-    comp[i] = nc;
-    while (!stack.empty()) {
-      const int a = stack.back();
-      stack.pop_back();
-      for (const int b : nb[a])
-        if (core[b] && comp[b] < 0) comp[b] = nc, stack.push_back(b);
-    }
-    ++nc;
-  }
-  for (int i = 0; i < n; ++i) {  // border: nearest core, ties to the lexicographically smaller
-    if (core[i]) continue;
-    int best = -1;
-    for (const int j : nb[i]) {
-      if (!core[j]) continue;
-      const double d = (pts[j] - pts[i]).squaredNorm();
-      if (best < 0 || d < (pts[best] - pts[i]).squaredNorm() ||
-          (d == (pts[best] - pts[i]).squaredNorm() && LexLess(pts[j], pts[best])))
-        best = j;
-    }
-    if (best >= 0) comp[i] = comp[best];
-  }
+  const int nc = comp.empty() ? 0 : *std::max_element(comp.begin(), comp.end()) + 1;
   CHECK(dbscan.num_clusters() == nc);
   CHECK(Partition(labels, identity) == Partition(comp, identity));
   // Labels are numbered by first appearance in input order.
@@ -312,6 +323,71 @@ TEST_CASE("DBSCAN in given cells labels as Run does", "[dbscan]") {
   // Run after RunInCells on the same object: its own fine grid again.
   const auto again = given.Run(pts);
   CHECK(std::vector<int>(again.begin(), again.end()) == got);
+}
+
+TEST_CASE("DBSCAN in given cells joins components through the outer rings as brute force does",
+          "[dbscan]") {
+  // Vehicle-like blobs on the filter's 0.5 m cells (eps = 1 m: reach 3), 1 - 8 points per cell,
+  // random gaps between blobs: blobs one to three cells apart join or not by their facing points
+  // (the outer rings), which only the cells near another ring-1 component try. 6 blobs on a small
+  // area (the rectangles' path) and 150 on a large one (more ring-1 components than the
+  // rectangles take: every core cell tries the outer rings).
+  const std::uint64_t seed = GENERATE(range(1, 11));
+  const int blobs = GENERATE(6, 150);
+  const double extent = blobs < 50 ? 8.0 : 60.0;
+  CounterRng rng(seed, RngPurpose::kTest, 2, 0);
+  std::vector<Position> pts;
+  for (int b = 0; b < blobs; ++b) {
+    const int x0 = static_cast<int>(rng.Uniform(0.0, extent / 0.5)),
+              y0 = static_cast<int>(rng.Uniform(0.0, extent / 0.5));
+    const int w = 1 + static_cast<int>(rng.Uniform(0.0, 5.0)),
+              h = 1 + static_cast<int>(rng.Uniform(0.0, 3.0));
+    for (int x = x0; x < x0 + w; ++x)
+      for (int y = y0; y < y0 + h; ++y)
+        for (int k = 1 + static_cast<int>(rng.Uniform(0.0, 8.0)); k > 0; --k)
+          pts.emplace_back(0.5 * (x + rng.Uniform()), 0.5 * (y + rng.Uniform()));
+  }
+  const PointCells cells = GroupByCells(pts, Position::Zero(), 0.5);
+  const DbscanParams params{.eps = 1.0, .min_points = 3};
+  Dbscan dbscan(params);
+  const auto labels = dbscan.RunInCells(pts, {}, cells);
+  int weight_misses = 0;
+  const std::vector<int> expected = ReferenceLabels(pts, {}, params, &weight_misses);
+  std::vector<int> identity(pts.size());
+  std::iota(identity.begin(), identity.end(), 0);
+  CHECK(Partition(labels, identity) == Partition(expected, identity));
+  CHECK(dbscan.num_clusters() == *std::max_element(expected.begin(), expected.end()) + 1);
+  CHECK(dbscan.num_clusters() > 1);
+}
+
+TEST_CASE("DBSCAN in given cells notices a run's point outside its cell on each side", "[dbscan]") {
+  // The lattice points grouped by 0.5 m cells; in a run of several points one point is moved
+  // 2.5 m along one axis (the others stay inside), so that only the run's lowest or highest
+  // coordinate leaves the cell: RunInCells must notice it and give Run's labels, which trusting
+  // the cell (the moved point taken as core in its crowded cell, or unseen where it now lies)
+  // would change.
+  const std::uint64_t seed = GENERATE(range(1, 6));
+  std::vector<Position> base = RandomPoints(seed, 400, 12.0, false);
+  const PointCells cells = GroupByCells(base, Position::Zero(), 0.5);
+  const Position moves[] = {{2.5, 0.0}, {-2.5, 0.0}, {0.0, 2.5}, {0.0, -2.5}};
+  const int n = static_cast<int>(base.size());
+  int tried = 0;
+  for (std::size_t r = 0; r < cells.runs.size(); ++r) {
+    const int first = cells.runs[r].first;
+    const int last = r + 1 < cells.runs.size() ? cells.runs[r + 1].first : n;
+    if (last - first < 3) continue;
+    for (const Position& move : moves) {
+      std::vector<Position> pts = base;
+      pts[first + 1] += move;  // neither the run's first nor its last point
+      Dbscan given({.eps = 1.0, .min_points = 3}), reference({.eps = 1.0, .min_points = 3});
+      const auto got = given.RunInCells(pts, {}, cells);
+      const auto expected = reference.Run(pts);
+      CHECK(std::vector<int>(got.begin(), got.end()) ==
+            std::vector<int>(expected.begin(), expected.end()));
+      ++tried;
+    }
+  }
+  CHECK(tried >= 40);
 }
 
 TEST_CASE("DBSCAN in given cells links points exactly eps apart three cells apart", "[dbscan]") {

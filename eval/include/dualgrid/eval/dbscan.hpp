@@ -143,6 +143,14 @@ class Dbscan {
   // Core-point components on the fine grid (after FineCells and the core flags); fills
   // component_ for core points, returns the count.
   int CoreComponents(std::span<const Position> points);
+  // Joins the components of the core cells `from` with those of the cells in rings first_ring ..
+  // last_ring of half_ around them whose core points lie within eps of theirs.
+  void JoinRings(std::span<const Position> points, int first_ring, int last_ring,
+                 std::span<const int> from);
+  // After ring 1 is joined: the core cells within reach_ cells (along both axes) of the bounding
+  // rectangle of another ring-1 component, in cell order (all core cells when there are more than
+  // a few dozen components). Only their outer rings can join two components.
+  std::span<const int> OuterRingCells();
   int FindRoot(int c);
 
   CellTable buckets_;  // eps cells: bucket b holds sorted_[start_[b] .. start_[b + 1])
@@ -172,11 +180,22 @@ class Dbscan {
   std::vector<Offset> half_, block_;
   std::vector<int> ring_start_;
   bool whole_core_ = true;
+  // CountCore made every point of a cell holding min_points points core (whole_core_ without the
+  // weighted criterion); fine_sorted_ is the identity (GivenCells: points in cell order).
+  bool whole_cells_core_ = false, sorted_is_identity_ = false;
   std::vector<std::int64_t> fx_, fy_, cx_, cy_;
   std::vector<int> fine_cell_, fine_start_, fine_sorted_, parent_, root_component_;
   std::vector<int> core_start_, core_sorted_;
   std::vector<int> core_cells_;             // the cells holding core points
   std::vector<std::ptrdiff_t> half_delta_;  // half_ as steps in the dense table
+  // OuterRingCells: the ring-1 components' rectangles [x0, x1] x [y0, y1] in cell indices, each
+  // core cell's component (ring1_of_[k] for core_cells_[k]), the components near each one
+  // (near_boxes_[near_start_[i] .. near_start_[i + 1])) and the cells it returns.
+  struct CellBox {
+    std::int64_t x0, x1, y0, y1;
+  };
+  std::vector<CellBox> ring1_boxes_;
+  std::vector<int> ring1_of_, near_start_, near_boxes_, outer_cells_;
   std::vector<int> component_;
   std::vector<int> labels_;
   std::vector<int> relabel_;
