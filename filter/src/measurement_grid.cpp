@@ -191,13 +191,16 @@ double RelOf(const RowSensor& c, int lx, double* fx) {
 // The dx interval [*dmin, *dmax] [m] of the row's points inside the wedge of half angle
 // atan(tan_w) around the boresight (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0: three linear
 // conditions in dx); false when it is empty.
-bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax) {
+// With min_k > 0, false also when a condition's slope |k| is at most min_k (its bound in doubt).
+bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax,
+                   double min_k = 0.0) {
   *dmin = -kInf;
   *dmax = kInf;
   const double cb = c.cb, sb = c.sb, dy = c.dy;
   for (const auto& [k, d] :
        {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
         std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
+    if (min_k > 0.0 && !(std::abs(k) > min_k)) return false;
     if (k > 0.0) {
       *dmin = std::max(*dmin, -d / k);
     } else if (k < 0.0) {
@@ -236,17 +239,56 @@ constexpr double kNoKey = -1.0;
 // and its bits OR-ed into the view where the storage row wraps or not. Flush at the end.
 class RowWindow {
  public:
-  RowWindow(const RowSensor& c, std::uint8_t* view, int first) : c_(c), view_(view), base_(first) {}
+  // Cells [in_a, in_b] (none when in_a > in_b) pass the range and wedge tests for certain.
+  RowWindow(const RowSensor& c, std::uint8_t* view, int first, int in_a, int in_b)
+      : c_(c), view_(view), base_(first), in_a_(in_a), in_b_(in_b) {}
   // Cells [a, e], a the cell after the last Put's, under `key`: the square of their bins' range
   // [m^2] (kInf: no detection; kFreeKey, 0: every cell in range is in front of, behind it), or
-  // kNoKey: no bits here.
+  // kNoKey: no bits here. The certain cells take Inner, the others the window.
   void Put(int a, int e, double key) {
+    if (a > e) return;
+    const int ia = std::max(a, in_a_), ib = std::min(e, in_b_);
+    if (ia > ib) {
+      Window(a, e, key);
+      return;
+    }
+    Window(a, ia - 1, key);
+    Flush();
+    Inner(ia, ib, key);
+    base_ = ib + 1;
+    Window(ib + 1, e, key);
+  }
+  // Cells [a, e], a the cell after the window's last, in the window (any cells).
+  void Window(int a, int e, double key) {
     while (a <= e) {
       const int m = std::min(e, base_ + kWindow - 1);
       std::fill(key_ + (a - base_), key_ + (m - base_ + 1), key);
       n_ = m - base_ + 1;
       if (n_ == kWindow) Flush();
       a = m + 1;
+    }
+  }
+  // Cells [a, e] of the certain ones under key: its bits, OR-ed into the view.
+  void Inner(int a, int e, double key) {
+    if (key < 0.0) return;  // kNoKey
+    const std::uint8_t fixed = key == kInf       ? (kObserved | kNoReturn)
+                               : key == kFreeKey ? (kObserved | kFreeRay)
+                               : key == 0.0      ? kObserved
+                                                 : 0;
+    const double x0 = c_.x0, r = c_.r, ox = c_.ox, dydy = c_.dy * c_.dy;
+    const int wrap = static_cast<int>(c_.nx - c_.sx0);  // first lx whose storage column wraps
+    for (int part = 0; part < 2; ++part) {
+      const int pa = part == 0 ? a : std::max(a, wrap);
+      const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+      std::uint8_t* dst = view_ + c_.row + c_.sx0 - (part == 0 ? 0 : c_.nx);
+      if (fixed != 0) {
+        for (int lx = pa; lx <= pe; ++lx) dst[lx] |= fixed;
+        continue;
+      }
+      for (int lx = pa; lx <= pe; ++lx) {  // in front of the range or not, per cell
+        const double dx = x0 + (lx + 0.5) * r - ox;
+        dst[lx] |= dx * dx + dydy < key ? (kObserved | kFreeRay) : kObserved;
+      }
     }
   }
   void Flush() {
@@ -297,7 +339,7 @@ class RowWindow {
  private:
   const RowSensor& c_;
   std::uint8_t* view_;
-  int base_, n_ = 0;
+  int base_, in_a_, in_b_, n_ = 0;
   // Per cell its key (Put); a whole lane beyond the window.
   double key_[kWindow + 2];
 };
@@ -570,7 +612,7 @@ void MeasurementGrid::Prepare(const Position& centre, std::span<const Measuremen
   bin_run_end_.resize(bin_range_.size());
   bound_offset_.resize(ns + 1);
   bound_.resize(bin_range_.size() + ns);  // at most bins + 1 per sensor
-  sensor_trig_.resize(3 * static_cast<std::size_t>(ns));
+  sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
   PlaceDetections();
 }
 
@@ -738,9 +780,12 @@ void MeasurementGrid::FieldOfViewTables(std::span<const SensorCoverage> cov) {
   const int ns = static_cast<int>(cov.size());
   // Per-sensor trigonometry once per cycle, not per row (Prepare sized the tables).
   for (int k = 0; k < ns; ++k) {
-    sensor_trig_[3 * k] = std::cos(cov[k].boresight);
-    sensor_trig_[3 * k + 1] = std::sin(cov[k].boresight);
-    sensor_trig_[3 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+    sensor_trig_[4 * k] = std::cos(cov[k].boresight);
+    sensor_trig_[4 * k + 1] = std::sin(cov[k].boresight);
+    sensor_trig_[4 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
+    // The wedge 1e-9 rad inside (RowWindow's certain cells), -1: none.
+    const double inner = cov[k].half_fov - 1e-9;
+    sensor_trig_[4 * k + 3] = inner > 0.0 && cov[k].half_fov < 0.5 * kPi ? std::tan(inner) : -1.0;
   }
   // Last bin of the run of equal ranges each bin belongs to (per sensor): O(1) uniformity test.
   for (int k = 0; k < ns; ++k) {
@@ -788,7 +833,7 @@ void MeasurementGrid::ViewBounds(std::span<const SensorCoverage> cov) {
     bound_offset_[k] = n;
     if (bound_dir_offset_[k + 1] == bound_dir_offset_[k]) continue;  // a wide sensor
     const std::int64_t b_lo = bin_offset_[k], bins = bin_offset_[k + 1] - b_lo;
-    const double cb = sensor_trig_[3 * k], sb = sensor_trig_[3 * k + 1];
+    const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
     const std::array<double, 2>* dir = bound_dir_.data() + bound_dir_offset_[k];
     const auto add = [&](std::int64_t b, double br_after) {
       const double gx = dir[b][0] * cb - dir[b][1] * sb, gy = dir[b][0] * sb + dir[b][1] * cb;
@@ -850,9 +895,9 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
         std::min(nx_ - 1, static_cast<int>(std::floor((sc.origin.x() + half_x - x0) / r)));
     // Sensor frame (fx along the boresight): the field-of-view test needs no atan2 when
     // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
-    const double cb = sensor_trig_[3 * k], sb = sensor_trig_[3 * k + 1];
+    const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
     const bool narrow = sc.half_fov < 0.5 * kPi;
-    const double tan_hf = sensor_trig_[3 * k + 2];
+    const double tan_hf = sensor_trig_[4 * k + 2];
     const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
     const RowSensor rs{x0,
                        r,
@@ -876,8 +921,21 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     int lo_x = lx_lo, hi_x = lx_hi;
     if (narrow && !WedgeSpan(rs, &lo_x, &hi_x)) continue;
     if (lo_x > hi_x) continue;
+    // The cells that pass the range and wedge tests for certain (a cell of margin, and 1e-9 of
+    // the squared range and of the half angle: far above the tests' roundings).
+    int in_a = 1, in_b = 0;
+    const double hx2 = max2 * (1.0 - 1e-9) - dy * dy;
+    if (dy * dy >= min2 && hx2 > 0.0 && (!narrow || sensor_trig_[4 * k + 3] > 0.0)) {
+      double dmin = -std::sqrt(hx2), dmax = -dmin, wmin, wmax;
+      if (!narrow || WedgeInterval(rs, sensor_trig_[4 * k + 3], &wmin, &wmax, 1e-9)) {
+        if (narrow) dmin = std::max(dmin, wmin), dmax = std::min(dmax, wmax);
+        const double ax = x0 + 0.5 * r - sc.origin.x(), big = 4.0 * nx_;  // dx of cell lx - lx r
+        in_a = static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big));
+        in_b = static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big));
+      }
+    }
     ExactQueue exact(rs, view_.data());
-    RowWindow out(rs, view_.data(), lo_x);
+    RowWindow out(rs, view_.data(), lo_x, in_a, in_b);
     if (narrow && std::abs(dy) > 1e-6 * (sc.max_range + r)) {  // WalkRow's condition
       const std::int64_t b0 = bound_offset_[k];
       WalkRow(rs, bound_.data() + b0, static_cast<int>(bound_offset_[k + 1] - b0), lo_x, hi_x,

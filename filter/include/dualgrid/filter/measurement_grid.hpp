@@ -187,7 +187,7 @@ class MeasurementGrid {
   // Per-sensor bearing bins for the ray free space.
   std::vector<double> bin_range_;
   std::vector<std::int64_t> bin_offset_;
-  std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov)
+  std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
   // Per sensor of a half_fov below pi/2 (a narrow one), the unit directions in the sensor frame
   // (x along the boresight) at which the computed bearing (FastAtan2) crosses its bins' bounds
