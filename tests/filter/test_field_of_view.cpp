@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -75,9 +76,11 @@ std::uint8_t PlainBits(const FilterParams& fp, const std::array<std::int64_t, 2>
   return bits;
 }
 
-// Cells of the grid built for `centre` whose bits differ from the plain test's.
+// Cells of the grid built for `centre` whose bits differ from the plain test's; counts (when
+// given) adds the cells with bit 1, 2 and 4 and all cells.
 int WrongCells(const FilterParams& fp, const Position& centre, const std::vector<Measurement>& z,
-               const std::vector<SensorCoverage>& cov) {
+               const std::vector<SensorCoverage>& cov,
+               std::array<std::int64_t, 4>* counts = nullptr) {
   MeasurementGrid mg(fp);
   mg.Build(centre, z, cov);
   const auto bins = BinRanges(fp, z, cov);
@@ -86,8 +89,13 @@ int WrongCells(const FilterParams& fp, const Position& centre, const std::vector
   int wrong = 0;
   for (int ly = 0; ly < ny; ++ly) {
     for (int lx = 0; lx < nx; ++lx) {
+      const std::uint8_t want = PlainBits(fp, origin, lx, ly, cov, bins);
       const std::int64_t s = Mod(origin[1] + ly, ny) * nx + Mod(origin[0] + lx, nx);
-      wrong += mg.view()[s] != PlainBits(fp, origin, lx, ly, cov, bins);
+      wrong += mg.view()[s] != want;
+      if (counts != nullptr) {
+        for (int b = 0; b < 3; ++b) (*counts)[b] += (want & (1 << b)) != 0;
+        ++(*counts)[3];
+      }
     }
   }
   return wrong;
@@ -142,7 +150,7 @@ TEST_CASE("the field of view's row walk keeps the per-cell bits in corner cases"
 TEST_CASE("every cell's field-of-view bits are those of the plain per-cell test", "[filter][fov]") {
   FilterParams fp;  // 200 m x 25 m at 0.5 m, 1 deg bins
   CounterRng rng(37, RngPurpose::kTest, 0, 0);
-  std::int64_t observed = 0, free_ray = 0, no_return = 0, cells = 0;
+  std::array<std::int64_t, 4> counts{};  // cells with bit 1, 2, 4; all cells
   for (int scene = 0; scene < 40; ++scene) {
     // Five radars around an ego (narrow corner and side ones, a front one, sometimes a wide or
     // full-circle one), detections along their rays (some far beyond the grid).
@@ -164,27 +172,12 @@ TEST_CASE("every cell's field-of-view bits are those of the plain per-cell test"
       const Position p = c.origin + range * Vector2(std::cos(a), std::sin(a));
       z.push_back({p, Velocity(0.0, 0.0), c.origin});
     }
-    MeasurementGrid mg(fp);
-    mg.Build(ego + Vector2(rng.Uniform(-2.0, 2.0), rng.Uniform(-2.0, 2.0)), z, cov);
-    const auto bins = BinRanges(fp, z, cov);
-    const auto origin = mg.origin_index();
-    const int nx = fp.CellsX(), ny = fp.CellsY();
-    int wrong = 0;
-    for (int ly = 0; ly < ny; ++ly) {
-      for (int lx = 0; lx < nx; ++lx) {
-        const std::uint8_t want = PlainBits(fp, origin, lx, ly, cov, bins);
-        const std::int64_t s = Mod(origin[1] + ly, ny) * nx + Mod(origin[0] + lx, nx);
-        wrong += mg.view()[s] != want;
-        observed += (want & 1) != 0;
-        free_ray += (want & 2) != 0;
-        no_return += (want & 4) != 0;
-        ++cells;
-      }
-    }
+    const Position centre = ego + Vector2(rng.Uniform(-2.0, 2.0), rng.Uniform(-2.0, 2.0));
     INFO("scene " << scene << " with " << nz << " detections");
-    CHECK(wrong == 0);
+    CHECK(WrongCells(fp, centre, z, cov, &counts) == 0);
   }
   // The scenes reach every kind of cell.
+  const auto [observed, free_ray, no_return, cells] = counts;
   CHECK(observed > cells / 4);
   CHECK(free_ray > cells / 50);
   CHECK(no_return > cells / 50);
