@@ -226,6 +226,23 @@ bool WedgeSpan(const RowSensor& c, int* lo_x, int* hi_x) {
   return true;
 }
 
+// The cells [*in_a, *in_b] of the row that pass the range and wedge tests for certain (left
+// as they are when none or in doubt): 1e-9 inside the squared range and inside the half angle
+// (tan_in: tan(half_fov - 1e-9), <= 0: none), a cell of margin; far above the tests' roundings.
+void CertainCells(const RowSensor& c, double tan_in, int* in_a, int* in_b) {
+  const double hx2 = c.max2 * (1.0 - 1e-9) - c.dy * c.dy;
+  if (!(c.dy * c.dy >= c.min2 && hx2 > 0.0 && (!c.narrow || tan_in > 0.0))) return;
+  double dmin = -std::sqrt(hx2), dmax = -dmin, wmin, wmax;
+  if (c.narrow) {
+    if (!WedgeInterval(c, tan_in, &wmin, &wmax, 1e-9)) return;
+    dmin = std::max(dmin, wmin);
+    dmax = std::min(dmax, wmax);
+  }
+  const double ax = c.x0 + 0.5 * c.r - c.ox, big = 4.0 * static_cast<double>(c.nx);  // dx - lx r
+  *in_a = static_cast<int>(std::clamp(std::ceil((dmin - ax) / c.r) + 1.0, -big, big));
+  *in_b = static_cast<int>(std::clamp(std::floor((dmax - ax) / c.r) - 1.0, -big, big));
+}
+
 // Cells per window of RowWindow.
 constexpr int kWindow = 128;
 // RowWindow's keys beside a squared range: every cell in front of its range (any d2 < it), none.
@@ -921,19 +938,8 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     int lo_x = lx_lo, hi_x = lx_hi;
     if (narrow && !WedgeSpan(rs, &lo_x, &hi_x)) continue;
     if (lo_x > hi_x) continue;
-    // The cells that pass the range and wedge tests for certain (a cell of margin, and 1e-9 of
-    // the squared range and of the half angle: far above the tests' roundings).
     int in_a = 1, in_b = 0;
-    const double hx2 = max2 * (1.0 - 1e-9) - dy * dy;
-    if (dy * dy >= min2 && hx2 > 0.0 && (!narrow || sensor_trig_[4 * k + 3] > 0.0)) {
-      double dmin = -std::sqrt(hx2), dmax = -dmin, wmin, wmax;
-      if (!narrow || WedgeInterval(rs, sensor_trig_[4 * k + 3], &wmin, &wmax, 1e-9)) {
-        if (narrow) dmin = std::max(dmin, wmin), dmax = std::min(dmax, wmax);
-        const double ax = x0 + 0.5 * r - sc.origin.x(), big = 4.0 * nx_;  // dx of cell lx - lx r
-        in_a = static_cast<int>(std::clamp(std::ceil((dmin - ax) / r) + 1.0, -big, big));
-        in_b = static_cast<int>(std::clamp(std::floor((dmax - ax) / r) - 1.0, -big, big));
-      }
-    }
+    CertainCells(rs, sensor_trig_[4 * k + 3], &in_a, &in_b);
     ExactQueue exact(rs, view_.data());
     RowWindow out(rs, view_.data(), lo_x, in_a, in_b);
     if (narrow && std::abs(dy) > 1e-6 * (sc.max_range + r)) {  // WalkRow's condition
