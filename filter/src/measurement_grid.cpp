@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -27,10 +28,17 @@ constexpr int kStampColumns = 32;
 
 // Bound on |FastAtan2 - atan2| (measured 2.04e-4 rad at the octant boundary), with margin.
 constexpr double kAtanError = 5e-4;
-// Half width [rad] of the bearings around a run edge that SettleZoned leaves to the exact test:
-// beyond it a stretch's end points pass Settle's test (their computed bearings stay more than
-// 2 kAtanError + kAtanError inside the run).
-constexpr double kEdgeZone = 4.0 * kAtanError;
+// Half width [rad] of the directions around a view bound (ViewBound) whose cells WalkRow leaves
+// to the exact test. A cell's computed bearing is FastAtan2's exact-arithmetic value at a
+// direction within ~1e-15 rad of the cell's, +- 2.2e-15 rad (the roundings of fx, fy, the
+// division, the polynomial and pi - r); that function's slope is 0.976 - 1.005 between its
+// jumps; the bins' index (rel + half_fov) / free_angle_bin moves its bounds by < 2e-15 rad; the
+// bounds' directions (Newton, rotation) are within ~1e-15 rad. Beyond 1e-11 rad (over 1,000
+// times their sum) a cell's bearing is on the side of the bound its direction is on.
+constexpr double kAngleMargin = 1e-11;
+// Rounding of positions [m] per metre of coordinate magnitude (x0, the sensor, dx, dy), with a
+// wide margin (a double's is 1.1e-16).
+constexpr double kPositionMargin = 1e-12;
 
 namespace hn = hwy::HWY_NAMESPACE;
 using DD = hn::ScalableTag<double>;  // the pinned SSE4 target: two lanes, no FMA
@@ -54,6 +62,33 @@ hn::Vec<DD> FastAtan2V(hn::Vec<DD> y, hn::Vec<DD> x) {
   return hn::IfThenZeroElse(hn::Eq(mx, hn::Zero(d)), r);
 }
 
+// The a in [0, 1] with FastAtanOctant(a) = v, v in [0, FastAtanOctant(1)] (Newton from tan v,
+// which is within 2.1e-4; the slope is >= 0.49: to ~1e-16 in five steps).
+double InverseAtanOctant(double v) {
+  double a = std::clamp(std::tan(v), 0.0, 1.0);
+  for (int i = 0; i < 5; ++i) {
+    const double s = a * a;
+    const double slope = 1.0 + s * (-3.0 * kAtanC1 + s * (5.0 * kAtanC2 - 7.0 * kAtanC3 * s));
+    a = std::clamp(a - (FastAtanOctant(a) - v) / slope, 0.0, 1.0);
+  }
+  return a;
+}
+
+// The unit direction (x, y) whose FastAtan2 (exact arithmetic) is t [rad], |t| < pi/2: FastAtan2
+// increases with the direction, and every t within its jump at the octant bound (FastAtanOctant(1)
+// to pi/2 - FastAtanOctant(1), 4.1e-4 rad) maps to that bound, pi/4.
+std::array<double, 2> FastAtan2Direction(double t) {
+  const double v = std::abs(t), p1 = FastAtanOctant(1.0);
+  double x = 1.0, y = 1.0;
+  if (v <= p1) {
+    y = InverseAtanOctant(v);
+  } else if (v >= 0.5 * kPi - p1) {
+    x = InverseAtanOctant(std::max(0.0, 0.5 * kPi - v));
+  }
+  const double n = std::hypot(x, y);
+  return {x / n, (t < 0.0 ? -y : y) / n};
+}
+
 // One sensor's constants along one logical row (FieldOfViewRow): cell lx's centre lies at
 // dx = x0 + (lx + 0.5) r - ox, dy from the sensor; cb, sb: cos, sin of the boresight.
 // bins[0, nbins): the sensor's bearing bins' ranges [m], inv_bin their inverse width [1/rad],
@@ -67,6 +102,7 @@ struct RowSensor {
   int nbins;
   double inv_bin;
   std::int64_t row, sx0, nx;
+  int ly;  // the logical row
 };
 
 // Cells per batch of ExactGeometry.
@@ -155,13 +191,16 @@ double RelOf(const RowSensor& c, int lx, double* fx) {
 // The dx interval [*dmin, *dmax] [m] of the row's points inside the wedge of half angle
 // atan(tan_w) around the boresight (fx > 0, fx tan - fy >= 0, fx tan + fy >= 0: three linear
 // conditions in dx); false when it is empty.
-bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax) {
+// With min_k > 0, false also when a condition's slope |k| is at most min_k (its bound in doubt).
+bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax,
+                   double min_k = 0.0) {
   *dmin = -kInf;
   *dmax = kInf;
   const double cb = c.cb, sb = c.sb, dy = c.dy;
   for (const auto& [k, d] :
        {std::pair{cb, dy * sb}, std::pair{cb * tan_w + sb, dy * (sb * tan_w - cb)},
         std::pair{cb * tan_w - sb, dy * (sb * tan_w + cb)}}) {
+    if (min_k > 0.0 && !(std::abs(k) > min_k)) return false;
     if (k > 0.0) {
       *dmin = std::max(*dmin, -d / k);
     } else if (k < 0.0) {
@@ -174,11 +213,8 @@ bool WedgeInterval(const RowSensor& c, double tan_w, double* dmin, double* dmax)
 }
 
 // A narrow sensor's row [*lo_x, *hi_x] clipped to its wedge, two cells of margin (the exact test
-// still decides every cell), and the cells [*in_lo, *in_hi] of the inner wedge (half angle
-// atan(tan_in), one cell of margin; left empty when tan_in <= 0), which pass the field-of-view
-// part of Settle's test at once: segmenting the row there first saves the bisection down to the
-// wedge edges. False when the row misses the wedge.
-bool WedgeSpan(const RowSensor& c, double tan_in, int* lo_x, int* hi_x, int* in_lo, int* in_hi) {
+// or the walk still decides every cell). False when the row misses the wedge.
+bool WedgeSpan(const RowSensor& c, int* lo_x, int* hi_x) {
   const double ax = c.x0 + 0.5 * c.r - c.ox;  // dx of cell lx = ax + lx r
   const double big = 4.0 * static_cast<double>(c.nx);
   double dmin, dmax;
@@ -187,14 +223,143 @@ bool WedgeSpan(const RowSensor& c, double tan_in, int* lo_x, int* hi_x, int* in_
   const double l1 = std::clamp(std::ceil((dmax - ax) / c.r) + 2.0, -big, big);
   *lo_x = std::max(*lo_x, static_cast<int>(l0));
   *hi_x = std::min(*hi_x, static_cast<int>(l1));
-  if (tan_in > 0.0 && WedgeInterval(c, tan_in, &dmin, &dmax)) {
-    *in_lo = std::max(*lo_x,
-                      static_cast<int>(std::clamp(std::ceil((dmin - ax) / c.r) + 1.0, -big, big)));
-    *in_hi = std::min(*hi_x,
-                      static_cast<int>(std::clamp(std::floor((dmax - ax) / c.r) - 1.0, -big, big)));
-  }
   return true;
 }
+
+// The cells [*in_a, *in_b] of the row that pass the range and wedge tests for certain (left
+// as they are when none or in doubt): 1e-9 inside the squared range and inside the half angle
+// (tan_in: tan(half_fov - 1e-9), <= 0: none), a cell of margin; far above the tests' roundings.
+void CertainCells(const RowSensor& c, double tan_in, int* in_a, int* in_b) {
+  const double hx2 = c.max2 * (1.0 - 1e-9) - c.dy * c.dy;
+  if (!(c.dy * c.dy >= c.min2 && hx2 > 0.0 && (!c.narrow || tan_in > 0.0))) return;
+  double dmin = -std::sqrt(hx2), dmax = -dmin, wmin, wmax;
+  if (c.narrow) {
+    if (!WedgeInterval(c, tan_in, &wmin, &wmax, 1e-9)) return;
+    dmin = std::max(dmin, wmin);
+    dmax = std::min(dmax, wmax);
+  }
+  const double ax = c.x0 + 0.5 * c.r - c.ox, big = 4.0 * static_cast<double>(c.nx);  // dx - lx r
+  *in_a = static_cast<int>(std::clamp(std::ceil((dmin - ax) / c.r) + 1.0, -big, big));
+  *in_b = static_cast<int>(std::clamp(std::floor((dmax - ax) / c.r) - 1.0, -big, big));
+}
+
+// Cells per window of RowWindow.
+constexpr int kWindow = 128;
+// RowWindow's keys beside a squared range: every cell in front of its range (any d2 < it), none.
+constexpr double kFreeKey = std::numeric_limits<double>::max();
+constexpr double kNoKey = -1.0;
+
+// One sensor's bits along its row, put cell after cell from a first one: per cell the range of
+// its bins (then its bearing lies within the field of view) or none (a cell the exact test
+// decides, or outside the field of view). Each window of kWindow cells then gets the exact
+// test's range and wedge parts per cell on lanes (its operations lane by lane, the same bits),
+// and its bits OR-ed into the view where the storage row wraps or not. Flush at the end.
+class RowWindow {
+ public:
+  // Cells [in_a, in_b] (none when in_a > in_b) pass the range and wedge tests for certain.
+  RowWindow(const RowSensor& c, std::uint8_t* view, int first, int in_a, int in_b)
+      : c_(c), view_(view), base_(first), in_a_(in_a), in_b_(in_b) {}
+  // Cells [a, e], a the cell after the last Put's, under `key`: the square of their bins' range
+  // [m^2] (kInf: no detection; kFreeKey, 0: every cell in range is in front of, behind it), or
+  // kNoKey: no bits here. The certain cells take Inner, the others the window.
+  void Put(int a, int e, double key) {
+    if (a > e) return;
+    const int ia = std::max(a, in_a_), ib = std::min(e, in_b_);
+    if (ia > ib) {
+      Window(a, e, key);
+      return;
+    }
+    Window(a, ia - 1, key);
+    Flush();
+    Inner(ia, ib, key);
+    base_ = ib + 1;
+    Window(ib + 1, e, key);
+  }
+  // Cells [a, e], a the cell after the window's last, in the window (any cells).
+  void Window(int a, int e, double key) {
+    while (a <= e) {
+      const int m = std::min(e, base_ + kWindow - 1);
+      std::fill(key_ + (a - base_), key_ + (m - base_ + 1), key);
+      n_ = m - base_ + 1;
+      if (n_ == kWindow) Flush();
+      a = m + 1;
+    }
+  }
+  // Cells [a, e] of the certain ones under key: its bits, OR-ed into the view.
+  void Inner(int a, int e, double key) {
+    if (key < 0.0) return;  // kNoKey
+    const std::uint8_t fixed = key == kInf       ? (kObserved | kNoReturn)
+                               : key == kFreeKey ? (kObserved | kFreeRay)
+                               : key == 0.0      ? kObserved
+                                                 : 0;
+    const double x0 = c_.x0, r = c_.r, ox = c_.ox, dydy = c_.dy * c_.dy;
+    const int wrap = static_cast<int>(c_.nx - c_.sx0);  // first lx whose storage column wraps
+    for (int part = 0; part < 2; ++part) {
+      const int pa = part == 0 ? a : std::max(a, wrap);
+      const int pe = part == 0 ? std::min(e, wrap - 1) : e;
+      std::uint8_t* dst = view_ + c_.row + c_.sx0 - (part == 0 ? 0 : c_.nx);
+      if (fixed != 0) {
+        for (int lx = pa; lx <= pe; ++lx) dst[lx] |= fixed;
+        continue;
+      }
+      for (int lx = pa; lx <= pe; ++lx) {  // in front of the range or not, per cell
+        const double dx = x0 + (lx + 0.5) * r - ox;
+        dst[lx] |= dx * dx + dydy < key ? (kObserved | kFreeRay) : kObserved;
+      }
+    }
+  }
+  void Flush() {
+    if (n_ == 0) return;
+    const DD d;
+    const int lanes = static_cast<int>(hn::Lanes(d));
+    const hn::Rebind<std::int32_t, DD> di;
+    const hn::Rebind<std::uint8_t, DD> du8;
+    const auto x0 = hn::Set(d, c_.x0), r = hn::Set(d, c_.r), ox = hn::Set(d, c_.ox);
+    const auto dydy = hn::Set(d, c_.dy * c_.dy), dysb = hn::Set(d, c_.dy * c_.sb);
+    const auto dycb = hn::Set(d, c_.dy * c_.cb), cb = hn::Set(d, c_.cb), sb = hn::Set(d, c_.sb);
+    const auto min2 = hn::Set(d, c_.min2), max2 = hn::Set(d, c_.max2);
+    const auto tan_hf = hn::Set(d, c_.tan_hf), inf = hn::Set(d, kInf);
+    const auto observed = hn::Set(d, kObserved), no_return = hn::Set(d, kObserved | kNoReturn);
+    const auto free_ray = hn::Set(d, kObserved | kFreeRay);
+    const auto step = hn::Set(d, static_cast<double>(lanes));
+    // lx + 0.5 of the lanes' cells (exact in a double)
+    auto l = hn::Add(hn::Iota(d, 0.0), hn::Set(d, base_ + 0.5));
+    std::uint8_t bits[kWindow + 2];
+    key_[n_] = kNoKey;
+    for (int i = 0; i < n_; i += lanes, l = hn::Add(l, step)) {  // key_: whole lanes
+      const auto dx = hn::Sub(hn::Add(x0, hn::Mul(l, r)), ox);
+      const auto d2 = hn::Add(hn::Mul(dx, dx), dydy);
+      auto in = hn::And(hn::Ge(d2, min2), hn::Le(d2, max2));
+      if (c_.narrow) {
+        const auto fx = hn::Add(hn::Mul(dx, cb), dysb), fy = hn::Sub(dycb, hn::Mul(dx, sb));
+        in =
+            hn::And(in, hn::And(hn::Gt(fx, hn::Zero(d)), hn::Le(hn::Abs(fy), hn::Mul(fx, tan_hf))));
+      }
+      const auto key = hn::LoadU(d, key_ + i);
+      in = hn::And(in, hn::Ge(key, hn::Zero(d)));  // kNoKey: no bits here
+      const auto v = hn::IfThenElse(hn::Eq(key, inf), no_return,
+                                    hn::IfThenElse(hn::Lt(d2, key), free_ray, observed));
+      const auto b = hn::DemoteTo(di, hn::IfThenElseZero(in, v));
+      hn::StoreU(hn::DemoteTo(du8, b), du8, bits + i);
+    }
+    const int base = base_, wrap = static_cast<int>(c_.nx - c_.sx0);  // first lx that wraps
+    for (int part = 0; part < 2; ++part) {
+      const int pa = part == 0 ? base : std::max(base, wrap);
+      const int pe = part == 0 ? std::min(base + n_ - 1, wrap - 1) : base + n_ - 1;
+      std::uint8_t* dst = view_ + c_.row + c_.sx0 - (part == 0 ? 0 : c_.nx);
+      for (int lx = pa; lx <= pe; ++lx) dst[lx] |= bits[lx - base];
+    }
+    base_ += n_;
+    n_ = 0;
+  }
+
+ private:
+  const RowSensor& c_;
+  std::uint8_t* view_;
+  int base_, in_a_, in_b_, n_ = 0;
+  // Per cell its key (Put); a whole lane beyond the window.
+  double key_[kWindow + 2];
+};
 
 // Cells [a, e] of the row, each given the bits of the exact test: a segment whose cells' bins
 // provably hold one range (below) is filled without per-cell bearings, any other is split in
@@ -203,7 +368,7 @@ bool WedgeSpan(const RowSensor& c, double tan_in, int* lo_x, int* hi_x, int* in_
 // within 2 kAtanError of the hull of the end points' ones and their bins (a monotonic function of
 // the bearing) within the bins of that hull. If all those bins hold the same range, every cell
 // gets the same bin value as in the exact test without its atan2.
-void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, std::uint8_t* view) {
+void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, RowWindow& out) {
   int stack[128][2];
   int top = 0;
   stack[top][0] = a0;
@@ -214,6 +379,7 @@ void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, std::uint8_t*
     const int a = stack[top][0], e = stack[top][1];
     if (e - a < 4) {
       for (int lx = a; lx <= e; ++lx) exact.Add(lx);
+      out.Put(a, e, kNoKey);
       continue;
     }
     double fxa, fxe;
@@ -237,74 +403,96 @@ void Settle(const RowSensor& c, int a0, int e0, ExactQueue& exact, std::uint8_t*
       ++top;
       continue;
     }
-    // Branch-free over the segment (vectorises), split where the storage row wraps.
-    const std::uint8_t bits_in = br == kInf ? (kObserved | kNoReturn) : kObserved;
-    const std::uint8_t bits_front = br == kInf ? bits_in : (kObserved | kFreeRay);
-    const double br2 = br * br;
-    const int wrap = static_cast<int>(c.nx - c.sx0);  // first lx whose storage column wraps
-    // Locals, not c's fields: the byte stores below may alias them (no vectorisation otherwise).
-    const double x0 = c.x0, r = c.r, ox = c.ox, dy = c.dy, cb = c.cb, sb = c.sb;
-    const double min2 = c.min2, max2 = c.max2, tan_hf = c.tan_hf;
-    const bool narrow = c.narrow;
-    for (int part = 0; part < 2; ++part) {
-      const int pa = part == 0 ? a : std::max(a, wrap);
-      const int pe = part == 0 ? std::min(e, wrap - 1) : e;
-      std::uint8_t* dst = view + c.row + c.sx0 - (part == 0 ? 0 : c.nx);
-      for (int lx = pa; lx <= pe; ++lx) {
-        const double dx = x0 + (lx + 0.5) * r - ox;
-        const double d2 = dx * dx + dy * dy;
-        const double fx = dx * cb + dy * sb, fy = dy * cb - dx * sb;
-        const bool in = (d2 >= min2) & (d2 <= max2) &
-                        ((!narrow) | ((fx > 0.0) & (std::abs(fy) <= fx * tan_hf)));
-        const std::uint8_t v = d2 < br2 ? bits_front : bits_in;
-        dst[lx] |= in ? v : 0;
-      }
-    }
+    out.Put(a, e, br * br);
   }
 }
 
-// Cells [a, e] of the row (inside the sensor's inner wedge), as Settle, segmented first at the
-// sensor's run edges: the cells whose true bearing lies within kEdgeZone of an edge go to the
-// exact test, the stretches between them to Settle (an edge whose zone holds no cell centre still
-// ends the stretch before it). The edges are
-// phi[0, n) [rad, ascending, relative to the boresight], cot[k] the cotangent of edge k's global
-// direction, so that its ray meets the row at dx = dy cot. Only the segmentation depends on this
-// geometry, never a cell's bits (Settle and the exact test decide them).
-void SettleZoned(const RowSensor& c, const double* phi, const double* cot, int n, int a, int e,
-                 ExactQueue& exact, std::uint8_t* view) {
-  double fxa, fxe;
-  const double ra = RelOf(c, a, &fxa), re = RelOf(c, e, &fxe);
-  const double margin = kAtanError + kEdgeZone;
-  const int k0 = static_cast<int>(std::lower_bound(phi, phi + n, std::min(ra, re) - margin) - phi);
-  const int k1 = static_cast<int>(std::upper_bound(phi, phi + n, std::max(ra, re) + margin) - phi);
-  const bool up = ra <= re;                   // the bearing grows with lx
-  const double ax = c.x0 + 0.5 * c.r - c.ox;  // dx of cell lx = ax + lx r
-  const double lo_l = a - 1.0, hi_l = e + 1.0;
-  // Zone half width per unit rho^2 [cells / m^2], and 1 / r (inverses: zones only).
-  const double per_rho2 = 1.25 * kEdgeZone / (std::abs(c.dy) * c.r), inv_r = 1.0 / c.r;
-  int pos = a;  // cells [a, pos) are done
-  for (int i = 0; i < k1 - k0; ++i) {
-    const int k = up ? k0 + i : k1 - 1 - i;
-    // dx of the bearings phi[k] +- kEdgeZone, to first order in the angle (d dx / d phi =
-    // rho^2 / |dy|), with a quarter of margin for the curvature.
-    const double dxc = c.dy * cot[k];
-    const double lc = (dxc - ax) * inv_r, half = per_rho2 * (dxc * dxc + c.dy * c.dy);
-    const double l0 = lc - half, l1 = lc + half;
-    if (!(l0 <= l1)) continue;  // NaN: no zone (Settle still decides)
-    const int zl = static_cast<int>(std::clamp(std::ceil(l0), lo_l, hi_l));
-    const int zh = std::min(e, static_cast<int>(std::clamp(std::floor(l1), lo_l, hi_l)));
-    if (zl > pos) {  // the stretch before the edge, also when no cell centre lies in its zone
-      const int end = std::min(zl - 1, e);
-      if (end - pos < 4) {  // as Settle would
-        for (; pos <= end; ++pos) exact.Add(pos);
-      } else {
-        Settle(c, pos, end, exact, view);
-        pos = end + 1;
-      }
+// dx [m] of cell lx of the row from the sensor: the expression of every per-cell test.
+double DxOf(const RowSensor& c, int lx) { return c.x0 + (lx + 0.5) * c.r - c.ox; }
+
+// The region of cell lx among a narrow sensor's view bounds vb[0, n) (ascending bearing): the
+// number of bounds whose direction lies below the cell's, or -1 when the cell is not clearly in
+// front of the sensor (fx) or its direction is within kAngleMargin of a probed bound. The side
+// of a bound is the sign of the cross product of its direction and the cell's: in front of the
+// sensor the two differ by less than pi.
+int RegionAt(const RowSensor& c, const ViewBound* vb, int n, int lx, double pos_margin) {
+  const double dx = DxOf(c, lx);
+  const double fx = dx * c.cb + c.dy * c.sb, rho = std::abs(dx) + std::abs(c.dy);
+  if (!(fx > kAngleMargin * rho)) return -1;
+  const double tol = 2.0 * kAngleMargin * rho + pos_margin;
+  int lo = 0, hi = n;
+  while (lo < hi) {
+    const int mid = lo + (hi - lo) / 2;
+    const double side = vb[mid].gx * c.dy - vb[mid].gy * dx;
+    if (std::abs(side) <= tol) return -1;
+    if (side > 0.0) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
     }
-    for (; pos <= zh; ++pos) exact.Add(pos);
   }
-  if (pos <= e) Settle(c, pos, e, exact, view);
+  return lo;
+}
+
+// RowWindow's key of region j of a narrow sensor's view bounds vb[0, n) on logical row ly: none
+// outside the field of view, else that of the run after bound j - 1 on this row (ViewBound).
+double RegionKey(const ViewBound* vb, int n, int j, int ly) {
+  if (j <= 0 || j >= n) return kNoKey;
+  const ViewBound& b = vb[j - 1];
+  if (b.br_after == kInf) return kInf;
+  if (ly >= b.mixed_lo && ly <= b.mixed_hi) return b.br_after * b.br_after;
+  return ly >= b.free_lo && ly <= b.free_hi ? kFreeKey : 0.0;
+}
+
+// Cells [a, e] of a narrow sensor's row, each given the bits of the exact test, with per-cell
+// bearings only within kAngleMargin of a view bound. FastAtan2, as a function of the direction,
+// increases (with upward jumps) over the field of view, and so does the bins' index: a cell's
+// bearing lies on the side of a bound's value its direction lies on, once their directions
+// differ by more than kAngleMargin. Along the row the direction turns monotonically (up when dy <
+// 0), so the row is walked from its first cell of known region (RegionAt; cells before it take
+// the exact test) across the bounds' rays where they meet it (dx = dy cot), skipping those
+// between regions of the same key on this row (RegionKey): each stretch between two crossings
+// gets its key, the cells within the margin of a crossing take the exact test. vb[0, n): the
+// sensor's bounds; the row's |dy| must exceed 1e-6 (max_range + r), so that the margin's image
+// on the row (2 kAngleMargin rho^2 / |dy|) is linear to 1e-5.
+void WalkRow(const RowSensor& c, const ViewBound* vb, int n, int a, int e, ExactQueue& exact,
+             RowWindow& out) {
+  const double ady = std::abs(c.dy), inv_r = 1.0 / c.r;
+  const double ax = c.x0 + 0.5 * c.r - c.ox;  // dx of cell lx ~ ax + lx r
+  const double pos_margin =
+      kPositionMargin * (1.0 + std::abs(c.x0) + std::abs(c.ox) + ady + c.r * c.nx);
+  int pos = a, j = -1;
+  for (; pos <= e; ++pos) {
+    j = RegionAt(c, vb, n, pos, pos_margin);
+    if (j >= 0) break;
+    exact.Add(pos);
+    out.Put(pos, pos, kNoKey);
+  }
+  const int dj = c.dy < 0.0 ? 1 : -1;  // the regions' order along the row
+  double key = RegionKey(vb, n, j, c.ly);
+  while (pos <= e) {
+    int jn = j + dj;  // the next region of another key
+    double key_n = 0.0;
+    while (jn >= 0 && jn <= n && (key_n = RegionKey(vb, n, jn, c.ly)) == key) jn += dj;
+    const int k = dj > 0 ? jn - 1 : jn;                  // the bound before it
+    if (jn < 0 || jn > n || !(vb[k].gy * c.dy > 0.0)) {  // none, or its ray misses the row
+      out.Put(pos, e, key);
+      break;
+    }
+    // The last cell before its crossing's margin and the first after it.
+    const double dxc = c.dy * vb[k].cot;
+    const double h = 2.0 * kAngleMargin * (dxc * dxc + c.dy * c.dy) / ady + pos_margin +
+                     kPositionMargin * std::abs(dxc);
+    const double lim_lo = pos - 1.0, lim_hi = e + 1.0;
+    const int le = static_cast<int>(std::clamp(std::floor((dxc - h - ax) * inv_r), lim_lo, lim_hi));
+    const int ln = static_cast<int>(std::clamp(std::ceil((dxc + h - ax) * inv_r), lim_lo, lim_hi));
+    out.Put(pos, std::min(le, e), key);
+    for (int lx = std::max(pos, le + 1); lx < ln; ++lx) exact.Add(lx);
+    out.Put(std::max(pos, le + 1), ln - 1, kNoKey);
+    pos = std::max(pos, ln);
+    j = jn;
+    key = key_n;
+  }
 }
 
 // One row of a detection's stamp, n cells at consecutive storage columns: cell i at squared
@@ -439,9 +627,8 @@ void MeasurementGrid::Prepare(const Position& centre, std::span<const Measuremen
   }
   bin_range_.assign(bin_offset_[ns], kInf);
   bin_run_end_.resize(bin_range_.size());
-  edge_offset_.resize(ns + 1);
-  edge_phi_.resize(bin_range_.size());
-  edge_cot_.resize(bin_range_.size());
+  bound_offset_.resize(ns + 1);
+  bound_.resize(bin_range_.size() + ns);  // at most bins + 1 per sensor
   sensor_trig_.resize(4 * static_cast<std::size_t>(ns));
   PlaceDetections();
 }
@@ -613,8 +800,8 @@ void MeasurementGrid::FieldOfViewTables(std::span<const SensorCoverage> cov) {
     sensor_trig_[4 * k] = std::cos(cov[k].boresight);
     sensor_trig_[4 * k + 1] = std::sin(cov[k].boresight);
     sensor_trig_[4 * k + 2] = cov[k].half_fov < 0.5 * kPi ? std::tan(cov[k].half_fov) : 0.0;
-    // Inner wedge (half_fov - 4 kAtanError): its cells pass the segment test below at once.
-    const double inner = cov[k].half_fov - 4.0 * kAtanError;
+    // The wedge 1e-9 rad inside (RowWindow's certain cells), -1: none.
+    const double inner = cov[k].half_fov - 1e-9;
     sensor_trig_[4 * k + 3] = inner > 0.0 && cov[k].half_fov < 0.5 * kPi ? std::tan(inner) : -1.0;
   }
   // Last bin of the run of equal ranges each bin belongs to (per sensor): O(1) uniformity test.
@@ -626,32 +813,85 @@ void MeasurementGrid::FieldOfViewTables(std::span<const SensorCoverage> cov) {
                             : static_cast<int>(b - b_lo);
     }
   }
-  RunEdges(cov);
+  BoundDirections(cov);
+  ViewBounds(cov);
 }
 
-void MeasurementGrid::RunEdges(std::span<const SensorCoverage> cov) {
+void MeasurementGrid::BoundDirections(std::span<const SensorCoverage> cov) {
   const int ns = static_cast<int>(cov.size());
-  const double w = params_.free_angle_bin;
-  const double cw = std::cos(w), sw = std::sin(w);
+  bool same = static_cast<int>(bound_key_.size()) == ns;
+  for (int k = 0; same && k < ns; ++k) {
+    same = bound_key_[k].first == cov[k].half_fov &&
+           bound_key_[k].second == bin_offset_[k + 1] - bin_offset_[k];
+  }
+  if (same) return;  // sensors fixed on the ego: computed once
+  bound_key_.resize(ns);
+  bound_dir_offset_.assign(ns + 1, 0);
+  bound_dir_.clear();
+  for (int k = 0; k < ns; ++k) {
+    const std::int64_t bins = bin_offset_[k + 1] - bin_offset_[k];
+    bound_key_[k] = {cov[k].half_fov, bins};
+    if (cov[k].half_fov < 0.5 * kPi) {
+      for (std::int64_t b = 0; b <= bins; ++b) {
+        const double t = b == bins
+                             ? cov[k].half_fov
+                             : -cov[k].half_fov + static_cast<double>(b) * params_.free_angle_bin;
+        bound_dir_.push_back(FastAtan2Direction(t));
+      }
+    }
+    bound_dir_offset_[k + 1] = static_cast<std::int64_t>(bound_dir_.size());
+  }
+}
+
+void MeasurementGrid::ViewBounds(std::span<const SensorCoverage> cov) {
+  const int ns = static_cast<int>(cov.size());
   std::int64_t n = 0;
   for (int k = 0; k < ns; ++k) {
-    edge_offset_[k] = n;
-    const std::int64_t b_lo = bin_offset_[k], b_hi = bin_offset_[k + 1];
+    bound_offset_[k] = n;
+    if (bound_dir_offset_[k + 1] == bound_dir_offset_[k]) continue;  // a wide sensor
+    const std::int64_t b_lo = bin_offset_[k], bins = bin_offset_[k + 1] - b_lo;
     const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
-    // (c, s): the direction of bin b's lower edge, -half_fov + b w, in the sensor frame, by
-    // rotation (its rounding only moves the zones, never a cell's bits).
-    double c = std::cos(cov[k].half_fov), s = -std::sin(cov[k].half_fov);
-    for (std::int64_t b = b_lo + 1; b < b_hi; ++b) {
-      const double c1 = c * cw - s * sw;
-      s = s * cw + c * sw;
-      c = c1;
-      if (bin_range_[b] == bin_range_[b - 1]) continue;
-      edge_phi_[n] = -cov[k].half_fov + static_cast<double>(b - b_lo) * w;
-      edge_cot_[n] = (c * cb - s * sb) / (c * sb + s * cb);  // global direction's x / y
-      ++n;
+    const std::array<double, 2>* dir = bound_dir_.data() + bound_dir_offset_[k];
+    const auto add = [&](std::int64_t b, double br_after) {
+      const double gx = dir[b][0] * cb - dir[b][1] * sb, gy = dir[b][0] * sb + dir[b][1] * cb;
+      bound_[n++] = {gx, gy, gx / gy, br_after, 0, -1, 0, -1};
+    };
+    add(0, bin_range_[b_lo]);  // the field of view's start
+    for (std::int64_t b = 1; b < bins; ++b) {
+      if (bin_range_[b_lo + b] != bin_range_[b_lo + b - 1]) add(b, bin_range_[b_lo + b]);
     }
+    add(bins, std::numeric_limits<double>::quiet_NaN());  // its end
+    BoundRows(cov[k].origin.y(), bound_.data() + bound_offset_[k], n - bound_offset_[k]);
   }
-  edge_offset_[ns] = n;
+  bound_offset_[ns] = n;
+}
+
+void MeasurementGrid::BoundRows(double oy, ViewBound* vb, std::int64_t n) const {
+  const double r = params_.resolution, y0 = static_cast<double>(origin_gy_) * r;
+  // Logical row (fractional) whose centre y0 + (ly + 0.5) r lies at y = oy + dy.
+  const auto row_at = [&](double dy) {
+    return std::clamp((oy + dy - y0) / r - 0.5, -2.0, static_cast<double>(ny_) + 1.0);
+  };
+  for (std::int64_t i = 0; i + 1 < n; ++i) {  // the run from bound i to bound i + 1
+    const double br = vb[i].br_after;
+    if (!(br < kInf)) continue;
+    // The arc of radius br between the two directions (counterclockwise, < pi): its y extent,
+    // with +-br where it turns through +-y (taken whenever that is in doubt).
+    const double gx0 = vb[i].gx, gx1 = vb[i + 1].gx;
+    double lo = br * std::min(vb[i].gy, vb[i + 1].gy), hi = br * std::max(vb[i].gy, vb[i + 1].gy);
+    if (gx0 >= -1e-9 && gx1 <= 1e-9) hi = br;
+    if (gx0 <= 1e-9 && gx1 >= -1e-9) lo = -br;
+    // Margin [m]: the cells' directions within kAngleMargin of the run's bounds, the roundings
+    // of d2 and of the rows' y (far below it).
+    const double m = 1e-9 * (1.0 + br) +
+                     kPositionMargin * (std::abs(oy) + std::abs(y0) + r * static_cast<double>(ny_));
+    vb[i].mixed_lo = static_cast<int>(std::ceil(row_at(lo - m)));
+    vb[i].mixed_hi = static_cast<int>(std::floor(row_at(hi + m)));
+    // A row off the arc meets the run's sector wholly inside the circle or wholly outside: inside
+    // when it crosses the pie (the sensor's y to the arc's extent).
+    vb[i].free_lo = static_cast<int>(std::ceil(row_at(std::min(lo, 0.0))));
+    vb[i].free_hi = static_cast<int>(std::floor(row_at(std::max(hi, 0.0))));
+  }
 }
 
 void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov) {
@@ -674,7 +914,7 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
     // half_fov < 90 deg; atan2 only runs for cells inside the field of view (for the bin).
     const double cb = sensor_trig_[4 * k], sb = sensor_trig_[4 * k + 1];
     const bool narrow = sc.half_fov < 0.5 * kPi;
-    const double tan_hf = sensor_trig_[4 * k + 2], tan_in = sensor_trig_[4 * k + 3];
+    const double tan_hf = sensor_trig_[4 * k + 2];
     const double min2 = sc.min_range * sc.min_range, max2 = sc.max_range * sc.max_range;
     const RowSensor rs{x0,
                        r,
@@ -693,21 +933,23 @@ void MeasurementGrid::FieldOfViewRow(int ly, std::span<const SensorCoverage> cov
                        1.0 / params_.free_angle_bin,
                        row,
                        sx0,
-                       nx_};
-    int lo_x = lx_lo, hi_x = lx_hi, in_lo = 1, in_hi = 0;  // inner cells: none unless narrow
-    if (narrow && !WedgeSpan(rs, tan_in, &lo_x, &hi_x, &in_lo, &in_hi)) continue;
+                       nx_,
+                       ly};
+    int lo_x = lx_lo, hi_x = lx_hi;
+    if (narrow && !WedgeSpan(rs, &lo_x, &hi_x)) continue;
     if (lo_x > hi_x) continue;
+    int in_a = 1, in_b = 0;
+    CertainCells(rs, sensor_trig_[4 * k + 3], &in_a, &in_b);
     ExactQueue exact(rs, view_.data());
-    if (in_lo <= in_hi) {
-      // The inner wedge's cells (the most) segmented at the run edges first.
-      if (lo_x < in_lo) Settle(rs, lo_x, in_lo - 1, exact, view_.data());
-      const std::int64_t e0 = edge_offset_[k], n = edge_offset_[k + 1] - e0;
-      SettleZoned(rs, edge_phi_.data() + e0, edge_cot_.data() + e0, static_cast<int>(n), in_lo,
-                  in_hi, exact, view_.data());
-      if (in_hi < hi_x) Settle(rs, in_hi + 1, hi_x, exact, view_.data());
-    } else {
-      Settle(rs, lo_x, hi_x, exact, view_.data());
+    RowWindow out(rs, view_.data(), lo_x, in_a, in_b);
+    if (narrow && std::abs(dy) > 1e-6 * (sc.max_range + r)) {  // WalkRow's condition
+      const std::int64_t b0 = bound_offset_[k];
+      WalkRow(rs, bound_.data() + b0, static_cast<int>(bound_offset_[k + 1] - b0), lo_x, hi_x,
+              exact, out);
+    } else {  // a wide sensor, or a row (almost) through a narrow one
+      Settle(rs, lo_x, hi_x, exact, out);
     }
+    out.Flush();
     exact.Flush();
   }
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -75,12 +76,81 @@ std::uint8_t PlainBits(const FilterParams& fp, const std::array<std::int64_t, 2>
   return bits;
 }
 
+// Cells of the grid built for `centre` whose bits differ from the plain test's; counts (when
+// given) adds the cells with bit 1, 2 and 4 and all cells.
+int WrongCells(const FilterParams& fp, const Position& centre, const std::vector<Measurement>& z,
+               const std::vector<SensorCoverage>& cov,
+               std::array<std::int64_t, 4>* counts = nullptr) {
+  MeasurementGrid mg(fp);
+  mg.Build(centre, z, cov);
+  const auto bins = BinRanges(fp, z, cov);
+  const auto origin = mg.origin_index();
+  const int nx = fp.CellsX(), ny = fp.CellsY();
+  int wrong = 0;
+  for (int ly = 0; ly < ny; ++ly) {
+    for (int lx = 0; lx < nx; ++lx) {
+      const std::uint8_t want = PlainBits(fp, origin, lx, ly, cov, bins);
+      const std::int64_t s = Mod(origin[1] + ly, ny) * nx + Mod(origin[0] + lx, nx);
+      wrong += mg.view()[s] != want;
+      if (counts != nullptr) {
+        for (int b = 0; b < 3; ++b) (*counts)[b] += (want & (1 << b)) != 0;
+        ++(*counts)[3];
+      }
+    }
+  }
+  return wrong;
+}
+
 }  // namespace
+
+// The row walk's corner cases: sensors on a row of cell centres or within 1e-7 m of one (the
+// rows through them take the bisection), boresights along the axes and diagonals (bounds parallel
+// to the rows, FastAtan2's octant jump), half angles near pi/2 and near 0, a minimum range that
+// rows cross, far origins, few detections and many, wide runs of one range (wide bins or
+// dilation: arcs that turn through +-y, across many rows).
+TEST_CASE("the field of view's row walk keeps the per-cell bits in corner cases", "[filter][fov]") {
+  FilterParams fp;
+  fp.length_x = 60.0;  // 120 x 50 cells: more scenes
+  CounterRng rng(3737, RngPurpose::kTest, 0, 0);
+  for (int scene = 0; scene < 150; ++scene) {
+    // Wide runs of one range (wide bins, wide dilation): arcs that turn through +-y.
+    fp.free_angle_bin = scene % 5 == 2 ? 0.1 : 1.0 * M_PI / 180.0;
+    fp.free_bin_dilation = scene % 5 == 3 ? 15 : 1;
+    const double far = scene % 3 == 0 ? 1e6 : 0.0;
+    const Position ego(far + rng.Uniform(-100.0, 100.0), -far + rng.Uniform(-100.0, 100.0));
+    std::vector<SensorCoverage> cov;
+    for (int k = 0; k < 4; ++k) {
+      Position o = ego + Vector2(rng.Uniform(-4.0, 4.0), rng.Uniform(-4.0, 4.0));
+      if ((scene + k) % 4 == 0) o.y() = (std::floor(o.y() / 0.5) + 0.5) * 0.5;  // on a row
+      if ((scene + k) % 4 == 1) o.y() = (std::floor(o.y() / 0.5) + 0.5) * 0.5 + 1e-7;
+      double boresight = rng.Uniform(-M_PI, M_PI);
+      if ((scene + k) % 3 == 0) boresight = M_PI / 4.0 * std::floor(rng.Uniform(-4.0, 4.0));
+      const double u = rng.Uniform(0.0, 1.0);
+      const double hf = u < 0.2   ? M_PI / 2.0 - rng.Uniform(1e-9, 1e-3)
+                        : u < 0.3 ? rng.Uniform(1e-4, 0.05)
+                                  : rng.Uniform(0.1, 1.5);
+      const double min_range = scene % 2 == 0 ? rng.Uniform(0.0, 6.0) : 0.0;
+      cov.push_back({o, boresight, hf, min_range, rng.Uniform(10.0, 70.0)});
+    }
+    std::vector<Measurement> z;
+    const int nz = scene % 4 == 0 ? 3 : static_cast<int>(rng.Uniform(0.0, 400.0));
+    for (int j = 0; j < nz; ++j) {
+      const SensorCoverage& c = cov[static_cast<std::size_t>(j) % cov.size()];
+      const double a = c.boresight + rng.Uniform(-c.half_fov, c.half_fov);
+      const double range = rng.Uniform(0.3, 1.1 * c.max_range);
+      z.push_back(
+          {c.origin + range * Vector2(std::cos(a), std::sin(a)), Velocity(0.0, 0.0), c.origin});
+    }
+    const Position centre = ego + Vector2(rng.Uniform(-2.0, 2.0), rng.Uniform(-2.0, 2.0));
+    INFO("scene " << scene << " with " << nz << " detections");
+    CHECK(WrongCells(fp, centre, z, cov) == 0);
+  }
+}
 
 TEST_CASE("every cell's field-of-view bits are those of the plain per-cell test", "[filter][fov]") {
   FilterParams fp;  // 200 m x 25 m at 0.5 m, 1 deg bins
   CounterRng rng(37, RngPurpose::kTest, 0, 0);
-  std::int64_t observed = 0, free_ray = 0, no_return = 0, cells = 0;
+  std::array<std::int64_t, 4> counts{};  // cells with bit 1, 2, 4; all cells
   for (int scene = 0; scene < 40; ++scene) {
     // Five radars around an ego (narrow corner and side ones, a front one, sometimes a wide or
     // full-circle one), detections along their rays (some far beyond the grid).
@@ -102,27 +172,12 @@ TEST_CASE("every cell's field-of-view bits are those of the plain per-cell test"
       const Position p = c.origin + range * Vector2(std::cos(a), std::sin(a));
       z.push_back({p, Velocity(0.0, 0.0), c.origin});
     }
-    MeasurementGrid mg(fp);
-    mg.Build(ego + Vector2(rng.Uniform(-2.0, 2.0), rng.Uniform(-2.0, 2.0)), z, cov);
-    const auto bins = BinRanges(fp, z, cov);
-    const auto origin = mg.origin_index();
-    const int nx = fp.CellsX(), ny = fp.CellsY();
-    int wrong = 0;
-    for (int ly = 0; ly < ny; ++ly) {
-      for (int lx = 0; lx < nx; ++lx) {
-        const std::uint8_t want = PlainBits(fp, origin, lx, ly, cov, bins);
-        const std::int64_t s = Mod(origin[1] + ly, ny) * nx + Mod(origin[0] + lx, nx);
-        wrong += mg.view()[s] != want;
-        observed += (want & 1) != 0;
-        free_ray += (want & 2) != 0;
-        no_return += (want & 4) != 0;
-        ++cells;
-      }
-    }
+    const Position centre = ego + Vector2(rng.Uniform(-2.0, 2.0), rng.Uniform(-2.0, 2.0));
     INFO("scene " << scene << " with " << nz << " detections");
-    CHECK(wrong == 0);
+    CHECK(WrongCells(fp, centre, z, cov, &counts) == 0);
   }
   // The scenes reach every kind of cell.
+  const auto [observed, free_ray, no_return, cells] = counts;
   CHECK(observed > cells / 4);
   CHECK(free_ray > cells / 50);
   CHECK(no_return > cells / 50);

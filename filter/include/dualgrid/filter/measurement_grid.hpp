@@ -37,6 +37,16 @@ struct SensorCoverage {
 class DynamicGrid;
 namespace detail {
 struct Team;
+/// One bound of a sensor's field of view or of a run of equal bin ranges (MeasurementGrid): the
+/// global unit direction (gx, gy) at which the cells' computed bearing crosses it, gx / gy, and
+/// the range [m] of the bins after it (kInf: no detection; NaN: outside the field of view). For
+/// a finite range, the logical rows [mixed_lo, mixed_hi] that may meet the arc of that range
+/// between this bound and the next (others see the run's cells all in front of the range or all
+/// behind it), and the rows [free_lo, free_hi] that meet the sector inside that range.
+struct ViewBound {
+  double gx, gy, cot, br_after;
+  int mixed_lo, mixed_hi, free_lo, free_hi;
+};
 }  // namespace detail
 
 }  // namespace dualgrid::filter
@@ -123,7 +133,12 @@ class MeasurementGrid {
   void StampBands(int band_lo, int band_hi);
   void Bins(std::span<const SensorCoverage> cov);               // the bins' ranges (serial)
   void FieldOfViewTables(std::span<const SensorCoverage> cov);  // per-sensor constants (serial)
-  void RunEdges(std::span<const SensorCoverage> cov);  // edge_* (FieldOfViewTables, serial)
+  // bound_dir_ for the sensors' bins (FieldOfViewTables, serial): recomputed only when a
+  // sensor's half_fov or bin count differs from the last build's.
+  void BoundDirections(std::span<const SensorCoverage> cov);
+  void ViewBounds(std::span<const SensorCoverage> cov);  // bound_* (FieldOfViewTables, serial)
+  // The row ranges of one sensor's bounds vb[0, n) (ViewBounds), the sensor at y = oy [m].
+  void BoundRows(double oy, detail::ViewBound* vb, std::int64_t n) const;
   void FieldOfViewRow(int ly, std::span<const SensorCoverage> cov);  // view_ of logical row ly
   // Per detection the unit line of sight and the signed radial speed into det_los_ (and, with
   // the fit, in bucket order into det_los_b_: after FillBuckets).
@@ -174,10 +189,19 @@ class MeasurementGrid {
   std::vector<std::int64_t> bin_offset_;
   std::vector<double> sensor_trig_;  // per sensor: cos, sin of the boresight, tan(half_fov), inner
   std::vector<int> bin_run_end_;     // per bin: last bin (sensor-local) of its run of equal ranges
-  // Per sensor [edge_offset_[k], edge_offset_[k + 1]): the edges between its runs of equal bin
-  // ranges, ascending: bearing from the boresight [rad], cotangent of the global direction.
-  std::vector<std::int64_t> edge_offset_;
-  std::vector<double> edge_phi_, edge_cot_;
+  // Per sensor of a half_fov below pi/2 (a narrow one), the unit directions in the sensor frame
+  // (x along the boresight) at which the computed bearing (FastAtan2) crosses its bins' bounds
+  // -half_fov + b free_angle_bin, b = 0 .. bins: bins + 1 entries from bound_dir_offset_[k]
+  // (none for a wide sensor). They depend on half_fov and the bin width alone: bound_key_ holds
+  // each sensor's half_fov and bin count they were computed for.
+  std::vector<std::array<double, 2>> bound_dir_;
+  std::vector<std::int64_t> bound_dir_offset_;
+  std::vector<std::pair<double, std::int64_t>> bound_key_;
+  // A narrow sensor's view bounds of this build (detail::ViewBound), per sensor
+  // [bound_offset_[k], bound_offset_[k + 1]), in ascending bearing: the field of view's start,
+  // the edges between its runs of equal bin ranges, its end.
+  std::vector<std::int64_t> bound_offset_;
+  std::vector<detail::ViewBound> bound_;
 
   std::vector<double> det_los_;                 // per detection: unit line of sight, v_r . u
   std::vector<double> det_los_b_;               // det_los_ in bucket order (the fit's gathering)
