@@ -3,7 +3,8 @@
 // its defining property, RobustDopplerFit against the plain fit of reference/doppler_fit.hpp on
 // random neighbourhoods that take every path: the floor, a median near the last one, the
 // quickselect, failures, NaN; RobustDopplerFitPair and RunFits against RobustDopplerFit; FitMemo's
-// keys) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
+// keys; GatherNeighbours against the bucket-by-bucket gathering) and the field of view's bearings
+// on SIMD lanes (FastAtan2Lanes).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
