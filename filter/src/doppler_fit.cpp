@@ -341,6 +341,40 @@ int GatherRange(const double* x, const double* y, std::int64_t k0, std::int64_t 
   return n;
 }
 
+// One pass over a[0, n) (no NaN) against g: the values < g counted, the smallest of those >= g
+// (+inf if none) and the largest of those < g (-inf if none), on lanes.
+struct Bracket {
+  int below;
+  double above, under;
+};
+
+Bracket BracketOf(const double* a, int n, double g) {
+  const D2 d;
+  const V2 vg = hn::Set(d, g), inf = hn::Set(d, kInf), minus_inf = hn::Set(d, -kInf);
+  V2 above = inf, under = minus_inf;
+  auto count = hn::Zero(DI2());
+  int i = 0;
+  for (; i + 2 <= n; i += 2) {
+    const V2 v = hn::LoadU(d, a + i);
+    const auto lt = hn::Lt(v, vg);
+    count = Tally(count, lt);
+    above = hn::Min(above, hn::IfThenElse(lt, inf, v));
+    under = hn::Max(under, hn::IfThenElse(lt, v, minus_inf));
+  }
+  const std::array<int, 2> c = Counts(count);
+  alignas(16) double hi[2], lo[2];
+  hn::Store(above, d, hi);
+  hn::Store(under, d, lo);
+  Bracket b{c[0] + c[1], std::min(hi[0], hi[1]), std::max(lo[0], lo[1])};
+  for (; i < n; ++i) {
+    const bool lt = a[i] < g;
+    b.below += lt;
+    if (lt) b.under = std::max(b.under, a[i]);
+    if (!lt) b.above = std::min(b.above, a[i]);
+  }
+  return b;
+}
+
 }  // namespace
 
 namespace detail {
@@ -356,10 +390,12 @@ double MadFloorBound(double floor) {
 
 double SelectRank(const double* a, int n, int k, double guess) {
   assert(0 <= k && k < n && n <= kFitMaxNeighbours);
-  int below = 0;  // values < guess
-  for (int i = 0; i < n; ++i) below += a[i] < guess;
+  const Bracket b = BracketOf(a, n, guess);
+  const int below = b.below;  // values < guess
   // Rank k is the (k - below)-th smallest of the values >= guess, or the (below - 1 - k)-th
-  // largest of those < guess.
+  // largest of those < guess: the first two cases (most passes) from the same pass.
+  if (below == k) return b.above;
+  if (below == k + 1) return b.under;
   if (below <= k && k - below < kNearRanks)
     return NearRank<Among::kAtLeast>(a, n, guess, k - below);
   if (below > k && below - 1 - k < kNearRanks)
