@@ -29,9 +29,6 @@ using namespace detail;
 
 namespace {
 
-// Candidates looked at per detection at most (docs/algorithm.md, step 4a): bounds a fit's cost
-// when thousands of detections crowd its buckets, so that a cycle's cost stays linear in them.
-constexpr int kMaxCandidates = 8 * kFitMaxNeighbours;
 constexpr int kIterations = 6;
 constexpr double kTukey = 4.685;  // 95 % efficiency at Gaussian noise
 constexpr double kMadToSigma = 1.4826;
@@ -318,6 +315,66 @@ void TukeyWeightsPair(const double* r, const double* real, int n, V2 c, double* 
   inliers[1] = k[1];
 }
 
+// Appends to key[n, ...) the positions k in [k0, k1), in order, of the points (x[k], y[k]) within
+// radius2 [m^2] of (px, py), while n < kFitMaxNeighbours and *looked < kMaxCandidates (every k
+// looked at counts); returns the new n. Two points per step on lanes, each as the scalar test.
+int GatherRange(const double* x, const double* y, std::int64_t k0, std::int64_t k1, double px,
+                double py, double radius2, int* key, int n, int* looked) {
+  const D2 d;
+  const V2 vpx = hn::Set(d, px), vpy = hn::Set(d, py), vr = hn::Set(d, radius2);
+  std::int64_t k = k0;
+  for (; k + 2 <= k1 && n <= kFitMaxNeighbours - 2 && *looked <= kMaxCandidates - 2;
+       k += 2, *looked += 2) {
+    const V2 ex = hn::Sub(hn::LoadU(d, x + k), vpx), ey = hn::Sub(hn::LoadU(d, y + k), vpy);
+    std::uint8_t far = 0;
+    hn::StoreMaskBits(d, hn::Gt(hn::Add(hn::Mul(ex, ex), hn::Mul(ey, ey)), vr), &far);
+    key[n] = static_cast<int>(k);  // written always, kept when within the radius
+    n += (far & 1) == 0;
+    key[n] = static_cast<int>(k + 1);
+    n += (far & 2) == 0;
+  }
+  for (; k < k1 && n < kFitMaxNeighbours && *looked < kMaxCandidates; ++k, ++*looked) {
+    const double ex = x[k] - px, ey = y[k] - py;
+    key[n] = static_cast<int>(k);
+    n += !(ex * ex + ey * ey > radius2);
+  }
+  return n;
+}
+
+// One pass over a[0, n) (no NaN) against g: the values < g counted, the smallest of those >= g
+// (+inf if none) and the largest of those < g (-inf if none), on lanes.
+struct Bracket {
+  int below;
+  double above, under;
+};
+
+Bracket BracketOf(const double* a, int n, double g) {
+  const D2 d;
+  const V2 vg = hn::Set(d, g), inf = hn::Set(d, kInf), minus_inf = hn::Set(d, -kInf);
+  V2 above = inf, under = minus_inf;
+  auto count = hn::Zero(DI2());
+  int i = 0;
+  for (; i + 2 <= n; i += 2) {
+    const V2 v = hn::LoadU(d, a + i);
+    const auto lt = hn::Lt(v, vg);
+    count = Tally(count, lt);
+    above = hn::Min(above, hn::IfThenElse(lt, inf, v));
+    under = hn::Max(under, hn::IfThenElse(lt, v, minus_inf));
+  }
+  const std::array<int, 2> c = Counts(count);
+  alignas(16) double hi[2], lo[2];
+  hn::Store(above, d, hi);
+  hn::Store(under, d, lo);
+  Bracket b{c[0] + c[1], std::min(hi[0], hi[1]), std::max(lo[0], lo[1])};
+  for (; i < n; ++i) {
+    const bool lt = a[i] < g;
+    b.below += lt;
+    if (lt) b.under = std::max(b.under, a[i]);
+    if (!lt) b.above = std::min(b.above, a[i]);
+  }
+  return b;
+}
+
 }  // namespace
 
 namespace detail {
@@ -333,10 +390,12 @@ double MadFloorBound(double floor) {
 
 double SelectRank(const double* a, int n, int k, double guess) {
   assert(0 <= k && k < n && n <= kFitMaxNeighbours);
-  int below = 0;  // values < guess
-  for (int i = 0; i < n; ++i) below += a[i] < guess;
+  const Bracket b = BracketOf(a, n, guess);
+  const int below = b.below;  // values < guess
   // Rank k is the (k - below)-th smallest of the values >= guess, or the (below - 1 - k)-th
-  // largest of those < guess.
+  // largest of those < guess: the first two cases (most passes) from the same pass.
+  if (below == k) return b.above;
+  if (below == k + 1) return b.under;
   if (below <= k && k - below < kNearRanks)
     return NearRank<Among::kAtLeast>(a, n, guess, k - below);
   if (below > k && below - 1 - k < kNearRanks)
@@ -390,7 +449,7 @@ void FitMemo::Add(const int* key, int n, bool ok, const DopplerFit& f) {
 // the median and the scale per lane (scalar, as RobustDopplerFit), a lane's work ending where its
 // fit does.
 void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound, DopplerFit f[2],
-                          bool ok[2]) {
+                          bool ok[2], double* first_guess) {
   assert(in[0].n >= 3 && in[0].n <= kFitMaxNeighbours);
   assert(in[1].n >= 3 && in[1].n <= kFitMaxNeighbours);
   const int n = (std::max(in[0].n, in[1].n) + 1) & ~1;  // even: ResidualsPair
@@ -411,7 +470,7 @@ void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound
     ok[l] = true;
   }
   SolvePair(ux, uy, y, w, n, f, ok);
-  double guess[2] = {floor_bound, floor_bound};  // the lanes' last medians selected
+  double guess[2] = {*first_guess, *first_guess};  // the lanes' last medians selected
   for (int it = 0; it < kIterations && (ok[0] || ok[1]); ++it) {
     int below[2], inliers[2];
     bool unordered[2];
@@ -420,6 +479,7 @@ void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound
     for (int l = 0; l < 2; ++l) {
       if (!ok[l]) continue;
       f[l].scale = Scale(rl[l], in[l].n, below[l], unordered[l], floor, &guess[l]);
+      if (it == 0) *first_guess = guess[l];
       c[l] = kTukey * f[l].scale;
     }
     TukeyWeightsPair(r, real, n, Lanes(c[0], c[1]), w, inliers);
@@ -432,11 +492,11 @@ void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound
   }
 }
 
-void RunFits::Submit(int i, int n) {
+void RunFits::Submit(int i, int n, const double* by_key) {
   assert(0 <= i && i < kRun);
   ok_[i] = false;
   if (n < 3) return;
-  const Gathered& g = queue_[queued_];
+  Gathered& g = queue_[queued_];
   if (memo_.Find(g.key, n, &ok_[i], &fit_[i])) return;
   for (int q = 0; q < queued_; ++q) {
     if (queued_n_[q] == n && std::equal(g.key, g.key + n, queue_[q].key)) {
@@ -445,6 +505,12 @@ void RunFits::Submit(int i, int n) {
       waiter_of_[waiters_++] = q;
       return;
     }
+  }
+  for (int k = 0; k < n; ++k) {  // a fit to compute: its inputs
+    const double* e = by_key + 3 * static_cast<std::ptrdiff_t>(g.key[k]);
+    g.ux[k] = e[0];
+    g.uy[k] = e[1];
+    g.y[k] = e[2];
   }
   queued_n_[queued_] = n;
   queued_i_[queued_++] = i;
@@ -459,7 +525,7 @@ void RunFits::FitQueued() {
   if (queued_ == 2) {
     const FitInput in[2] = {{queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0]},
                             {queue_[1].ux, queue_[1].uy, queue_[1].y, queued_n_[1]}};
-    RobustDopplerFitPair(in, floor_, floor_bound_, f, ok);
+    RobustDopplerFitPair(in, floor_, floor_bound_, f, ok, &first_guess_);
   } else if (queued_ == 1) {
     ok[0] = RobustDopplerFit(queue_[0].ux, queue_[0].uy, queue_[0].y, queued_n_[0], floor_,
                              floor_bound_, &f[0]);
@@ -479,11 +545,63 @@ void RunFits::FitQueued() {
 
 }  // namespace detail
 
-double MeasurementGrid::BucketGap(double p, int b, int nb, double origin) const {
-  const double edge = 1.0 / bucket_inv_;
+namespace {
+
+// Distance [m] along one axis from coordinate p to bucket b of nb along it, whose axis starts at
+// `origin` [m] (bucket edge 1 / inv [m]); the edge buckets reach out without end. The squared
+// distance of a point to a bucket is the sum of its two axes' squared gaps.
+double BucketGap(double p, int b, int nb, double origin, double inv) {
+  const double edge = 1.0 / inv;
   const double lo = origin + b * edge;
   return std::max({(b == 0 ? -kInf : lo) - p, 0.0, p - (b == nb - 1 ? kInf : lo + edge)});
 }
+
+}  // namespace
+
+namespace detail {
+
+int GatherNeighbours(const BucketView& v, double px, double py, int bx, int by, int reach,
+                     double radius2, int* key) {
+  const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(v.nbx - 1, bx + reach);
+  const int cy_lo = std::max(0, by - reach), cy_hi = std::min(v.nby - 1, by + reach);
+  // The squared gaps of the window's bucket columns and rows, once per detection (per bucket
+  // beyond kWindow of them: a radius of many buckets).
+  double gx2[kWindow], gy2[kWindow];
+  const bool tabled = cx_hi - cx_lo < kWindow && cy_hi - cy_lo < kWindow;
+  for (int cx = cx_lo; tabled && cx <= cx_hi; ++cx) {
+    const double g = BucketGap(px, cx, v.nbx, v.ox, v.inv);
+    gx2[cx - cx_lo] = g * g;
+  }
+  for (int cy = cy_lo; tabled && cy <= cy_hi; ++cy) {
+    const double g = BucketGap(py, cy, v.nby, v.oy, v.inv);
+    gy2[cy - cy_lo] = g * g;
+  }
+  const auto distance2 = [&](int cx, int cy) {  // from p to bucket (cx, cy) [m^2]
+    if (tabled) return gx2[cx - cx_lo] + gy2[cy - cy_lo];
+    const double gx = BucketGap(px, cx, v.nbx, v.ox, v.inv),
+                 gy = BucketGap(py, cy, v.nby, v.oy, v.inv);
+    return gx * gx + gy * gy;
+  };
+  int n = 0, looked = 0;
+  for (int cy = cy_lo; cy <= cy_hi; ++cy) {
+    const std::int64_t row = static_cast<std::int64_t>(cy) * v.nbx;
+    for (int cx = cx_lo; cx <= cx_hi; ++cx) {
+      // No neighbour can lie there (a relative margin for the rounding of BucketOf's edges).
+      if (distance2(cx, cy) > radius2 * (1.0 + 1e-9)) continue;
+      // A run of such buckets side by side: one range of bucket order.
+      const int first = cx;
+      while (cx < cx_hi && !(distance2(cx + 1, cy) > radius2 * (1.0 + 1e-9))) ++cx;
+      // The first kFitMaxNeighbours within the radius of the first kMaxCandidates looked at
+      // (v.x, v.y: in bucket order).
+      n = GatherRange(v.x, v.y, v.start[row + first], v.start[row + cx + 1], px, py, radius2, key,
+                      n, &looked);
+      if (n == kFitMaxNeighbours || looked == kMaxCandidates) return n;
+    }
+  }
+  return n;
+}
+
+}  // namespace detail
 
 void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const std::span<const Measurement> z = z_;
@@ -497,51 +615,14 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const double oy = static_cast<double>(origin_gy_) * params_.resolution;
   const double* const los = det_los_.data();  // ComputeLinesOfSight, this cycle
   const double* const los_b = det_los_b_.data();
-  // Detection j's neighbours into g; their count (0: not near the grid, no birth from it).
+  const BucketView buckets{
+      det_x_.data(), det_y_.data(), bucket_start_.data(), nbx_, nby_, bucket_inv_, ox, oy};
+  // Detection j's neighbours' keys into g; their count (0: not near the grid, no birth from it).
   const auto gather = [&](int j, RunFits::Gathered& g) {
     if (det_bucket_[j] < 0) return 0;
     const Position& p = z[j].position;
     const auto [bx, by] = BucketOf(p.x(), p.y());
-    const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(nbx_ - 1, bx + reach);
-    const int cy_lo = std::max(0, by - reach), cy_hi = std::min(nby_ - 1, by + reach);
-    // The squared gaps of the window's bucket columns and rows, once per detection (per bucket
-    // beyond kWindow of them: a radius of many buckets).
-    double gx2[kWindow], gy2[kWindow];
-    const bool tabled = cx_hi - cx_lo < kWindow && cy_hi - cy_lo < kWindow;
-    for (int cx = cx_lo; tabled && cx <= cx_hi; ++cx) {
-      const double g = BucketGap(p.x(), cx, nbx_, ox);
-      gx2[cx - cx_lo] = g * g;
-    }
-    for (int cy = cy_lo; tabled && cy <= cy_hi; ++cy) {
-      const double g = BucketGap(p.y(), cy, nby_, oy);
-      gy2[cy - cy_lo] = g * g;
-    }
-    const auto distance2 = [&](int cx, int cy) {  // from p to bucket (cx, cy) [m^2]
-      if (tabled) return gx2[cx - cx_lo] + gy2[cy - cy_lo];
-      const double gx = BucketGap(p.x(), cx, nbx_, ox), gy = BucketGap(p.y(), cy, nby_, oy);
-      return gx * gx + gy * gy;
-    };
-    int n = 0, looked = 0;
-    for (int cy = cy_lo; cy <= cy_hi; ++cy) {
-      for (int cx = cx_lo; cx <= cx_hi; ++cx) {
-        // No neighbour can lie there (a relative margin for the rounding of BucketOf's edges).
-        if (distance2(cx, cy) > radius2 * (1.0 + 1e-9)) continue;
-        const std::int64_t b = static_cast<std::int64_t>(cy) * nbx_ + cx;
-        for (std::int64_t k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k, ++looked) {
-          // The first kFitMaxNeighbours within the radius of the first kMaxCandidates looked at.
-          if (n == kFitMaxNeighbours || looked == kMaxCandidates) goto gathered;
-          // det_x_/det_y_, los_b: the positions and lines of sight in bucket order (contiguous).
-          const double ex = det_x_[k] - p.x(), ey = det_y_[k] - p.y();
-          g.ux[n] = los_b[3 * k];  // written always, kept when within the radius (no branch)
-          g.uy[n] = los_b[3 * k + 1];
-          g.y[n] = los_b[3 * k + 2];
-          g.key[n] = static_cast<int>(k);
-          n += !(ex * ex + ey * ey > radius2);
-        }
-      }
-    }
-  gathered:
-    return n;
+    return GatherNeighbours(buckets, p.x(), p.y(), bx, by, reach, radius2, g.key);
   };
   // Runs of RunFits::kRun detections in detection order (one object's detections of one scan
   // side by side: often equal neighbourhoods).
@@ -549,7 +630,7 @@ void MeasurementGrid::FitDetectionVelocities(const Team& t) {
   const auto run = [&](std::int64_t r) {
     RunFits fits(floor, floor_bound);
     const int j0 = static_cast<int>(r) * kRun, end = std::min(nz, j0 + kRun);
-    for (int j = j0; j < end; ++j) fits.Submit(j - j0, gather(j, fits.Next()));
+    for (int j = j0; j < end; ++j) fits.Submit(j - j0, gather(j, fits.Next()), los_b);
     fits.Finish();
     for (int j = j0; j < end; ++j) {
       det_fit_t_[j] = 0.0;

@@ -3,7 +3,8 @@
 // its defining property, RobustDopplerFit against the plain fit of reference/doppler_fit.hpp on
 // random neighbourhoods that take every path: the floor, a median near the last one, the
 // quickselect, failures, NaN; RobustDopplerFitPair and RunFits against RobustDopplerFit; FitMemo's
-// keys) and the field of view's bearings on SIMD lanes (FastAtan2Lanes).
+// keys; GatherNeighbours against the bucket-by-bucket gathering) and the field of view's bearings
+// on SIMD lanes (FastAtan2Lanes).
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -215,6 +216,7 @@ TEST_CASE("RobustDopplerFitPair gives each lane's single fit bit for bit",
   // padded), fits that fail (at the start or in a later reweighting) beside fits that do not.
   CounterRng rng(13, RngPurpose::kTest, 0, 0);
   int outcomes[2][2] = {};  // [lane 0 ok][lane 1 ok]
+  double guess = 1.0;       // the pairs' first median guess
   for (int pair = 0; pair < 6000; ++pair) {
     const Hood a = AnyHood(rng);
     const Hood b = pair % 5 == 0 ? DrawHood(rng, a.n(), 0.1, 0.2, 1.5) : AnyHood(rng);
@@ -223,7 +225,10 @@ TEST_CASE("RobustDopplerFitPair gives each lane's single fit bit for bit",
                                             {b.ux.data(), b.uy.data(), b.y.data(), b.n()}};
     DopplerFit f[2];
     bool ok[2];
-    filter::detail::RobustDopplerFitPair(in, floor, filter::detail::MadFloorBound(floor), f, ok);
+    // Any first guess (it only steers the selection): the last pair's, or a far one.
+    if (pair % 3 == 0) guess = pair % 2 == 0 ? kInf : 0.0;
+    filter::detail::RobustDopplerFitPair(in, floor, filter::detail::MadFloorBound(floor), f, ok,
+                                         &guess);
     INFO("pair " << pair << " n " << a.n() << ", " << b.n());
     REQUIRE(SameAsSingle(a, ok[0], f[0], floor));
     REQUIRE(SameAsSingle(b, ok[1], f[1], floor));
@@ -259,16 +264,24 @@ TEST_CASE("RunFits gives every detection its single fit, repeats and short lists
       for (std::size_t k = 0; k < key.size(); ++k) key[k] = 1000 * i + static_cast<int>(k);
       keys.push_back(key);
     }
+    // The neighbours' (ux, uy, y) by key, as Submit reads them.
+    std::vector<double> by_key(3 * 1000 * RunFits::kRun, std::nan(""));
+    for (int i = 0; i < size; ++i) {
+      const Hood& h = hoods[static_cast<std::size_t>(i)];
+      for (int k = 0; k < h.n(); ++k) {
+        const std::size_t e = 3 * static_cast<std::size_t>(keys[static_cast<std::size_t>(i)][k]);
+        by_key[e] = h.ux[k];
+        by_key[e + 1] = h.uy[k];
+        by_key[e + 2] = h.y[k];
+      }
+    }
     auto fits = std::make_unique<RunFits>(0.1, filter::detail::MadFloorBound(0.1));
     for (int i = 0; i < size; ++i) {
       RunFits::Gathered& g = fits->Next();
       const Hood& h = hoods[static_cast<std::size_t>(i)];
-      std::copy(h.ux.begin(), h.ux.end(), g.ux);
-      std::copy(h.uy.begin(), h.uy.end(), g.uy);
-      std::copy(h.y.begin(), h.y.end(), g.y);
       std::copy(keys[static_cast<std::size_t>(i)].begin(), keys[static_cast<std::size_t>(i)].end(),
                 g.key);
-      fits->Submit(i, h.n());
+      fits->Submit(i, h.n(), by_key.data());
     }
     fits->Finish();
     for (int i = 0; i < size; ++i) {
@@ -283,6 +296,76 @@ TEST_CASE("RunFits gives every detection its single fit, repeats and short lists
       }
     }
   }
+}
+
+TEST_CASE("GatherNeighbours keeps the neighbours of the bucket-by-bucket gathering",
+          "[filter][doppler_fit]") {
+  CounterRng rng(23, RngPurpose::kTest, 0, 0);
+  int capped = 0, budget = 0, gathered = 0;  // queries that hit each cap; with neighbours
+  for (int round = 0; round < 400; ++round) {
+    // A bucket grid of nbx x nby buckets of edge e from (ox, oy), points placed as BucketOf
+    // places them (the edge buckets reaching out), some rounds crowded.
+    const int nbx = 1 + static_cast<int>(rng.NextU32() % 9),
+              nby = 1 + static_cast<int>(rng.NextU32() % 9);
+    const double e = rng.Uniform(0.5, 4.0), inv = 1.0 / e;
+    const double ox = rng.Uniform(-50.0, 50.0), oy = rng.Uniform(-50.0, 50.0);
+    const int points = static_cast<int>(rng.NextU32() % (round % 4 == 0 ? 3000 : 200));
+    const auto bucket_of = [&](double px, double py) {
+      const double fx = std::clamp(std::floor((px - ox) * inv), 0.0, nbx - 1.0);
+      const double fy = std::clamp(std::floor((py - oy) * inv), 0.0, nby - 1.0);
+      return std::pair<int, int>{static_cast<int>(fx), static_cast<int>(fy)};
+    };
+    const auto draw = [&] {  // a point on or a little beyond the grid
+      return std::pair<double, double>{ox + rng.Uniform(-0.2, 1.2) * nbx * e,
+                                       oy + rng.Uniform(-0.2, 1.2) * nby * e};
+    };
+    std::vector<std::vector<std::pair<double, double>>> in(static_cast<std::size_t>(nbx * nby));
+    for (int i = 0; i < points; ++i) {
+      const auto p = draw();
+      const auto [bx, by] = bucket_of(p.first, p.second);
+      in[static_cast<std::size_t>(by * nbx + bx)].push_back(p);
+    }
+    std::vector<double> x, y;
+    std::vector<std::int64_t> start{0};
+    for (const auto& b : in) {
+      for (const auto& p : b) {
+        x.push_back(p.first);
+        y.push_back(p.second);
+      }
+      start.push_back(static_cast<std::int64_t>(x.size()));
+    }
+    const filter::detail::BucketView v{x.data(), y.data(), start.data(), nbx, nby, inv, ox, oy};
+    for (int q = 0; q < 20; ++q) {
+      const auto [px, py] =
+          q < 10 && !x.empty()
+              ? std::pair<double, double>{x[rng.NextU32() % x.size()], y[rng.NextU32() % y.size()]}
+              : draw();
+      const auto [bx, by] = bucket_of(px, py);
+      // Small radii in crowded rounds: the candidates' budget binds before the list is full.
+      const bool small = round % 4 == 0 && q % 2 == 0;
+      const double radius = (small ? rng.Uniform(0.05, 0.4) : rng.Uniform(0.1, 2.5)) * e;
+      const int reach = static_cast<int>(std::ceil(radius * inv));
+      int want[kFitMaxNeighbours], got[kFitMaxNeighbours];
+      const int n_want = filter_ref::GatherRef(v, px, py, bx, by, reach, radius * radius, want);
+      const int n_got =
+          filter::detail::GatherNeighbours(v, px, py, bx, by, reach, radius * radius, got);
+      INFO("round " << round << " query " << q);
+      REQUIRE(n_got == n_want);
+      REQUIRE(std::equal(want, want + n_want, got));
+      capped += n_want == kFitMaxNeighbours;
+      gathered += n_want > 0;
+      int within = 0;  // all points within the radius: more than kept under the cap: the budget
+      for (std::size_t k = 0; k < x.size(); ++k)
+        within += !((x[k] - px) * (x[k] - px) + (y[k] - py) * (y[k] - py) > radius * radius);
+      budget += n_want < std::min(within, kFitMaxNeighbours);
+    }
+  }
+  // Every path taken: queries with and without neighbours, lists cut at kFitMaxNeighbours and
+  // by the kMaxCandidates looked at.
+  INFO("capped " << capped << " budget " << budget << " gathered " << gathered);
+  CHECK(capped > 50);
+  CHECK(budget > 50);
+  CHECK(gathered > 1000);
 }
 
 TEST_CASE("FitMemo finds a fit only under its exact key, the newest slots kept",

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "dualgrid/filter/doppler_fit.hpp"
 
@@ -53,6 +55,38 @@ inline bool RobustFit(const double* ux, const double* uy, const double* y, int n
     if (f->inliers < 3 || !SolveFit(ux, uy, y, w, n, f)) return false;
   }
   return true;
+}
+
+// The fit's gathering as it was before the runs of buckets (issue 37, c65417c): bucket by bucket
+// in each row, every point of a bucket not wholly beyond the radius looked at, the first
+// kFitMaxNeighbours within the radius kept among the first kMaxCandidates looked at.
+inline double BucketGapRef(double p, int b, int nb, double origin, double inv) {
+  const double edge = 1.0 / inv;
+  const double lo = origin + b * edge;
+  const double inf = std::numeric_limits<double>::infinity();
+  return std::max({(b == 0 ? -inf : lo) - p, 0.0, p - (b == nb - 1 ? inf : lo + edge)});
+}
+
+inline int GatherRef(const filter::detail::BucketView& v, double px, double py, int bx, int by,
+                     int reach, double radius2, int* key) {
+  const int cx_lo = std::max(0, bx - reach), cx_hi = std::min(v.nbx - 1, bx + reach);
+  const int cy_lo = std::max(0, by - reach), cy_hi = std::min(v.nby - 1, by + reach);
+  int n = 0, looked = 0;
+  for (int cy = cy_lo; cy <= cy_hi; ++cy) {
+    for (int cx = cx_lo; cx <= cx_hi; ++cx) {
+      const double gx = BucketGapRef(px, cx, v.nbx, v.ox, v.inv);
+      const double gy = BucketGapRef(py, cy, v.nby, v.oy, v.inv);
+      if (gx * gx + gy * gy > radius2 * (1.0 + 1e-9)) continue;
+      const std::int64_t b = static_cast<std::int64_t>(cy) * v.nbx + cx;
+      for (std::int64_t k = v.start[b]; k < v.start[b + 1]; ++k, ++looked) {
+        if (n == filter::detail::kFitMaxNeighbours || looked == filter::detail::kMaxCandidates)
+          return n;
+        const double ex = v.x[k] - px, ey = v.y[k] - py;
+        if (!(ex * ex + ey * ey > radius2)) key[n++] = static_cast<int>(k);
+      }
+    }
+  }
+  return n;
 }
 
 }  // namespace dualgrid::filter_ref

@@ -5,10 +5,36 @@
 // bit, against its definition.
 #pragma once
 
+#include <cstdint>
+
 namespace dualgrid::filter::detail {
 
 /// Neighbours per fit at most (the first ones in bucket order).
 constexpr int kFitMaxNeighbours = 64;
+
+/// Candidates looked at per detection at most (docs/algorithm.md, step 4a): bounds a fit's cost
+/// when thousands of detections crowd its buckets, so that a cycle's cost stays linear in them.
+constexpr int kMaxCandidates = 8 * kFitMaxNeighbours;
+
+/// The detection buckets as the fit's gathering reads them: bucket (cx, cy) of nbx x nby holds
+/// the points start[cy nbx + cx] to start[cy nbx + cx + 1] - 1 of x, y [m] (bucket order); the
+/// buckets' edge is 1 / inv [m], bucket (0, 0) starts at (ox, oy) [m], and the edge buckets reach
+/// out without end. Borrowed arrays.
+struct BucketView {
+  const double* x;
+  const double* y;
+  const std::int64_t* start;
+  int nbx, nby;
+  double inv, ox, oy;
+};
+
+/// A detection's neighbours at (px, py) [m] in bucket (bx, by) (the one it is placed in): the
+/// bucket-order positions of the first kFitMaxNeighbours points within sqrt(radius2) [m] of it
+/// among the first kMaxCandidates looked at, the buckets within `reach` of (bx, by) looked at row
+/// by row (those wholly beyond the radius skipped). Into key (kFitMaxNeighbours entries); returns
+/// their count.
+int GatherNeighbours(const BucketView& v, double px, double py, int bx, int by, int reach,
+                     double radius2, int* key);
 
 /// The fit's result: the velocity [m/s], the scale sigma [m/s] and A = sum_i w_i u_i u_i^T at
 /// the solution (its entries a00, a01, a11), and the inliers of the last reweighting.
@@ -48,9 +74,11 @@ struct FitInput {
 
 /// RobustDopplerFit of two neighbourhoods at once, one per SIMD lane: ok[l] and f[l] are what
 /// RobustDopplerFit(in[l], floor, floor_bound) gives, bit for bit (f[l] partial where ok[l] is
-/// false).
+/// false). *first_guess [m/s, any value]: where the first pass's median selection starts
+/// (SelectRank's guess: it only steers the work); set to the last first-pass median selected, a
+/// good start for the next pair of a run (neighbouring detections, similar residuals).
 void RobustDopplerFitPair(const FitInput in[2], double floor, double floor_bound, DopplerFit f[2],
-                          bool ok[2]);
+                          bool ok[2], double* first_guess);
 
 /// The last few fits of one thread's run of detections, each under its key: the neighbours it
 /// gathered (their positions in the detection buckets, in gathering order). RobustDopplerFit is a
@@ -84,17 +112,19 @@ class FitMemo {
 class RunFits {
  public:
   static constexpr int kRun = 32;
-  /// A neighbourhood: the gathered arrays and their key (FitMemo).
+  /// A neighbourhood: its key (FitMemo), and the arrays Submit fills from it.
   struct Gathered {
     double ux[kFitMaxNeighbours], uy[kFitMaxNeighbours], y[kFitMaxNeighbours];
     int key[kFitMaxNeighbours];
   };
 
   RunFits(double floor, double floor_bound) : floor_(floor), floor_bound_(floor_bound) {}
-  /// Where the next neighbourhood is gathered before Submit.
+  /// Where the next neighbourhood's key is gathered before Submit.
   Gathered& Next() { return queue_[queued_]; }
-  /// Detection i's neighbourhood: the first n entries of Next(). n < 3: no fit. Each i once.
-  void Submit(int i, int n);
+  /// Detection i's neighbourhood: the first n entries of Next().key, whose ux, uy and y are
+  /// by_key[3 key], [3 key + 1], [3 key + 2] (read only for a fit not found in the memo or the
+  /// queue). n < 3: no fit. Each i once.
+  void Submit(int i, int n, const double* by_key);
   /// Fits what is still queued; then Result holds every submitted detection's fit.
   void Finish();
   /// Detection i's fit after Finish (false: no fit; *f then unspecified).
@@ -107,6 +137,7 @@ class RunFits {
   void FitQueued();  // the queue's one or two fits, their results and their waiters'
 
   double floor_, floor_bound_;
+  double first_guess_ = floor_bound_;  // RobustDopplerFitPair's, carried from pair to pair
   FitMemo memo_;
   Gathered queue_[2];
   int queued_ = 0, queued_n_[2] = {0, 0}, queued_i_[2] = {0, 0};

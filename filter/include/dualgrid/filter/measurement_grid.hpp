@@ -149,10 +149,6 @@ class MeasurementGrid {
   // Detection bucket (clamped to the bucket grid) of a point. Inline: UpdateCells asks it for
   // every cell holding particles.
   std::pair<int, int> BucketOf(double px, double py) const;
-  // Distance [m] along one axis from coordinate p to bucket b of nb along it, whose axis starts
-  // at `origin` [m]; the edge buckets reach out without end (BucketOf clamps to them). The
-  // squared distance of a point to a bucket is the sum of its two axes' squared gaps.
-  double BucketGap(double p, int b, int nb, double origin) const;
 
   FilterParams params_;
   bool with_fit_ = false;
