@@ -79,6 +79,20 @@ Edge RandomEdge(CounterRng& rng, const Position& s) {
   return {a, a + length * UnitVector(heading)};
 }
 
+// `count` straight-ish rails alternating left and right of the x axis (4 - 20 m off it), from
+// -half_length to half_length [m], with corners every min_gap - max_gap [m].
+void AddRandomRails(radar::Scene& scene, CounterRng& rng, int count, double half_length,
+                    double min_gap, double max_gap) {
+  for (int i = 0; i < count; ++i) {
+    radar::Polyline line;
+    line.id = 1000 + i;
+    const double y = (i % 2 == 0 ? -1.0 : 1.0) * rng.Uniform(4.0, 20.0);
+    for (double x = -half_length; x < half_length; x += rng.Uniform(min_gap, max_gap))
+      line.points.push_back(Position(x, y + rng.Uniform(-0.5, 0.5)));
+    scene.polylines.push_back(line);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("WalkEdges gives the kept samples of WalkEdge bit for bit", "[radar][edge_walk]") {
@@ -142,14 +156,7 @@ TEST_CASE("the scan keeps the rails' scatterers in walking order", "[radar][edge
                           rng.Uniform(-0.3, 0.3), 4.5, 1.8};
       scene.targets.push_back(t);
     }
-    for (int i = 0; i < 4; ++i) {
-      radar::Polyline line;
-      line.id = 1000 + i;
-      const double y = (i % 2 == 0 ? -1.0 : 1.0) * rng.Uniform(4.0, 20.0);
-      for (double x = -200.0; x < 200.0; x += rng.Uniform(3.0, 60.0))
-        line.points.push_back(Position(x, y + rng.Uniform(-0.5, 0.5)));
-      scene.polylines.push_back(line);
-    }
+    AddRandomRails(scene, rng, 4, 200.0, 3.0, 60.0);
     radar::EgoMotion ego;
     ego.pose = Pose2{Position(0.0, 0.0), rng.Uniform(-0.2, 0.2)};
     ego.velocity = Velocity(25.0, 0.0);
@@ -264,14 +271,7 @@ TEST_CASE("Scan with the sensors' rails walked together equals ScanSensor per se
       t.yaw_rate = rng.Uniform(-0.2, 0.2);
       scene.targets.push_back(t);
     }
-    for (int i = 0; i < 3; ++i) {
-      radar::Polyline line;
-      line.id = 1000 + i;
-      const double y = (i % 2 == 0 ? -1.0 : 1.0) * rng.Uniform(4.0, 20.0);
-      for (double x = -250.0; x < 250.0; x += rng.Uniform(5.0, 200.0))
-        line.points.push_back(Position(x, y + rng.Uniform(-0.5, 0.5)));
-      scene.polylines.push_back(line);
-    }
+    AddRandomRails(scene, rng, 3, 250.0, 5.0, 200.0);
     radar::EgoMotion ego;
     ego.pose = Pose2{Position(rng.Uniform(-5.0, 5.0), 0.0), rng.Uniform(-0.3, 0.3)};
     ego.velocity = Velocity(rng.Uniform(0.0, 35.0), 0.0);
